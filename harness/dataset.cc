@@ -1,0 +1,865 @@
+#include "harness/dataset.h"
+
+#include <signal.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+namespace harness {
+namespace fs = std::filesystem;
+namespace {
+
+// Name of the file in a partial folder that records the writing process (removed by Finish).
+constexpr const char* kWriterPidFile = ".writer_pid";
+// Tolerances for "is this a rotation" on options and EuRoC extrinsics.
+constexpr double kRotationTolerance = 1e-6;  // max |R^T R - I| entry
+// An EuRoC pair counts as already rectified within these.
+constexpr double kRectifiedIntrinsicsTolerancePx = 1e-6;
+constexpr double kRectifiedRotationTolerance = 1e-6;  // max |R_cam0_cam1 - I| entry
+constexpr double kRectifiedOffsetToleranceM = 1e-6;   // |y|, |z| of cam1 in cam0 (metres)
+constexpr double kRectifiedDistortionTolerance = 1e-12;
+
+constexpr const char* kEurocGroundTruthHeader =
+    "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
+    "q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], "
+    "b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], "
+    "b_a_RS_S_z [m s^-2]";
+
+bool Fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+std::string Where(const std::string& path, int line) {
+  return path + ":" + std::to_string(line) + ": ";
+}
+
+std::string Join(const std::string& a, const std::string& b) { return (fs::path(a) / b).string(); }
+
+std::string FrameName(size_t index, const char* extension) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06zu%s", index, extension);
+  return name;
+}
+
+std::string SizeText(const cv::Mat& m) {
+  return std::to_string(m.cols) + "x" + std::to_string(m.rows);
+}
+
+bool IsRotation(const Eigen::Matrix3d& R, double tolerance) {
+  if (!R.allFinite()) return false;
+  const double err = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  return err <= tolerance && R.determinant() > 0.0;
+}
+
+bool WriteBytes(const std::string& path, const std::vector<uchar>& bytes, std::string* error) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return Fail(error, path + ": cannot open for writing");
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  if (!out) return Fail(error, path + ": write error");
+  return true;
+}
+
+bool MakeDir(const std::string& path, std::string* error) {
+  std::error_code ec;
+  fs::create_directories(path, ec);
+  if (ec) return Fail(error, path + ": cannot create folder: " + ec.message());
+  return true;
+}
+
+// Folder names without a trailing separator ("out/" -> "out"), so "DIR.partial-" is a sibling.
+std::string NormalizeDir(const std::string& dir) {
+  fs::path p = fs::path(dir).lexically_normal();
+  std::string s = p.string();
+  while (s.size() > 1 && s.back() == '/') s.pop_back();
+  return s;
+}
+
+// z-depth (metres, float) -> millimetres (uint16); 0 where there is no representable depth.
+cv::Mat DepthToMillimetres(const cv::Mat& depth_m) {
+  cv::Mat mm(depth_m.size(), CV_16UC1);
+  for (int r = 0; r < depth_m.rows; ++r) {
+    const float* src = depth_m.ptr<float>(r);
+    uint16_t* dst = mm.ptr<uint16_t>(r);
+    for (int c = 0; c < depth_m.cols; ++c) {
+      const double d = src[c];
+      long long v = 0;
+      if (std::isfinite(d) && d > 0.0) v = std::llround(d * 1000.0);
+      dst[c] = (v > 0 && v <= 65535) ? static_cast<uint16_t>(v) : 0;
+    }
+  }
+  return mm;
+}
+
+// Removes "<dir>.partial-*" siblings left by writer processes that no longer run.
+void RemoveStalePartials(const std::string& dir) {
+  const fs::path target(dir);
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string prefix = target.filename().string() + ".partial-";
+  std::error_code ec;
+  std::vector<fs::path> stale;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    std::ifstream pid_in(it->path() / kWriterPidFile);
+    long pid = 0;
+    if (!(pid_in >> pid) || pid <= 0) continue;  // not ours, or still being created
+    if (::kill(static_cast<pid_t>(pid), 0) == -1 && errno == ESRCH) stale.push_back(it->path());
+  }
+  for (const fs::path& p : stale) fs::remove_all(p, ec);
+}
+
+std::string CalibRow(const char* key, const double p[12]) {
+  std::string row = key;
+  for (int i = 0; i < 12; ++i) row += ' ' + FormatDouble(p[i]);
+  return row + '\n';
+}
+
+std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d& T_body_cam,
+                            const vo::StereoCamera& camera, double rate_hz) {
+  const Eigen::Matrix4d& T = T_body_cam.matrix();
+  std::string s;
+  s += "# General sensor definitions.\n";
+  s += "sensor_type: camera\n";
+  s += "comment: " + comment + "\n\n";
+  s += "# Sensor extrinsics wrt. the body-frame.\n";
+  s += "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
+  for (int r = 0; r < 4; ++r) {
+    if (r > 0) s += "         ";
+    for (int c = 0; c < 4; ++c) {
+      s += FormatDouble(r == 3 ? (c == 3 ? 1.0 : 0.0) : T(r, c));
+      s += (c < 3) ? ", " : (r < 3 ? ",\n" : "]\n");
+    }
+  }
+  s += "\n# Camera specific definitions.\n";
+  s += "rate_hz: " + FormatDouble(rate_hz) + "\n";
+  s += "resolution: [" + std::to_string(camera.width) + ", " + std::to_string(camera.height) + "]\n";
+  s += "camera_model: pinhole\n";
+  s += "intrinsics: [" + FormatDouble(camera.fx_px) + ", " + FormatDouble(camera.fy_px) + ", " +
+       FormatDouble(camera.cx_px) + ", " + FormatDouble(camera.cy_px) + "] #fu, fv, cu, cv\n";
+  s += "distortion_model: radial-tangential\n";
+  s += "distortion_coefficients: [0, 0, 0, 0]\n";
+  return s;
+}
+
+// Splits a CSV line on ',' and trims blanks around each field.
+std::vector<std::string_view> SplitCsv(std::string_view line) {
+  std::vector<std::string_view> fields;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = line.find(',', start);
+    std::string_view f = line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
+    while (!f.empty() && (f.front() == ' ' || f.front() == '\t')) f.remove_prefix(1);
+    while (!f.empty() && (f.back() == ' ' || f.back() == '\t')) f.remove_suffix(1);
+    fields.push_back(f);
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return fields;
+}
+
+bool ParseInt64(std::string_view text, int64_t* value) {
+  if (text.empty()) return false;
+  const std::from_chars_result r = std::from_chars(text.data(), text.data() + text.size(), *value);
+  return r.ec == std::errc() && r.ptr == text.data() + text.size();
+}
+
+double NsToSeconds(int64_t t_ns) { return static_cast<double>(t_ns) / 1e9; }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+bool ParseDatasetFormat(const std::string& name, DatasetFormat* format) {
+  if (name == "kitti") *format = DatasetFormat::kKitti;
+  else if (name == "euroc") *format = DatasetFormat::kEuroc;
+  else return false;
+  return true;
+}
+
+const char* DatasetFormatName(DatasetFormat format) {
+  switch (format) {
+    case DatasetFormat::kKitti: return "kitti";
+    case DatasetFormat::kEuroc: return "euroc";
+  }
+  return "unknown";
+}
+
+int64_t TimeToNs(double time_s) { return std::llround(time_s * 1e9); }
+
+// ---------------------------------------------------------------------------------------------
+// DatasetWriter
+
+bool DatasetWriter::Options::IsValid(std::string* error) const {
+  if (format != DatasetFormat::kKitti && format != DatasetFormat::kEuroc)
+    return Fail(error, "format must be kitti or euroc");
+  if (png_compression < 0 || png_compression > 9)
+    return Fail(error, "png_compression must be in [0, 9], got " + std::to_string(png_compression));
+  if (!T_body_cam0.matrix().allFinite() || !IsRotation(T_body_cam0.linear(), kRotationTolerance))
+    return Fail(error, "T_body_cam0 must be finite with a rotation in its linear part");
+  if (!std::isfinite(rate_hz) || rate_hz < 0.0)
+    return Fail(error, "rate_hz must be finite and >= 0, got " + FormatDouble(rate_hz));
+  return true;
+}
+
+DatasetWriter::~DatasetWriter() { RemovePartial(); }
+
+void DatasetWriter::RemovePartial() {
+  if (finished_ || partial_dir_.empty()) return;
+  std::error_code ec;
+  fs::remove_all(partial_dir_, ec);
+  partial_dir_.clear();
+}
+
+bool DatasetWriter::Open(const std::string& dir, const vo::StereoCamera& camera,
+                         std::string* error) {
+  if (is_open() || finished_) return Fail(error, "DatasetWriter::Open: writer already used");
+  std::string why;
+  if (!options_.IsValid(&why)) return Fail(error, "DatasetWriter options: " + why);
+  if (!camera.IsValid(&why)) return Fail(error, "DatasetWriter camera: " + why);
+  if (dir.empty()) return Fail(error, "DatasetWriter: empty output folder name");
+  dir_ = NormalizeDir(dir);
+  camera_ = camera;
+
+  std::error_code ec;
+  if (fs::exists(dir_, ec)) {
+    if (!fs::is_directory(dir_, ec))
+      return Fail(error, dir_ + ": exists and is not a folder; refusing to replace it");
+    if (!options_.overwrite)
+      return Fail(error, dir_ + ": output folder already exists (set overwrite to replace it)");
+  }
+  const fs::path parent = fs::path(dir_).has_parent_path() ? fs::path(dir_).parent_path()
+                                                            : fs::path(".");
+  if (!MakeDir(parent.string(), error)) return false;
+  RemoveStalePartials(dir_);
+
+  // The partial folder: a unique sibling, created atomically.
+  std::string pattern = dir_ + ".partial-XXXXXX";
+  std::vector<char> buffer(pattern.begin(), pattern.end());
+  buffer.push_back('\0');
+  if (::mkdtemp(buffer.data()) == nullptr)
+    return Fail(error, pattern + ": cannot create the partial folder: " + std::strerror(errno));
+  partial_dir_ = buffer.data();
+  {
+    std::ofstream pid_out(Join(partial_dir_, kWriterPidFile));
+    pid_out << ::getpid() << '\n';
+  }
+
+  std::vector<std::string> folders = {"image_0", "image_1"};
+  if (options_.format == DatasetFormat::kEuroc) {
+    folders.push_back("mav0/cam0/data");
+    folders.push_back("mav0/cam1/data");
+  }
+  for (const std::string& f : folders) {
+    if (!MakeDir(Join(partial_dir_, f), error)) {
+      RemovePartial();
+      return false;
+    }
+  }
+  compression_params_ = {cv::IMWRITE_PNG_COMPRESSION, options_.png_compression,
+                         cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT};
+  return true;
+}
+
+bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
+  if (!is_open()) return Fail(error, "DatasetWriter::Add: writer is not open");
+  const size_t index = times_s_.size();
+  const std::string what = dir_ + ": frame " + std::to_string(index) + ": ";
+  const cv::Size size(camera_.width, camera_.height);
+  if (!std::isfinite(frame.time_s)) return Fail(error, what + "time is not finite");
+  const int64_t t_ns = TimeToNs(frame.time_s);
+  if (index > 0 && t_ns <= times_ns_.back())
+    return Fail(error, what + "time " + FormatDouble(frame.time_s) +
+                           " s is not after the previous frame's (need strictly increasing ns)");
+  if (frame.left.type() != CV_8UC1 || frame.left.size() != size)
+    return Fail(error, what + "left image must be CV_8UC1 " + std::to_string(size.width) + "x" +
+                           std::to_string(size.height) + ", got type " +
+                           std::to_string(frame.left.type()) + " " + SizeText(frame.left));
+  if (frame.right.type() != CV_8UC1 || frame.right.size() != size)
+    return Fail(error, what + "right image must be CV_8UC1 " + std::to_string(size.width) + "x" +
+                           std::to_string(size.height) + ", got type " +
+                           std::to_string(frame.right.type()) + " " + SizeText(frame.right));
+  const bool frame_depth = options_.write_depth && !frame.depth_m.empty();
+  if (frame_depth && (frame.depth_m.type() != CV_32FC1 || frame.depth_m.size() != size))
+    return Fail(error, what + "depth must be CV_32FC1 of the image size, got type " +
+                           std::to_string(frame.depth_m.type()) + " " + SizeText(frame.depth_m));
+  if (index == 0) {
+    has_gt_ = frame.has_gt;
+    has_depth_ = frame_depth;
+    if (has_depth_ && !MakeDir(Join(partial_dir_, "depth"), error)) return false;
+  } else {
+    if (frame.has_gt != has_gt_)
+      return Fail(error, what + (has_gt_ ? "has no ground truth but frame 0 has"
+                                         : "has ground truth but frame 0 has none"));
+    if (frame_depth != has_depth_)
+      return Fail(error, what + (has_depth_ ? "has no depth but frame 0 has"
+                                            : "has depth but frame 0 has none"));
+  }
+  if (has_gt_ && !frame.T_world_cam0.matrix().allFinite())
+    return Fail(error, what + "ground-truth pose is not finite");
+
+  // Images: encode once, write the same bytes to every layout.
+  const std::string png_ns = std::to_string(t_ns) + ".png";
+  for (int cam = 0; cam < 2; ++cam) {
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", cam == 0 ? frame.left : frame.right, png, compression_params_))
+      return Fail(error, what + "PNG encoding failed");
+    const std::string cam_name = std::to_string(cam);
+    if (!WriteBytes(Join(partial_dir_, "image_" + cam_name + "/" + FrameName(index, ".png")), png,
+                    error))
+      return false;
+    if (options_.format == DatasetFormat::kEuroc &&
+        !WriteBytes(Join(partial_dir_, "mav0/cam" + cam_name + "/data/" + png_ns), png, error))
+      return false;
+  }
+  if (has_depth_) {
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", DepthToMillimetres(frame.depth_m), png, compression_params_))
+      return Fail(error, what + "depth PNG encoding failed");
+    if (!WriteBytes(Join(partial_dir_, "depth/" + FrameName(index, ".png")), png, error))
+      return false;
+  }
+  times_s_.push_back(frame.time_s);
+  times_ns_.push_back(t_ns);
+  if (has_gt_) T_world_cam0_.push_back(frame.T_world_cam0);
+  return true;
+}
+
+bool DatasetWriter::WriteEurocText(std::string* error) const {
+  const size_t n = times_s_.size();
+  double rate_hz = options_.rate_hz;
+  if (rate_hz == 0.0 && n >= 2) {
+    std::vector<double> dt;
+    for (size_t i = 1; i < n; ++i) dt.push_back(times_s_[i] - times_s_[i - 1]);
+    std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+    rate_hz = std::round(1e3 / dt[dt.size() / 2]) / 1e3;  // to 1 mHz: 30, not 29.99999999997
+  }
+  Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
+  T_cam0_cam1.translation() = Eigen::Vector3d(camera_.baseline_m, 0.0, 0.0);
+  const Eigen::Isometry3d T_body_cam[2] = {options_.T_body_cam0,
+                                           options_.T_body_cam0 * T_cam0_cam1};
+  const char* comments[2] = {"vobench cam0 (left)", "vobench cam1 (right)"};
+  for (int cam = 0; cam < 2; ++cam) {
+    const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));
+    std::string csv = "#timestamp [ns],filename\n";
+    for (int64_t t_ns : times_ns_) csv += std::to_string(t_ns) + "," + std::to_string(t_ns) + ".png\n";
+    if (!WriteTextFile(Join(base, "data.csv"), csv, error)) return false;
+    if (!WriteTextFile(Join(base, "sensor.yaml"),
+                       EurocSensorYaml(comments[cam], T_body_cam[cam], camera_, rate_hz), error))
+      return false;
+  }
+  if (!has_gt_) return true;
+
+  // Ground truth: body pose in the world, velocity by finite differences, zero biases.
+  const std::string gt_dir = Join(partial_dir_, "mav0/state_groundtruth_estimate0");
+  if (!MakeDir(gt_dir, error)) return false;
+  const Eigen::Isometry3d T_cam0_body = options_.T_body_cam0.inverse();
+  std::vector<Eigen::Isometry3d> T_world_body(n);
+  for (size_t i = 0; i < n; ++i) T_world_body[i] = T_world_cam0_[i] * T_cam0_body;
+  std::string csv = std::string(kEurocGroundTruthHeader) + "\n";
+  for (size_t i = 0; i < n; ++i) {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    if (n >= 2) {
+      const size_t a = i == 0 ? 0 : i - 1, b = i + 1 == n ? n - 1 : i + 1;
+      v = (T_world_body[b].translation() - T_world_body[a].translation()) /
+          (times_s_[b] - times_s_[a]);
+    }
+    const Eigen::Vector3d p = T_world_body[i].translation();
+    const Eigen::Quaterniond q = CanonicalQuaternion(T_world_body[i].linear());
+    csv += std::to_string(times_ns_[i]);
+    for (double x : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z()})
+      csv += "," + FormatDouble(x);
+    csv += ",0,0,0,0,0,0\n";
+  }
+  return WriteTextFile(Join(gt_dir, "data.csv"), csv, error);
+}
+
+bool DatasetWriter::Finish(std::string* error) {
+  if (!is_open()) return Fail(error, "DatasetWriter::Finish: writer is not open");
+  if (times_s_.empty()) return Fail(error, dir_ + ": no frames were added");
+
+  // calib.txt: rectified projection matrices, P1 = K [I | (-baseline_m, 0, 0)].
+  const double P0[12] = {camera_.fx_px, 0, camera_.cx_px, 0,   0, camera_.fy_px,
+                         camera_.cy_px, 0, 0,             0,   1, 0};
+  double P1[12];
+  std::copy(P0, P0 + 12, P1);
+  P1[3] = -(camera_.fx_px * camera_.baseline_m);
+  if (!WriteTextFile(Join(partial_dir_, "calib.txt"), CalibRow("P0:", P0) + CalibRow("P1:", P1),
+                     error) ||
+      !WriteKittiTimes(Join(partial_dir_, "times.txt"), times_s_, error))
+    return false;
+
+  if (has_gt_) {
+    // Ground truth relative to the first left camera, as KITTI's poses.txt.
+    const Eigen::Isometry3d T_cam0first_world = T_world_cam0_.front().inverse();
+    std::vector<Eigen::Isometry3d> poses;
+    std::vector<StampedPose> tum;
+    for (size_t i = 0; i < times_s_.size(); ++i) {
+      poses.push_back(i == 0 ? Eigen::Isometry3d::Identity() : T_cam0first_world * T_world_cam0_[i]);
+      tum.push_back({times_s_[i], poses.back()});
+    }
+    if (!WriteKittiPoses(Join(partial_dir_, "poses.txt"), poses, error) ||
+        !WriteTum(Join(partial_dir_, "groundtruth_tum.txt"), tum, error) ||
+        !WriteKittiPoses(Join(partial_dir_, "T_world_cam0first.txt"), {T_world_cam0_.front()},
+                         error))
+      return false;
+  }
+  if (options_.format == DatasetFormat::kEuroc && !WriteEurocText(error)) return false;
+
+  std::error_code ec;
+  fs::remove(Join(partial_dir_, kWriterPidFile), ec);
+
+  // Publish: rename the partial folder to DIR (replacing an old DIR when allowed).
+  std::string old_dir;
+  if (fs::exists(dir_, ec)) {
+    if (!options_.overwrite)
+      return Fail(error, dir_ + ": output folder appeared while writing (set overwrite to replace it)");
+    std::string pattern = dir_ + ".old-XXXXXX";
+    std::vector<char> buffer(pattern.begin(), pattern.end());
+    buffer.push_back('\0');
+    if (::mkdtemp(buffer.data()) == nullptr)
+      return Fail(error, pattern + ": cannot create: " + std::strerror(errno));
+    old_dir = buffer.data();
+    if (::rename(dir_.c_str(), old_dir.c_str()) != 0) {
+      const std::string why = std::strerror(errno);
+      fs::remove_all(old_dir, ec);
+      return Fail(error, dir_ + ": cannot move the existing folder aside: " + why);
+    }
+  }
+  if (::rename(partial_dir_.c_str(), dir_.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    if (!old_dir.empty()) ::rename(old_dir.c_str(), dir_.c_str());  // put the old one back
+    return Fail(error, partial_dir_ + ": cannot rename to " + dir_ + ": " + why);
+  }
+  finished_ = true;
+  partial_dir_.clear();
+  if (!old_dir.empty()) fs::remove_all(old_dir, ec);
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// KITTI reader
+
+bool ReadKittiCalib(const std::string& path, vo::StereoCamera* camera, std::string* error) {
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, error)) {
+    if (error) *error += " (expected the KITTI calibration with P0: and P1: lines)";
+    return false;
+  }
+  std::vector<double> P[2];
+  std::string what;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const std::string& line = lines[i];
+    const size_t colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    const std::string key = line.substr(0, colon);
+    const int k = key == "P0" ? 0 : key == "P1" ? 1 : -1;
+    if (k < 0) continue;  // P2, P3, Tr, ...: not used
+    if (!ParseNumbers(std::string_view(line).substr(colon + 1), 12, &P[k], &what))
+      return Fail(error, Where(path, static_cast<int>(i) + 1) + key + ": " + what +
+                             " (expected 12 finite numbers, row-major 3x4 projection matrix)");
+  }
+  for (int k = 0; k < 2; ++k)
+    if (P[k].empty())
+      return Fail(error, path + ": no P" + std::to_string(k) +
+                             ": line (expected 'P" + std::to_string(k) + ": ' and 12 numbers)");
+  // Rectified pair: same intrinsics, only the x offset differs.
+  for (int idx : {0, 1, 2, 5, 6, 10}) {
+    if (std::abs(P[0][idx] - P[1][idx]) > 1e-9 * std::max(1.0, std::abs(P[0][idx])))
+      return Fail(error, path + ": P0 and P1 differ in entry " + std::to_string(idx + 1) +
+                             " (expected a rectified pair with equal intrinsics)");
+  }
+  camera->width = 0;
+  camera->height = 0;
+  camera->fx_px = P[0][0];
+  camera->fy_px = P[0][5];
+  camera->cx_px = P[0][2];
+  camera->cy_px = P[0][6];
+  if (!(camera->fx_px > 0.0) || !(camera->fy_px > 0.0))
+    return Fail(error, path + ": P0 focal lengths must be > 0");
+  camera->baseline_m = (P[0][3] - P[1][3]) / camera->fx_px;
+  if (!(camera->baseline_m > 0.0))
+    return Fail(error, path + ": baseline (P0[3] - P1[3]) / fx = " +
+                           FormatDouble(camera->baseline_m) +
+                           " m, expected > 0 (P1 column 4 holds -fx * baseline)");
+  return true;
+}
+
+std::string KittiReader::ImagePath(int cam, size_t index) const {
+  return Join(dir_, "image_" + std::to_string(cam) + "/" + FrameName(index, ".png"));
+}
+
+bool KittiReader::Open(const std::string& dir, const Options& options, std::string* error) {
+  *this = KittiReader();
+  options_ = options;
+  dir_ = NormalizeDir(dir);
+  std::error_code ec;
+  if (!fs::is_directory(dir_, ec)) return Fail(error, dir_ + ": dataset folder not found");
+  if (!ReadKittiCalib(Join(dir_, "calib.txt"), &camera_, error)) return false;
+  const std::string times_path = Join(dir_, "times.txt");
+  if (!ReadKittiTimes(times_path, &times_s_, error)) return false;
+  if (times_s_.empty()) return Fail(error, times_path + ": no frames (expected one time per line)");
+
+  // Ground truth.
+  std::string poses_path = options_.poses_path;
+  if (poses_path.empty() && fs::exists(Join(dir_, "poses.txt"), ec))
+    poses_path = Join(dir_, "poses.txt");
+  if (!poses_path.empty()) {
+    if (!ReadKittiPoses(poses_path, &T_cam0first_cam0_, error)) return false;
+    if (T_cam0first_cam0_.size() < times_s_.size())
+      return Fail(error, poses_path + ": has " + std::to_string(T_cam0first_cam0_.size()) +
+                             " poses but " + times_path + " lists " +
+                             std::to_string(times_s_.size()) +
+                             " frames (expected one pose per frame): fewer poses than frames");
+    if (T_cam0first_cam0_.size() > times_s_.size())
+      return Fail(error, poses_path + ": has " + std::to_string(T_cam0first_cam0_.size()) +
+                             " poses but " + times_path + " lists only " +
+                             std::to_string(times_s_.size()) +
+                             " frames (expected one pose per frame): more poses than frames");
+  } else if (options_.require_poses) {
+    return Fail(error, Join(dir_, "poses.txt") + ": ground truth required but not found");
+  }
+  const std::string world_path = Join(dir_, "T_world_cam0first.txt");
+  if (fs::exists(world_path, ec)) {
+    std::vector<Eigen::Isometry3d> T;
+    if (!ReadKittiPoses(world_path, &T, error)) return false;
+    if (T.size() != 1)
+      return Fail(error, world_path + ": expected exactly one pose (12 numbers), got " +
+                             std::to_string(T.size()));
+    T_world_cam0first_ = T[0];
+  }
+
+  // Every image must be there; frame 0 gives the image size.
+  for (size_t i = 0; i < times_s_.size(); ++i)
+    for (int cam = 0; cam < 2; ++cam)
+      if (!fs::is_regular_file(ImagePath(cam, i), ec))
+        return Fail(error, ImagePath(cam, i) + ": missing image file (frame " + std::to_string(i) +
+                               " of " + std::to_string(times_s_.size()) + " in times.txt)");
+  const cv::Mat left = cv::imread(ImagePath(0, 0), cv::IMREAD_GRAYSCALE);
+  const cv::Mat right = cv::imread(ImagePath(1, 0), cv::IMREAD_GRAYSCALE);
+  if (left.empty()) return Fail(error, ImagePath(0, 0) + ": cannot decode the image");
+  if (right.empty()) return Fail(error, ImagePath(1, 0) + ": cannot decode the image");
+  if (left.size() != right.size())
+    return Fail(error, ImagePath(1, 0) + ": size " + SizeText(right) + " differs from the left image's " +
+                           SizeText(left) + " (" + ImagePath(0, 0) + ")");
+  camera_.width = left.cols;
+  camera_.height = left.rows;
+  std::string why;
+  if (!camera_.IsValid(&why)) return Fail(error, Join(dir_, "calib.txt") + ": " + why);
+  has_depth_ = options_.load_depth && fs::is_directory(Join(dir_, "depth"), ec);
+  return true;
+}
+
+std::vector<StampedPose> KittiReader::GroundTruth() const {
+  std::vector<StampedPose> gt;
+  for (size_t i = 0; i < T_cam0first_cam0_.size(); ++i)
+    gt.push_back({times_s_[i], T_world_cam0first_ * T_cam0first_cam0_[i]});
+  return gt;
+}
+
+bool KittiReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const {
+  if (index >= size())
+    return Fail(error, dir_ + ": frame " + std::to_string(index) + " out of range (" +
+                           std::to_string(size()) + " frames)");
+  const cv::Size size(camera_.width, camera_.height);
+  cv::Mat images[2];
+  std::error_code ec;
+  for (int cam = 0; cam < 2; ++cam) {
+    const std::string path = ImagePath(cam, index);
+    if (!fs::is_regular_file(path, ec)) return Fail(error, path + ": missing image file");
+    images[cam] = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (images[cam].empty()) return Fail(error, path + ": cannot decode the image");
+    if (images[cam].size() != size)
+      return Fail(error, path + ": image size " + SizeText(images[cam]) + " differs from " +
+                             std::to_string(size.width) + "x" + std::to_string(size.height) +
+                             " (the size of frame 0)");
+  }
+  cv::Mat depth_m;
+  if (has_depth_) {
+    const std::string path = Join(dir_, "depth/" + FrameName(index, ".png"));
+    if (!fs::is_regular_file(path, ec)) return Fail(error, path + ": missing depth image");
+    const cv::Mat mm = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (mm.empty() || mm.type() != CV_16UC1)
+      return Fail(error, path + ": expected a 16-bit single-channel PNG (depth in millimetres)");
+    if (mm.size() != size)
+      return Fail(error, path + ": depth size " + SizeText(mm) + " differs from the image size");
+    mm.convertTo(depth_m, CV_32FC1, 1e-3);
+  }
+  frame->time_s = times_s_[index];
+  frame->left = images[0];
+  frame->right = images[1];
+  frame->depth_m = depth_m;
+  frame->has_gt = has_ground_truth();
+  frame->T_world_cam0 = frame->has_gt ? T_world_cam0first_ * T_cam0first_cam0_[index]
+                                      : Eigen::Isometry3d::Identity();
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// EuRoC reader
+
+bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibration,
+                         std::string* error) {
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, error)) return false;
+  // OpenCV-style files start with "%YAML:1.0", which yaml-cpp rejects: skip it.
+  std::string text;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (i == 0 && lines[i].rfind("%YAML:", 0) == 0) {
+      text += "\n";
+      continue;
+    }
+    text += lines[i] + "\n";
+  }
+  EurocCameraCalibration c;
+  try {
+    const YAML::Node root = YAML::Load(text);
+    auto require = [&](const char* key, const char* expected) -> YAML::Node {
+      const YAML::Node node = root[key];
+      if (!node) throw std::runtime_error(std::string("missing key '") + key + "' (expected " +
+                                          expected + ")");
+      return node;
+    };
+    auto numbers = [&](const YAML::Node& node, const char* key, size_t count) {
+      if (!node.IsSequence() || (count > 0 && node.size() != count))
+        throw std::runtime_error(std::string("'") + key + "': expected a list of " +
+                                 (count > 0 ? std::to_string(count) : std::string("any")) +
+                                 " numbers");
+      std::vector<double> v;
+      for (const YAML::Node& x : node) {
+        v.push_back(x.as<double>());
+        if (!std::isfinite(v.back()))
+          throw std::runtime_error(std::string("'") + key + "': value " +
+                                   std::to_string(v.size()) + " is not finite");
+      }
+      return v;
+    };
+    const YAML::Node T_BS = require("T_BS", "rows: 4, cols: 4, data: [16 numbers]");
+    if (!T_BS.IsMap() || !T_BS["data"])
+      throw std::runtime_error("'T_BS': expected a map with 'data: [16 numbers]'");
+    const std::vector<double> T = numbers(T_BS["data"], "T_BS.data", 16);
+    for (int r = 0; r < 4; ++r)
+      for (int col = 0; col < 4; ++col) c.T_body_cam.matrix()(r, col) = T[4 * r + col];
+    if (!c.T_body_cam.matrix().row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1)) ||
+        !IsRotation(c.T_body_cam.linear(), 1e-5))
+      throw std::runtime_error("'T_BS': expected a rigid transform (rotation, last row 0 0 0 1)");
+    const std::vector<double> k = numbers(require("intrinsics", "[fu, fv, cu, cv]"), "intrinsics", 4);
+    c.fu_px = k[0];
+    c.fv_px = k[1];
+    c.cu_px = k[2];
+    c.cv_px = k[3];
+    if (!(c.fu_px > 0.0) || !(c.fv_px > 0.0))
+      throw std::runtime_error("'intrinsics': focal lengths fu, fv must be > 0");
+    const std::vector<double> res = numbers(require("resolution", "[width, height]"), "resolution", 2);
+    c.width = static_cast<int>(res[0]);
+    c.height = static_cast<int>(res[1]);
+    if (c.width <= 0 || c.height <= 0 || c.width != res[0] || c.height != res[1])
+      throw std::runtime_error("'resolution': expected two positive integers [width, height]");
+    c.camera_model = require("camera_model", "pinhole").as<std::string>();
+    c.distortion_model = require("distortion_model", "radial-tangential | equidistant").as<std::string>();
+    c.distortion_coefficients =
+        numbers(require("distortion_coefficients", "a list of numbers"), "distortion_coefficients", 0);
+    if (root["rate_hz"]) c.rate_hz = root["rate_hz"].as<double>();
+  } catch (const YAML::Exception& e) {
+    return Fail(error, (e.mark.line >= 0 ? Where(path, e.mark.line + 1) : path + ": ") + e.msg);
+  } catch (const std::exception& e) {
+    return Fail(error, path + ": " + e.what());
+  }
+  *calibration = c;
+  return true;
+}
+
+namespace {
+
+// Reads a EuRoC camera data.csv ("#timestamp [ns],filename") into stamp -> image path.
+bool ReadEurocCameraCsv(const std::string& path, const std::string& image_dir,
+                        std::map<int64_t, std::string>* images, std::string* error) {
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, error)) return false;
+  images->clear();
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (IsBlankOrComment(lines[i])) continue;
+    const std::vector<std::string_view> f = SplitCsv(lines[i]);
+    int64_t t_ns = 0;
+    if (f.size() != 2 || !ParseInt64(f[0], &t_ns) || f[1].empty())
+      return Fail(error, Where(path, static_cast<int>(i) + 1) +
+                             "expected '<timestamp ns>,<file name>'");
+    if (!images->emplace(t_ns, Join(image_dir, std::string(f[1]))).second)
+      return Fail(error, Where(path, static_cast<int>(i) + 1) + "duplicate timestamp " +
+                             std::to_string(t_ns));
+  }
+  return true;
+}
+
+// Reads mav0/state_groundtruth_estimate0/data.csv: stamp, position, quaternion w x y z, ....
+bool ReadEurocGroundTruth(const std::string& path, std::vector<int64_t>* t_ns,
+                          std::vector<StampedPose>* T_world_body, std::string* error) {
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, error)) return false;
+  std::vector<double> v;
+  std::string what;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (IsBlankOrComment(lines[i])) continue;
+    const int line_no = static_cast<int>(i) + 1;
+    const size_t comma = lines[i].find(',');
+    int64_t stamp = 0;
+    std::string_view head = std::string_view(lines[i]).substr(0, comma);
+    while (!head.empty() && head.back() == ' ') head.remove_suffix(1);
+    if (comma == std::string::npos || !ParseInt64(head, &stamp))
+      return Fail(error, Where(path, line_no) + "expected '<timestamp ns>,p_x,p_y,p_z,q_w,q_x,q_y,q_z,...'");
+    const std::string_view rest = std::string_view(lines[i]).substr(comma + 1);
+    const size_t fields = SplitCsv(rest).size();
+    if (fields < 7 || !ParseNumbers(rest, fields, &v, &what))
+      return Fail(error, Where(path, line_no) + (fields < 7 ? "expected at least 8 fields" : what) +
+                             " (timestamp, p_RS_R xyz, q_RS wxyz, ...)");
+    Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+    if (std::abs(q.norm() - 1.0) > kTumQuaternionNormTolerance)
+      return Fail(error, Where(path, line_no) + "expected a unit quaternion q_RS (w x y z)");
+    q.normalize();
+    StampedPose p;
+    p.time_s = NsToSeconds(stamp);
+    p.T_world_cam.linear() = q.toRotationMatrix();
+    p.T_world_cam.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    t_ns->push_back(stamp);
+    T_world_body->push_back(p);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool EurocReader::Open(const std::string& dir, const Options& options, std::string* error) {
+  *this = EurocReader();
+  options_ = options;
+  dir_ = NormalizeDir(dir);
+  if (!std::isfinite(options_.gt_max_difference_s) || options_.gt_max_difference_s <= 0.0)
+    return Fail(error, "EurocReader options: gt_max_difference_s must be finite and > 0");
+  std::error_code ec;
+  const std::string mav0 = Join(dir_, "mav0");
+  if (!fs::is_directory(mav0, ec)) return Fail(error, mav0 + ": folder not found (EuRoC layout)");
+
+  std::map<int64_t, std::string> images[2];
+  for (int cam = 0; cam < 2; ++cam) {
+    const std::string base = Join(mav0, "cam" + std::to_string(cam));
+    if (!ReadEurocSensorYaml(Join(base, "sensor.yaml"), &cam_[cam], error)) return false;
+    if (!ReadEurocCameraCsv(Join(base, "data.csv"), Join(base, "data"), &images[cam], error))
+      return false;
+  }
+  // Stereo frames: stamps present in both cameras.
+  for (const auto& [t_ns, path0] : images[0]) {
+    const auto it = images[1].find(t_ns);
+    if (it == images[1].end()) continue;
+    t_ns_.push_back(t_ns);
+    files_[0].push_back(path0);
+    files_[1].push_back(it->second);
+  }
+  unpaired_ = images[0].size() + images[1].size() - 2 * t_ns_.size();
+  if (t_ns_.empty())
+    return Fail(error, Join(mav0, "cam0/data.csv") + ": no time stamp shared with cam1/data.csv");
+  for (size_t i = 0; i < t_ns_.size(); ++i)
+    for (int cam = 0; cam < 2; ++cam)
+      if (!fs::is_regular_file(files_[cam][i], ec))
+        return Fail(error, files_[cam][i] + ": missing image file (listed in cam" +
+                               std::to_string(cam) + "/data.csv)");
+
+  // Ground truth (optional), associated to the frames by time.
+  gt_index_.assign(t_ns_.size(), -1);
+  const std::string gt_path = Join(mav0, "state_groundtruth_estimate0/data.csv");
+  if (fs::exists(gt_path, ec)) {
+    std::vector<int64_t> gt_ns;
+    if (!ReadEurocGroundTruth(gt_path, &gt_ns, &gt_body_, error)) return false;
+    // Relative seconds keep nanosecond resolution in a double.
+    const int64_t t0 = t_ns_.front();
+    std::vector<double> frame_s, gt_s;
+    for (int64_t t : t_ns_) frame_s.push_back(NsToSeconds(t - t0));
+    for (int64_t t : gt_ns) gt_s.push_back(NsToSeconds(t - t0));
+    AssociateOptions assoc;
+    assoc.max_difference_s = options_.gt_max_difference_s;
+    for (const AssociatedPair& p : AssociateStamps(frame_s, gt_s, assoc))
+      gt_index_[p.first] = static_cast<long>(p.second);
+  }
+  return true;
+}
+
+bool EurocReader::Rectification(StereoRectification* rectification, std::string* error) const {
+  const std::string where = Join(dir_, "mav0/cam{0,1}/sensor.yaml") + ": ";
+  for (int cam = 0; cam < 2; ++cam) {
+    if (cam_[cam].camera_model != "pinhole")
+      return Fail(error, where + "camera_model '" + cam_[cam].camera_model +
+                             "' needs rectification (not implemented yet; expected pinhole)");
+    for (double d : cam_[cam].distortion_coefficients)
+      if (std::abs(d) > kRectifiedDistortionTolerance)
+        return Fail(error, where + "cam" + std::to_string(cam) +
+                               " has non-zero distortion: rectification not implemented yet");
+  }
+  const EurocCameraCalibration& a = cam_[0];
+  const EurocCameraCalibration& b = cam_[1];
+  if (a.width != b.width || a.height != b.height)
+    return Fail(error, where + "cam0 and cam1 resolutions differ");
+  const double dk = std::max({std::abs(a.fu_px - b.fu_px), std::abs(a.fv_px - b.fv_px),
+                              std::abs(a.cu_px - b.cu_px), std::abs(a.cv_px - b.cv_px)});
+  if (dk > kRectifiedIntrinsicsTolerancePx)
+    return Fail(error, where + "cam0 and cam1 intrinsics differ: rectification not implemented yet");
+  const Eigen::Isometry3d T_cam0_cam1 = a.T_body_cam.inverse() * b.T_body_cam;
+  const double dr = (T_cam0_cam1.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const Eigen::Vector3d t = T_cam0_cam1.translation();
+  if (dr > kRectifiedRotationTolerance || std::abs(t.y()) > kRectifiedOffsetToleranceM ||
+      std::abs(t.z()) > kRectifiedOffsetToleranceM || !(t.x() > 0.0))
+    return Fail(error, where + "cam1 is not at +x of cam0 with the same orientation: "
+                               "rectification not implemented yet");
+  StereoRectification r;
+  r.camera.width = a.width;
+  r.camera.height = a.height;
+  r.camera.fx_px = a.fu_px;
+  r.camera.fy_px = a.fv_px;
+  r.camera.cx_px = a.cu_px;
+  r.camera.cy_px = a.cv_px;
+  r.camera.baseline_m = t.x();
+  std::string why;
+  if (!r.camera.IsValid(&why)) return Fail(error, where + why);
+  *rectification = r;
+  return true;
+}
+
+bool EurocReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const {
+  if (index >= size())
+    return Fail(error, dir_ + ": frame " + std::to_string(index) + " out of range (" +
+                           std::to_string(size()) + " frames)");
+  cv::Mat images[2];
+  std::error_code ec;
+  for (int cam = 0; cam < 2; ++cam) {
+    const std::string& path = files_[cam][index];
+    if (!fs::is_regular_file(path, ec)) return Fail(error, path + ": missing image file");
+    images[cam] = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (images[cam].empty()) return Fail(error, path + ": cannot decode the image");
+    if (images[cam].cols != cam_[cam].width || images[cam].rows != cam_[cam].height)
+      return Fail(error, path + ": image size " + SizeText(images[cam]) + " differs from " +
+                             std::to_string(cam_[cam].width) + "x" +
+                             std::to_string(cam_[cam].height) + " (resolution in sensor.yaml)");
+  }
+  frame->time_s = NsToSeconds(t_ns_[index]);
+  frame->left = images[0];
+  frame->right = images[1];
+  frame->depth_m = cv::Mat();
+  const long gt = gt_index_[index];
+  frame->has_gt = gt >= 0;
+  frame->T_world_cam0 = frame->has_gt ? gt_body_[gt].T_world_cam * cam_[0].T_body_cam
+                                      : Eigen::Isometry3d::Identity();
+  return true;
+}
+
+}  // namespace harness

@@ -1,0 +1,249 @@
+// Stereo datasets on disk: a writer for the KITTI odometry layout (optionally also EuRoC/ASL),
+// and readers for both layouts, so simulated and real sequences run through the same VO.
+//
+// KITTI layout written by DatasetWriter (DIR = the output folder):
+//   image_0/%06d.png        left (cam0) images, 8-bit grayscale PNG
+//   image_1/%06d.png        right (cam1) images
+//   calib.txt               "P0: <12 numbers>" and "P1: <12 numbers>", row-major 3x4 projection
+//                           matrices of the rectified pair; P1 has -fx * baseline_m in column 4
+//   times.txt               one time stamp per frame (seconds)
+//   poses.txt               [ground truth only] T_cam0first_cam0k, 12 numbers per frame
+//                           (the left camera's pose in the FIRST left camera's frame, KITTI style)
+//   groundtruth_tum.txt     [ground truth only] the same poses with their times, TUM format
+//   T_world_cam0first.txt   [ground truth only] 12 numbers: the first left camera's pose in the
+//                           world, so T_world_cam0k = T_world_cam0first * T_cam0first_cam0k
+//   depth/%06d.png          [depth only] z-depth of the left view, 16-bit PNG, millimetres;
+//                           0 = no depth (also for depths <= 0, not finite, or > 65.535 m)
+// EuRoC/ASL layout, written in addition when Options::format is kEuroc:
+//   mav0/cam0/data/<t_ns>.png, mav0/cam0/data.csv ("#timestamp [ns],filename"),
+//   mav0/cam0/sensor.yaml (T_BS, intrinsics [fu, fv, cu, cv], zero radial-tangential distortion,
+//   resolution, rate_hz, camera_model pinhole); the same for cam1 (T_BS = T_body_cam0 *
+//   T_cam0_cam1); mav0/state_groundtruth_estimate0/data.csv [ground truth only]: the body pose
+//   T_world_body in the world, finite-differenced velocity, zero biases.
+// Time stamps in nanoseconds are int64: t_ns = llround(time_s * 1e9).
+//
+// Errors: functions return false and fill *error with the file (and line) and what was expected.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "harness/trajectory_io.h"
+#include "vo/camera.h"
+
+namespace harness {
+
+// One stereo frame in memory.
+struct DatasetFrame {
+  double time_s = 0.0;  // time stamp (seconds)
+  cv::Mat left;         // cam0 image, CV_8UC1
+  cv::Mat right;        // cam1 image, CV_8UC1, same size as left
+  cv::Mat depth_m;      // CV_32FC1 z-depth of the left view (metres), 0 = none; may be empty
+  bool has_gt = false;  // true when T_world_cam0 holds the ground-truth pose
+  Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();  // left camera in the world
+};
+
+enum class DatasetFormat {
+  kKitti,  // KITTI odometry layout only
+  kEuroc,  // KITTI layout plus the EuRoC/ASL layout under mav0/
+};
+// "kitti" / "euroc"; false for other names.
+bool ParseDatasetFormat(const std::string& name, DatasetFormat* format);
+const char* DatasetFormatName(DatasetFormat format);
+
+// Writes a sequence atomically: everything goes into a temporary sibling folder
+// "DIR.partial-XXXXXX" that is renamed to DIR only by Finish(). Destroying the writer before
+// Finish() (error, exception) removes the partial folder, so a half-written DIR never exists.
+// A process killed outright (SIGKILL, Ctrl-C without a handler) leaves the ".partial-" folder,
+// never DIR; Open() removes such leftovers of dead processes. Identical input gives
+// byte-identical files (fixed PNG parameters, FormatDouble numbers, no "now" anywhere).
+//
+// Usage:  DatasetWriter writer(options);
+//         if (!writer.Open(dir, camera, &error)) ...;
+//         for (...) if (!writer.Add(frame, &error)) ...;
+//         if (!writer.Finish(&error)) ...;
+class DatasetWriter {
+ public:
+  struct Options {
+    DatasetFormat format = DatasetFormat::kKitti;  // kEuroc also writes the mav0/ layout
+    bool overwrite = false;     // replace an existing DIR (on Finish); otherwise refuse
+    bool write_depth = true;    // write depth/%06d.png for frames that carry depth
+    int png_compression = 3;    // zlib level of every PNG, 0 (none) .. 9 (smallest, slowest)
+    Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();
+                                // EuRoC body frame: left camera in the body (rotation + metres)
+    double rate_hz = 0.0;       // rate written to sensor.yaml (Hz, >= 0); 0 = from the median
+                                // frame interval, rounded to 1 mHz
+
+    bool IsValid(std::string* error) const;
+  };
+
+  DatasetWriter() = default;
+  explicit DatasetWriter(Options options) : options_(std::move(options)) {}
+  ~DatasetWriter();  // removes the partial folder unless Finish() succeeded
+  DatasetWriter(const DatasetWriter&) = delete;
+  DatasetWriter& operator=(const DatasetWriter&) = delete;
+
+  // Checks options and camera, refuses an existing DIR unless options.overwrite, creates the
+  // partial folder (and DIR's parent folders).
+  bool Open(const std::string& dir, const vo::StereoCamera& camera, std::string* error);
+  // Writes the frame's images at once. Frames must come in strictly increasing time (distinct
+  // t_ns); images must be CV_8UC1 of the camera's size, depth empty or CV_32FC1 of that size.
+  // Ground truth and depth are all-or-nothing: the first frame decides for the sequence.
+  bool Add(const DatasetFrame& frame, std::string* error);
+  // Writes the text files and renames the partial folder to DIR. At least one frame needed.
+  bool Finish(std::string* error);
+
+  bool is_open() const { return !partial_dir_.empty(); }
+  bool finished() const { return finished_; }
+  size_t num_frames() const { return times_s_.size(); }
+  const std::string& partial_dir() const { return partial_dir_; }  // empty when not open
+
+ private:
+  void RemovePartial();
+  bool WriteEurocText(std::string* error) const;
+
+  Options options_;
+  vo::StereoCamera camera_;
+  std::string dir_;
+  std::string partial_dir_;
+  bool finished_ = false;
+  bool has_gt_ = false;
+  bool has_depth_ = false;
+  std::vector<double> times_s_;
+  std::vector<int64_t> times_ns_;
+  std::vector<Eigen::Isometry3d> T_world_cam0_;  // one per frame when has_gt_
+  std::vector<int> compression_params_;
+};
+
+// Time stamp in nanoseconds as written to EuRoC files.
+int64_t TimeToNs(double time_s);
+
+// --- KITTI odometry reader. Images load lazily, one frame at a time, as grayscale.
+class KittiReader {
+ public:
+  struct Options {
+    std::string poses_path;    // ground-truth file (KITTI poses); empty = DIR/poses.txt if it exists
+                               // (the KITTI benchmark keeps it apart: poses/NN.txt)
+    bool require_poses = false;  // fail Open() when there is no ground truth
+    bool load_depth = true;      // read depth/%06d.png when the folder exists
+  };
+
+  // Reads calib.txt (P0/P1 -> camera; baseline_m = (P0[3] - P1[3]) / fx, i.e. -P1[3]/fx for
+  // KITTI), times.txt, the ground truth and T_world_cam0first.txt when present; checks that
+  // every image file exists and reads frame 0 for the image size.
+  bool Open(const std::string& dir, std::string* error) { return Open(dir, Options(), error); }
+  bool Open(const std::string& dir, const Options& options, std::string* error);
+
+  const vo::StereoCamera& camera() const { return camera_; }
+  size_t size() const { return times_s_.size(); }
+  const std::vector<double>& times_s() const { return times_s_; }
+  bool has_ground_truth() const { return !T_cam0first_cam0_.empty(); }
+  // Ground truth in the first camera's frame (poses.txt), one per frame; empty when none.
+  const std::vector<Eigen::Isometry3d>& poses() const { return T_cam0first_cam0_; }
+  // From T_world_cam0first.txt; identity when absent (the world is the first camera).
+  const Eigen::Isometry3d& T_world_cam0first() const { return T_world_cam0first_; }
+  // Ground truth as a TUM-style trajectory in the world (empty when none).
+  std::vector<StampedPose> GroundTruth() const;
+
+  // Loads frame `index`: images (checked against the camera size), depth when present, and
+  // T_world_cam0 = T_world_cam0first * T_cam0first_cam0k when there is ground truth.
+  bool ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const;
+
+ private:
+  std::string ImagePath(int cam, size_t index) const;
+
+  Options options_;
+  std::string dir_;
+  vo::StereoCamera camera_;
+  std::vector<double> times_s_;
+  std::vector<Eigen::Isometry3d> T_cam0first_cam0_;
+  Eigen::Isometry3d T_world_cam0first_ = Eigen::Isometry3d::Identity();
+  bool has_depth_ = false;
+};
+
+// Parses a KITTI calib.txt: P0 and P1 (other keys ignored) into a camera without image size
+// (width/height left at 0). Fails on a missing key, a malformed line, non-finite numbers,
+// P0/P1 with different intrinsics, or a baseline <= 0.
+bool ReadKittiCalib(const std::string& path, vo::StereoCamera* camera, std::string* error);
+
+// --- EuRoC/ASL.
+
+// Calibration of one camera as sensor.yaml gives it (raw, possibly distorted).
+struct EurocCameraCalibration {
+  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();  // T_BS: camera in the body
+  double fu_px = 0.0;  // focal length x (pixels)
+  double fv_px = 0.0;  // focal length y (pixels)
+  double cu_px = 0.0;  // principal point x (pixels)
+  double cv_px = 0.0;  // principal point y (pixels)
+  std::string camera_model;                     // "pinhole"
+  std::string distortion_model;                 // "radial-tangential" (k1 k2 p1 p2) or "equidistant"
+  std::vector<double> distortion_coefficients;  // as listed in the file
+  int width = 0;                                // resolution (pixels)
+  int height = 0;
+  double rate_hz = 0.0;  // nominal frame rate (Hz)
+};
+bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibration,
+                         std::string* error);
+
+// Maps a raw EuRoC stereo pair onto the ideal rectified camera the VO expects (vo::StereoCamera:
+// equal intrinsics, cam1 at +baseline_m along cam0's x, no distortion). Computing it for
+// distorted / rotated pairs (cv::stereoRectify + initUndistortRectifyMap) is planned; today only
+// already-rectified pairs are accepted (EurocReader::Rectification), with empty maps.
+struct StereoRectification {
+  vo::StereoCamera camera;  // the rectified camera (output image size and intrinsics)
+  Eigen::Matrix3d R_cam0_rect0 = Eigen::Matrix3d::Identity();  // rectified left frame in raw cam0
+  Eigen::Matrix3d R_cam1_rect1 = Eigen::Matrix3d::Identity();  // rectified right frame in raw cam1
+  cv::Mat map0_x, map0_y;  // CV_32FC1 (height x width): raw cam0 pixel of each rectified pixel;
+                           // empty = identity (no remap needed)
+  cv::Mat map1_x, map1_y;  // the same for cam1
+  bool IsIdentity() const { return map0_x.empty() && map1_x.empty(); }
+};
+
+class EurocReader {
+ public:
+  struct Options {
+    double gt_max_difference_s = 0.003;  // ground-truth stamp must lie within this of the frame
+                                         // (seconds, > 0); EuRoC ground truth runs at 200 Hz
+  };
+
+  // Reads DIR/mav0/cam{0,1}/{data.csv,sensor.yaml} and, when present,
+  // mav0/state_groundtruth_estimate0/data.csv. Stereo frames are the stamps present in both
+  // cameras (the others are counted in unpaired_frames()).
+  bool Open(const std::string& dir, std::string* error) { return Open(dir, Options(), error); }
+  bool Open(const std::string& dir, const Options& options, std::string* error);
+
+  const EurocCameraCalibration& cam0() const { return cam_[0]; }
+  const EurocCameraCalibration& cam1() const { return cam_[1]; }
+  size_t size() const { return t_ns_.size(); }
+  const std::vector<int64_t>& times_ns() const { return t_ns_; }
+  size_t unpaired_frames() const { return unpaired_; }
+  // Ground-truth body poses T_world_body as in the file (empty when none).
+  const std::vector<StampedPose>& ground_truth_body() const { return gt_body_; }
+
+  // Identity rectification when the pair is already rectified (pinhole, zero distortion, equal
+  // intrinsics, R_cam0_cam1 = I and cam1 along +x of cam0, all within tolerance); otherwise
+  // false with the reason ("not implemented yet" for a real raw pair).
+  bool Rectification(StereoRectification* rectification, std::string* error) const;
+
+  // Raw images of frame `index` (grayscale, checked against the yaml resolution);
+  // has_gt and T_world_cam0 = T_world_body * T_body_cam0 when a ground-truth stamp is close
+  // enough. depth_m stays empty.
+  bool ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const;
+
+ private:
+  Options options_;
+  std::string dir_;
+  EurocCameraCalibration cam_[2];
+  std::vector<int64_t> t_ns_;
+  std::vector<std::string> files_[2];  // image paths per camera, aligned with t_ns_
+  std::vector<StampedPose> gt_body_;
+  std::vector<long> gt_index_;  // per frame: index into gt_body_, -1 = none
+  size_t unpaired_ = 0;
+};
+
+}  // namespace harness

@@ -1,0 +1,85 @@
+#include "harness/render.h"
+
+#include <chrono>
+#include <filesystem>
+
+#include "harness/progress.h"
+
+namespace harness {
+
+namespace fs = std::filesystem;
+
+bool ResolveScenario(const std::string& arg, sim::Scenario* scenario, std::string* error) {
+  std::string path = arg;
+  if (!fs::exists(path)) {
+    const std::string builtin = sim::BuiltinScenarioPath(arg);
+    if (arg.find('/') == std::string::npos && fs::exists(builtin)) {
+      path = builtin;
+    } else {
+      *error = arg + ": no such scenario file (and no built-in scenario of that name in " +
+               fs::path(builtin).parent_path().string() + ")";
+      return false;
+    }
+  }
+  return sim::LoadScenario(path, scenario, error);
+}
+
+vo::StereoCamera ToStereoCamera(const sim::StereoCalibration& c) {
+  vo::StereoCamera cam;
+  cam.width = c.width;
+  cam.height = c.height;
+  cam.fx_px = c.fx_px;
+  cam.fy_px = c.fy_px;
+  cam.cx_px = c.cx_px;
+  cam.cy_px = c.cy_px;
+  cam.baseline_m = c.baseline_m;
+  return cam;
+}
+
+DatasetFrame ToDatasetFrame(const sim::StereoFrame& f) {
+  DatasetFrame d;
+  d.time_s = f.time_s;
+  d.left = f.left;
+  d.right = f.right;
+  d.depth_m = f.depth_m;
+  d.has_gt = true;
+  d.T_world_cam0 = f.T_world_cam0;
+  return d;
+}
+
+bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
+                    const RenderOptions& options, RenderSummary* summary, std::string* error) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
+  if (!simulator) return false;
+  DatasetWriter::Options wopt;
+  wopt.format = options.format;
+  wopt.overwrite = options.overwrite;
+  wopt.T_body_cam0 = simulator->calibration().T_body_cam0;
+  wopt.rate_hz = scenario.rate_hz;
+  DatasetWriter writer(wopt);
+  if (!writer.Open(out_dir, ToStereoCamera(simulator->calibration()), error)) return false;
+
+  Progress progress("render " + scenario.name, simulator->EstimatedFrames(), options.progress);
+  sim::StereoFrame frame;
+  int n = 0;
+  while (simulator->Next(&frame, error)) {
+    if (!writer.Add(ToDatasetFrame(frame), error)) return false;
+    progress.Update(++n);
+    summary->sim_time_s = frame.time_s;
+  }
+  if (!error->empty()) return false;
+  if (!writer.Finish(error)) return false;
+  progress.Finish(n);
+
+  summary->frames = n;
+  summary->gl_renderer = simulator->gl_renderer();
+  const auto& track = simulator->body_track();
+  summary->path_length_m = 0.0;
+  for (size_t i = 1; i < track.size(); ++i) summary->path_length_m += (track[i] - track[i - 1]).head<2>().norm();
+  summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary->frames_per_s = summary->wall_time_s > 0 ? n / summary->wall_time_s : 0.0;
+  return true;
+}
+
+}  // namespace harness

@@ -1,0 +1,42 @@
+// `vobench render`: simulate a scenario and write its stereo sequence as a dataset on disk.
+#pragma once
+
+#include <string>
+
+#include "harness/dataset.h"
+#include "sim/scenario.h"
+#include "sim/simulator.h"
+#include "vo/camera.h"
+
+namespace harness {
+
+// Resolves a scenario argument: an existing file, or the name of a scenario shipped in
+// scenes/ ("l_hallway"). Loads and validates it.
+bool ResolveScenario(const std::string& arg, sim::Scenario* scenario, std::string* error);
+
+// The simulator's calibration as the VO's camera model.
+vo::StereoCamera ToStereoCamera(const sim::StereoCalibration& calibration);
+
+// A simulated frame as a dataset frame (with ground truth and depth).
+DatasetFrame ToDatasetFrame(const sim::StereoFrame& frame);
+
+struct RenderSummary {
+  int frames = 0;
+  double sim_time_s = 0.0;       // time of the last frame (s)
+  double path_length_m = 0.0;    // length of the robot base's track (m)
+  double wall_time_s = 0.0;      // rendering + writing wall time (s)
+  double frames_per_s = 0.0;     // stereo frames (with depth) rendered and written per second
+  std::string gl_renderer;
+};
+
+struct RenderOptions {
+  DatasetFormat format = DatasetFormat::kKitti;  // kEuroc also writes the mav0/ layout
+  bool overwrite = false;                        // replace an existing output folder
+  bool progress = true;                          // progress line on stderr
+};
+
+// Renders `scenario` into `out_dir` (atomically: nothing is left at out_dir on failure).
+bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
+                    const RenderOptions& options, RenderSummary* summary, std::string* error);
+
+}  // namespace harness

@@ -1,0 +1,339 @@
+#include "sim/scenario.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+namespace sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Strict reader over one YAML document: checks types, ranges and unknown keys, and turns
+// every problem into one message "FILE:LINE: key 'a.b': expected ..., got ...".
+class StrictReader {
+ public:
+  explicit StrictReader(std::string source) : source_(std::move(source)) {}
+
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+
+  void Fail(const YAML::Node& node, const std::string& key, const std::string& what) {
+    if (!error_.empty()) return;  // keep the first error
+    std::ostringstream msg;
+    msg << source_;
+    if (node.IsDefined() && node.Mark().line >= 0) msg << ":" << node.Mark().line + 1;
+    if (!key.empty()) msg << ": key '" << key << "'";
+    msg << ": " << what;
+    error_ = msg.str();
+  }
+
+  // Fails on any key of `map` not in `allowed`.
+  void CheckKeys(const YAML::Node& map, const std::string& prefix,
+                 const std::set<std::string>& allowed) {
+    if (!map.IsMap()) {
+      Fail(map, prefix, "expected a mapping");
+      return;
+    }
+    for (const auto& kv : map) {
+      const std::string key = kv.first.Scalar();
+      if (allowed.count(key) == 0) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        Fail(kv.first, Join(prefix, key), "unknown key (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  static std::string Join(const std::string& prefix, const std::string& key) {
+    return prefix.empty() ? key : prefix + "." + key;
+  }
+
+  void Double(const YAML::Node& map, const std::string& prefix, const std::string& key,
+              double* out) {
+    const YAML::Node n = map[key];
+    if (!n.IsDefined() || !ok()) return;
+    if (!n.IsScalar()) return Fail(n, Join(prefix, key), "expected a number");
+    try {
+      const double v = n.as<double>();
+      if (!std::isfinite(v)) return Fail(n, Join(prefix, key), "expected a finite number, got " + n.Scalar());
+      *out = v;
+    } catch (const YAML::Exception&) {
+      Fail(n, Join(prefix, key), "expected a number, got '" + n.Scalar() + "'");
+    }
+  }
+
+  void Int(const YAML::Node& map, const std::string& prefix, const std::string& key, int* out) {
+    const YAML::Node n = map[key];
+    if (!n.IsDefined() || !ok()) return;
+    try {
+      if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
+      *out = n.as<int>();
+    } catch (const YAML::Exception&) {
+      Fail(n, Join(prefix, key), "expected an integer, got '" + n.Scalar() + "'");
+    }
+  }
+
+  void Uint64(const YAML::Node& map, const std::string& prefix, const std::string& key,
+              uint64_t* out) {
+    const YAML::Node n = map[key];
+    if (!n.IsDefined() || !ok()) return;
+    try {
+      if (!n.IsScalar() || n.Scalar().empty() || n.Scalar()[0] == '-') throw YAML::Exception(n.Mark(), "");
+      *out = n.as<uint64_t>();
+    } catch (const YAML::Exception&) {
+      Fail(n, Join(prefix, key), "expected a non-negative integer, got '" + n.Scalar() + "'");
+    }
+  }
+
+  void String(const YAML::Node& map, const std::string& prefix, const std::string& key,
+              std::string* out) {
+    const YAML::Node n = map[key];
+    if (!n.IsDefined() || !ok()) return;
+    if (!n.IsScalar()) return Fail(n, Join(prefix, key), "expected a string");
+    *out = n.Scalar();
+  }
+
+  // Range checks on already-read values; `node` gives the line.
+  void Require(bool condition, const YAML::Node& map, const std::string& prefix,
+               const std::string& key, const std::string& what) {
+    if (!condition && ok()) Fail(map[key].IsDefined() ? map[key] : map, Join(prefix, key), what);
+  }
+
+ private:
+  std::string source_;
+  std::string error_;
+};
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+bool Scenario::IsValid(std::string* error) const {
+  std::ostringstream e;
+  if (path.size() < 2) e << "path: expected at least 2 waypoints, got " << path.size();
+  else if (!(rate_hz > 0)) e << "rate_hz: expected > 0, got " << rate_hz;
+  else if (!(physics_dt_s > 0 && physics_dt_s <= 0.01)) e << "physics_dt_s: expected in (0, 0.01], got " << physics_dt_s;
+  else if (!(max_duration_s > 0)) e << "max_duration_s: expected > 0";
+  else if (!(settle_s >= 0)) e << "settle_s: expected >= 0";
+  else if (!(robot.speed_mps > 0 && robot.speed_mps <= 3)) e << "robot.speed_mps: expected in (0, 3], got " << robot.speed_mps;
+  else if (!(robot.max_accel_mps2 > 0)) e << "robot.max_accel_mps2: expected > 0";
+  else if (!(robot.turn_rate_dps > 0 && robot.turn_rate_dps <= 360)) e << "robot.turn_rate_dps: expected in (0, 360]";
+  else if (!(robot.lookahead_m > 0)) e << "robot.lookahead_m: expected > 0";
+  else if (robot.corner_mode != "in_place" && robot.corner_mode != "arc") e << "robot.corner_mode: expected 'in_place' or 'arc', got '" << robot.corner_mode << "'";
+  else if (!(robot.goal_tolerance_m > 0)) e << "robot.goal_tolerance_m: expected > 0";
+  else if (camera.width < 16 || camera.width > 4096 || camera.height < 16 || camera.height > 4096) e << "camera.width/height: expected 16..4096, got " << camera.width << "x" << camera.height;
+  else if (!(camera.fovy_deg > 1 && camera.fovy_deg < 170)) e << "camera.fovy_deg: expected in (1, 170), got " << camera.fovy_deg;
+  else if (!(camera.baseline_m > 0)) e << "camera.baseline_m: expected > 0, got " << camera.baseline_m;
+  else if (!(camera.height_m > 0)) e << "camera.height_m: expected > 0, got " << camera.height_m;
+  else if (!(camera.pitch_deg > -80 && camera.pitch_deg < 80)) e << "camera.pitch_deg: expected in (-80, 80)";
+  else if (!(noise.pixel_sigma >= 0)) e << "noise.pixel_sigma: expected >= 0";
+  else if (!(noise.gain_sigma >= 0 && noise.gain_sigma < 0.5)) e << "noise.gain_sigma: expected in [0, 0.5)";
+  else if (!(noise.bias_sigma >= 0)) e << "noise.bias_sigma: expected >= 0";
+  else if (!(noise.motion_blur_exposure_s >= 0 && noise.motion_blur_exposure_s < 1.0 / rate_hz)) e << "noise.motion_blur_exposure_s: expected in [0, 1/rate_hz)";
+  else if (noise.motion_blur_exposure_s > 0 && noise.motion_blur_samples < 2) e << "noise.motion_blur_samples: expected >= 2 when motion blur is on";
+  else {
+    for (size_t i = 0; i < path.size(); ++i) {
+      if (!path[i].allFinite()) { e << "path[" << i << "]: expected finite coordinates"; break; }
+      if (i > 0 && (path[i] - path[i - 1]).norm() < 1e-3) { e << "path[" << i << "]: repeats the previous waypoint"; break; }
+    }
+  }
+  if (e.tellp() == 0) return true;
+  if (error) *error = e.str();
+  return false;
+}
+
+bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
+                   const std::string& base_dir, Scenario* scenario, std::string* error) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::ParserException& ex) {
+    if (error) *error = source_name + ":" + std::to_string(ex.mark.line + 1) + ": malformed YAML: " + ex.msg;
+    return false;
+  }
+  StrictReader r(source_name);
+  Scenario s;
+  if (!root.IsMap()) {
+    if (error) *error = source_name + ": expected a YAML mapping at the top level";
+    return false;
+  }
+  r.CheckKeys(root, "", {"name", "scene", "seed", "rate_hz", "physics_dt_s", "max_duration_s",
+                         "settle_s", "path", "robot", "camera", "noise", "textures"});
+  r.String(root, "", "name", &s.name);
+  std::string scene;
+  r.String(root, "", "scene", &scene);
+  if (r.ok() && scene.empty()) r.Fail(root, "scene", "required: the MJCF scene file (relative to the scenario file)");
+  r.Uint64(root, "", "seed", &s.seed);
+  r.Double(root, "", "rate_hz", &s.rate_hz);
+  r.Double(root, "", "physics_dt_s", &s.physics_dt_s);
+  r.Double(root, "", "max_duration_s", &s.max_duration_s);
+  r.Double(root, "", "settle_s", &s.settle_s);
+
+  // path: a sequence of [x, y] pairs.
+  const YAML::Node path = root["path"];
+  if (r.ok()) {
+    if (!path.IsDefined()) r.Fail(root, "path", "required: a list of at least 2 waypoints [x, y] (m)");
+    else if (!path.IsSequence()) r.Fail(path, "path", "expected a list of waypoints [x, y] (m)");
+    else {
+      for (size_t i = 0; i < path.size() && r.ok(); ++i) {
+        const YAML::Node wp = path[i];
+        const std::string key = "path[" + std::to_string(i) + "]";
+        if (!wp.IsSequence() || wp.size() != 2) { r.Fail(wp, key, "expected a pair [x, y] (m)"); break; }
+        Eigen::Vector2d p;
+        for (int k = 0; k < 2; ++k) {
+          try {
+            p[k] = wp[k].as<double>();
+          } catch (const YAML::Exception&) {
+            r.Fail(wp, key, "expected numbers, got '" + wp[k].Scalar() + "'");
+            break;
+          }
+          if (!std::isfinite(p[k])) r.Fail(wp, key, "expected finite numbers, got " + wp[k].Scalar());
+        }
+        s.path.push_back(p);
+      }
+      if (r.ok() && s.path.size() < 2)
+        r.Fail(path, "path", "expected at least 2 waypoints, got " + std::to_string(s.path.size()));
+    }
+  }
+
+  if (const YAML::Node n = root["robot"]; n.IsDefined() && r.ok()) {
+    r.CheckKeys(n, "robot", {"speed_mps", "max_accel_mps2", "turn_rate_dps", "lookahead_m",
+                             "corner_mode", "goal_tolerance_m"});
+    RobotOptions& o = s.robot;
+    r.Double(n, "robot", "speed_mps", &o.speed_mps);
+    r.Require(o.speed_mps > 0 && o.speed_mps <= 3, n, "robot", "speed_mps", "expected in (0, 3] m/s, got " + Num(o.speed_mps));
+    r.Double(n, "robot", "max_accel_mps2", &o.max_accel_mps2);
+    r.Require(o.max_accel_mps2 > 0, n, "robot", "max_accel_mps2", "expected > 0");
+    r.Double(n, "robot", "turn_rate_dps", &o.turn_rate_dps);
+    r.Require(o.turn_rate_dps > 0 && o.turn_rate_dps <= 360, n, "robot", "turn_rate_dps", "expected in (0, 360] deg/s");
+    r.Double(n, "robot", "lookahead_m", &o.lookahead_m);
+    r.Require(o.lookahead_m > 0, n, "robot", "lookahead_m", "expected > 0");
+    r.String(n, "robot", "corner_mode", &o.corner_mode);
+    r.Require(o.corner_mode == "in_place" || o.corner_mode == "arc", n, "robot", "corner_mode", "expected 'in_place' or 'arc', got '" + o.corner_mode + "'");
+    r.Double(n, "robot", "goal_tolerance_m", &o.goal_tolerance_m);
+    r.Require(o.goal_tolerance_m > 0, n, "robot", "goal_tolerance_m", "expected > 0");
+  }
+  if (const YAML::Node n = root["camera"]; n.IsDefined() && r.ok()) {
+    r.CheckKeys(n, "camera", {"width", "height", "fovy_deg", "baseline_m", "height_m", "forward_m", "pitch_deg"});
+    CameraOptions& o = s.camera;
+    r.Int(n, "camera", "width", &o.width);
+    r.Require(o.width >= 16 && o.width <= 4096, n, "camera", "width", "expected 16..4096 pixels, got " + std::to_string(o.width));
+    r.Int(n, "camera", "height", &o.height);
+    r.Require(o.height >= 16 && o.height <= 4096, n, "camera", "height", "expected 16..4096 pixels, got " + std::to_string(o.height));
+    r.Double(n, "camera", "fovy_deg", &o.fovy_deg);
+    r.Require(o.fovy_deg > 1 && o.fovy_deg < 170, n, "camera", "fovy_deg", "expected in (1, 170) degrees, got " + Num(o.fovy_deg));
+    r.Double(n, "camera", "baseline_m", &o.baseline_m);
+    r.Require(o.baseline_m > 0, n, "camera", "baseline_m", "expected a positive baseline (m), got " + Num(o.baseline_m));
+    r.Double(n, "camera", "height_m", &o.height_m);
+    r.Require(o.height_m > 0, n, "camera", "height_m", "expected > 0 m, got " + Num(o.height_m));
+    r.Double(n, "camera", "forward_m", &o.forward_m);
+    r.Double(n, "camera", "pitch_deg", &o.pitch_deg);
+    r.Require(o.pitch_deg > -80 && o.pitch_deg < 80, n, "camera", "pitch_deg", "expected in (-80, 80) degrees");
+  }
+  if (const YAML::Node n = root["noise"]; n.IsDefined() && r.ok()) {
+    r.CheckKeys(n, "noise", {"pixel_sigma", "gain_sigma", "bias_sigma", "motion_blur_exposure_s", "motion_blur_samples"});
+    NoiseOptions& o = s.noise;
+    r.Double(n, "noise", "pixel_sigma", &o.pixel_sigma);
+    r.Require(o.pixel_sigma >= 0, n, "noise", "pixel_sigma", "expected >= 0 grey levels");
+    r.Double(n, "noise", "gain_sigma", &o.gain_sigma);
+    r.Require(o.gain_sigma >= 0 && o.gain_sigma < 0.5, n, "noise", "gain_sigma", "expected in [0, 0.5)");
+    r.Double(n, "noise", "bias_sigma", &o.bias_sigma);
+    r.Require(o.bias_sigma >= 0, n, "noise", "bias_sigma", "expected >= 0 grey levels");
+    r.Double(n, "noise", "motion_blur_exposure_s", &o.motion_blur_exposure_s);
+    r.Require(o.motion_blur_exposure_s >= 0, n, "noise", "motion_blur_exposure_s", "expected >= 0 s");
+    r.Int(n, "noise", "motion_blur_samples", &o.motion_blur_samples);
+  }
+  if (const YAML::Node n = root["textures"]; n.IsDefined() && r.ok()) {
+    r.CheckKeys(n, "textures", {"seed"});
+    r.Uint64(n, "textures", "seed", &s.textures.seed);
+  }
+  if (!r.ok()) {
+    if (error) *error = r.error();
+    return false;
+  }
+  // Resolve the scene relative to the scenario's folder.
+  fs::path scene_path(scene);
+  if (scene_path.is_relative()) scene_path = fs::path(base_dir) / scene_path;
+  s.scene_path = scene_path.lexically_normal().string();
+  if (!fs::exists(s.scene_path)) {
+    if (error) *error = source_name + ": key 'scene': file not found: " + s.scene_path;
+    return false;
+  }
+  if (s.name.empty()) s.name = fs::path(source_name).stem().string();
+  s.source_path = source_name;
+  std::string why;
+  if (!s.IsValid(&why)) {
+    if (error) *error = source_name + ": " + why;
+    return false;
+  }
+  *scenario = std::move(s);
+  return true;
+}
+
+bool LoadScenario(const std::string& path, Scenario* scenario, std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    if (error) *error = path + ": cannot open scenario file (" + (fs::exists(path) ? "not readable" : "no such file") + ")";
+    return false;
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string base = fs::absolute(path).parent_path().string();
+  return ParseScenario(text.str(), path, base, scenario, error);
+}
+
+std::string ScenarioToYaml(const Scenario& s) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << s.name;
+  out << YAML::Key << "scene" << YAML::Value << s.scene_path;
+  out << YAML::Key << "seed" << YAML::Value << s.seed;
+  out << YAML::Key << "rate_hz" << YAML::Value << s.rate_hz;
+  out << YAML::Key << "physics_dt_s" << YAML::Value << s.physics_dt_s;
+  out << YAML::Key << "max_duration_s" << YAML::Value << s.max_duration_s;
+  out << YAML::Key << "settle_s" << YAML::Value << s.settle_s;
+  out << YAML::Key << "path" << YAML::Value << YAML::BeginSeq;
+  for (const auto& p : s.path) out << YAML::Flow << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;
+  out << YAML::EndSeq;
+  out << YAML::Key << "robot" << YAML::Value << YAML::BeginMap
+      << YAML::Key << "speed_mps" << YAML::Value << s.robot.speed_mps
+      << YAML::Key << "max_accel_mps2" << YAML::Value << s.robot.max_accel_mps2
+      << YAML::Key << "turn_rate_dps" << YAML::Value << s.robot.turn_rate_dps
+      << YAML::Key << "lookahead_m" << YAML::Value << s.robot.lookahead_m
+      << YAML::Key << "corner_mode" << YAML::Value << s.robot.corner_mode
+      << YAML::Key << "goal_tolerance_m" << YAML::Value << s.robot.goal_tolerance_m << YAML::EndMap;
+  out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap
+      << YAML::Key << "width" << YAML::Value << s.camera.width
+      << YAML::Key << "height" << YAML::Value << s.camera.height
+      << YAML::Key << "fovy_deg" << YAML::Value << s.camera.fovy_deg
+      << YAML::Key << "baseline_m" << YAML::Value << s.camera.baseline_m
+      << YAML::Key << "height_m" << YAML::Value << s.camera.height_m
+      << YAML::Key << "forward_m" << YAML::Value << s.camera.forward_m
+      << YAML::Key << "pitch_deg" << YAML::Value << s.camera.pitch_deg << YAML::EndMap;
+  out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap
+      << YAML::Key << "pixel_sigma" << YAML::Value << s.noise.pixel_sigma
+      << YAML::Key << "gain_sigma" << YAML::Value << s.noise.gain_sigma
+      << YAML::Key << "bias_sigma" << YAML::Value << s.noise.bias_sigma
+      << YAML::Key << "motion_blur_exposure_s" << YAML::Value << s.noise.motion_blur_exposure_s
+      << YAML::Key << "motion_blur_samples" << YAML::Value << s.noise.motion_blur_samples << YAML::EndMap;
+  out << YAML::Key << "textures" << YAML::Value << YAML::BeginMap
+      << YAML::Key << "seed" << YAML::Value << s.textures.seed << YAML::EndMap;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+std::string BuiltinScenarioPath(const std::string& name) {
+  return (fs::path(VOBENCH_SCENES_DIR) / (name + ".yaml")).string();
+}
+
+}  // namespace sim

@@ -1,0 +1,84 @@
+// A scenario: which scene, which path the robot drives, the stereo rig, noise, seeds.
+// Loaded from YAML (see scenes/l_hallway.yaml for a documented example).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace sim {
+
+// Differential-drive robot and its path-tracking controller (pure pursuit).
+struct RobotOptions {
+  double speed_mps = 0.4;          // commanded cruise speed (m/s), > 0 (Pioneer 2DX ≈ 0.3–0.5)
+  double max_accel_mps2 = 0.5;     // linear acceleration/deceleration limit (m/s²), > 0
+  double turn_rate_dps = 30.0;     // max angular rate when turning in place (deg/s), > 0
+  double lookahead_m = 0.5;        // pure-pursuit look-ahead distance (m), > 0
+  std::string corner_mode = "in_place";  // "in_place": stop and rotate at corners; "arc": cut
+                                         // corners on an arc (pure pursuit over the polyline)
+  double goal_tolerance_m = 0.02;  // a waypoint counts as reached within this distance (m), > 0
+  double wheel_radius_m = 0.095;   // driven-wheel radius (m), as in the MJCF robot
+  double track_m = 0.33;           // distance between the driven wheels (m), as in the MJCF robot
+};
+
+// Rectified stereo pair on the robot (the paper's Videre head by default).
+struct CameraOptions {
+  int width = 320;            // image width (pixels), 16..4096
+  int height = 240;           // image height (pixels), 16..4096
+  double fovy_deg = 55.0;     // vertical field of view (degrees), (1, 170)
+  double baseline_m = 0.09;   // stereo baseline (m), > 0
+  double height_m = 1.0;      // optical centre height above the floor (m), > 0
+  double forward_m = 0.15;    // optical centre ahead of the wheel axle (m)
+  double pitch_deg = 0.0;     // downward tilt of the optical axis (degrees), (-80, 80)
+};
+
+// Camera noise models; each is off at 0.
+struct NoiseOptions {
+  double pixel_sigma = 0.0;         // additive Gaussian pixel noise (grey levels, 0..255 scale)
+  double gain_sigma = 0.0;          // per-image multiplicative gain: gain ~ N(1, gain_sigma²)
+  double bias_sigma = 0.0;          // per-image exposure offset ~ N(0, bias_sigma²) (grey levels)
+  double motion_blur_exposure_s = 0.0;  // exposure time for motion blur (s); 0 = no blur
+  int motion_blur_samples = 5;      // renders averaged over the exposure, >= 2 when blur is on
+};
+
+// Procedural textures of the scene (sim/textures.h).
+struct TextureSettings {
+  uint64_t seed = 1;  // texture generator seed; the same seed gives the same hallway
+};
+
+struct Scenario {
+  std::string name;             // scenario name (file stem unless given)
+  std::string source_path;      // the YAML file it was read from (empty if built in code)
+  std::string scene_path;       // MJCF scene, resolved to an absolute path
+  uint64_t seed = 1;            // noise seed
+  double rate_hz = 10.0;        // camera frame rate (Hz), > 0; independent of the physics step
+  double physics_dt_s = 0.002;  // physics time step (s), > 0
+  double max_duration_s = 300;  // safety limit on simulated time (s)
+  double settle_s = 0.5;        // robot stands still this long before frame 0 (s), >= 0
+  std::vector<Eigen::Vector2d> path;  // waypoints (x, y) in the world frame (m), >= 2
+  RobotOptions robot;
+  CameraOptions camera;
+  NoiseOptions noise;
+  TextureSettings textures;
+
+  bool IsValid(std::string* error) const;
+};
+
+// Reads and validates a scenario file. On failure returns false and *error names the file,
+// the key (and line where known) and what was expected. Unknown keys are errors.
+bool LoadScenario(const std::string& path, Scenario* scenario, std::string* error);
+
+// Parses a scenario from YAML text; `source_name` is used in messages and `base_dir` to
+// resolve a relative scene path.
+bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
+                   const std::string& base_dir, Scenario* scenario, std::string* error);
+
+// Writes the effective scenario as YAML (every field, defaults included).
+std::string ScenarioToYaml(const Scenario& scenario);
+
+// Path of a scenario shipped in scenes/ by name ("l_hallway" -> <scenes>/l_hallway.yaml).
+std::string BuiltinScenarioPath(const std::string& name);
+
+}  // namespace sim

@@ -1,0 +1,353 @@
+#include "sim/simulator.h"
+
+#include <cmath>
+#include <cstring>
+#include <mutex>
+
+#include <mujoco/mujoco.h>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "sim/noise.h"
+#include "sim/path_follower.h"
+#include "sim/random.h"
+#include "sim/renderer.h"
+#include "sim/textures.h"
+
+namespace sim {
+namespace {
+
+// Names the scene must define (see scenes/robot_p2dx.xml).
+constexpr const char* kRobotBody = "robot";
+constexpr const char* kRobotJoint = "robot_root";
+constexpr const char* kLeftActuator = "drive_left";
+constexpr const char* kRightActuator = "drive_right";
+constexpr const char* kCam0 = "cam0";
+constexpr const char* kCam1 = "cam1";
+constexpr double kStoppedSpeedMps = 0.005;  // the robot counts as standing still below this
+
+// MuJoCo reports warnings through a global hook: log them and count them so that the
+// simulator (and its tests) can fail on any.
+int g_warning_count = 0;
+std::mutex g_warning_mutex;
+void WarningHook(const char* msg) {
+  std::lock_guard<std::mutex> lock(g_warning_mutex);
+  ++g_warning_count;
+  spdlog::warn("MuJoCo: {}", msg);
+}
+
+uint64_t HashName(const std::string& s) {  // FNV-1a
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+double YawOf(const mjtNum* quat) {  // MuJoCo quaternion (w, x, y, z)
+  const double w = quat[0], x = quat[1], y = quat[2], z = quat[3];
+  return std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+}
+
+// Camera pose in the world with computer-vision axes (x right, y down, z forward) from
+// MuJoCo's camera frame (x right, y up, looking along -z).
+Eigen::Isometry3d CameraPoseCv(const mjData* d, int cam_id) {
+  Eigen::Matrix3d R_world_mjcam;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R_world_mjcam(r, c) = d->cam_xmat[9 * cam_id + 3 * r + c];
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R_world_mjcam * Eigen::Vector3d(1, -1, -1).asDiagonal();
+  T.translation() = Eigen::Vector3d(d->cam_xpos[3 * cam_id], d->cam_xpos[3 * cam_id + 1],
+                                    d->cam_xpos[3 * cam_id + 2]);
+  return T;
+}
+
+Eigen::Isometry3d BodyPose(const mjData* d, int body_id) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const mjtNum* q = d->xquat + 4 * body_id;
+  T.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(d->xpos[3 * body_id], d->xpos[3 * body_id + 1], d->xpos[3 * body_id + 2]);
+  return T;
+}
+
+// Fills every texture whose name starts with a known kind ("wall_", "floor_", ...) with the
+// procedural generator, sized from the plane geom that uses it.
+bool FillTextures(mjModel* m, uint64_t seed, const std::string& scene, std::string* error) {
+  for (int t = 0; t < m->ntex; ++t) {
+    const std::string name = mj_id2name(m, mjOBJ_TEXTURE, t) ? mj_id2name(m, mjOBJ_TEXTURE, t) : "";
+    const std::string prefix = name.substr(0, name.find('_'));
+    TextureKind kind;
+    if (name.find('_') == std::string::npos || !ParseTextureKind(prefix, &kind)) continue;
+    if (m->tex_type[t] != mjTEXTURE_2D) {
+      *error = scene + ": texture '" + name + "' must be type=\"2d\" to be generated";
+      return false;
+    }
+    // The plane geom whose material carries this texture gives the surface size.
+    int geom = -1;
+    for (int g = 0; g < m->ngeom && geom < 0; ++g) {
+      const int mat = m->geom_matid[g];
+      if (mat >= 0 && m->mat_texid[mat] == t && m->geom_type[g] == mjGEOM_PLANE) geom = g;
+    }
+    if (geom < 0) {
+      *error = scene + ": texture '" + name + "' is not used by any plane geom (generated textures are sized from their plane)";
+      return false;
+    }
+    const double width_m = 2.0 * m->geom_size[3 * geom];
+    const double height_m = 2.0 * m->geom_size[3 * geom + 1];
+    const int w = m->tex_width[t], h = m->tex_height[t];
+    TextureOptions options;
+    options.px_per_m = w / width_m;
+    cv::Mat img = GenerateTexture(kind, width_m, height_m, DeriveSeed(seed, HashName(name)), options);
+    if (img.empty() || img.type() != CV_8UC3) {
+      *error = scene + ": texture generator failed for '" + name + "'";
+      return false;
+    }
+    if (img.cols != w || img.rows != h) cv::resize(img, img, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+    cv::cvtColor(img, img, cv::COLOR_BGR2RGB);
+    unsigned char* dst = m->tex_rgb + m->tex_adr[t];
+    for (int r = 0; r < h; ++r) std::memcpy(dst + static_cast<size_t>(r) * w * 3, img.ptr(r), static_cast<size_t>(w) * 3);
+  }
+  return true;
+}
+
+}  // namespace
+
+void IntrinsicsFromFovy(double fovy_deg, int width, int height, double* fx_px, double* fy_px,
+                        double* cx_px, double* cy_px) {
+  // MuJoCo's frustum spans the viewport's edges: half height = tan(fovy/2) at unit depth.
+  *fy_px = 0.5 * height / std::tan(0.5 * fovy_deg * M_PI / 180.0);
+  *fx_px = *fy_px;
+  // The optical axis passes through the viewport centre, an integer-pixel coordinate of
+  // (W-1)/2 when pixel centres sit at integers.
+  *cx_px = 0.5 * (width - 1);
+  *cy_px = 0.5 * (height - 1);
+}
+
+struct Simulator::Impl {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  std::unique_ptr<OffscreenRenderer> renderer;
+  std::unique_ptr<PathFollower> follower;
+  int body = -1, root_joint = -1, act_left = -1, act_right = -1, cam0 = -1, cam1 = -1;
+  long start_step = 0;      // physics step of frame time 0 (after settling)
+  int next_frame = 0;       // index of the frame being assembled
+  bool finished = false;    // path done and robot at rest: no further frames start
+  int warnings_at_start = 0;
+
+  ~Impl() {
+    renderer.reset();
+    if (d) mj_deleteData(d);
+    if (m) mj_deleteModel(m);
+  }
+};
+
+Simulator::Simulator(const Scenario& scenario) : scenario_(scenario), impl_(new Impl) {}
+Simulator::~Simulator() = default;
+
+const std::string& Simulator::gl_renderer() const { return impl_->renderer->gl_renderer(); }
+
+std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::string* error) {
+  std::string why;
+  if (!scenario.IsValid(&why)) {
+    *error = (scenario.source_path.empty() ? "scenario" : scenario.source_path) + ": " + why;
+    return nullptr;
+  }
+  mju_user_warning = WarningHook;
+  std::unique_ptr<Simulator> sim(new Simulator(scenario));
+  Impl& im = *sim->impl_;
+  const std::string& scene = scenario.scene_path;
+
+  char load_error[1024] = "";
+  im.m = mj_loadXML(scene.c_str(), nullptr, load_error, sizeof(load_error));
+  if (!im.m) {
+    *error = scene + ": cannot load MJCF scene: " + load_error;
+    return nullptr;
+  }
+  mjModel* m = im.m;
+  im.body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
+  im.root_joint = mj_name2id(m, mjOBJ_JOINT, kRobotJoint);
+  im.act_left = mj_name2id(m, mjOBJ_ACTUATOR, kLeftActuator);
+  im.act_right = mj_name2id(m, mjOBJ_ACTUATOR, kRightActuator);
+  im.cam0 = mj_name2id(m, mjOBJ_CAMERA, kCam0);
+  im.cam1 = mj_name2id(m, mjOBJ_CAMERA, kCam1);
+  if (im.body < 0 || im.root_joint < 0 || im.act_left < 0 || im.act_right < 0 || im.cam0 < 0 || im.cam1 < 0) {
+    *error = scene + ": the scene must contain the robot (body 'robot' with free joint 'robot_root', "
+             "actuators 'drive_left'/'drive_right', cameras 'cam0'/'cam1'); include robot_p2dx.xml";
+    return nullptr;
+  }
+  if (m->jnt_type[im.root_joint] != mjJNT_FREE || m->cam_bodyid[im.cam0] != im.body || m->cam_bodyid[im.cam1] != im.body) {
+    *error = scene + ": joint 'robot_root' must be a free joint and cameras 'cam0'/'cam1' must sit on body 'robot'";
+    return nullptr;
+  }
+  m->opt.timestep = scenario.physics_dt_s;
+
+  // Stereo rig: place both cameras from the scenario (body frame: x forward, y left, z up,
+  // origin at the wheel axle, which rests at wheel-radius height).
+  const CameraOptions& co = scenario.camera;
+  const double pitch = co.pitch_deg * M_PI / 180.0;
+  Eigen::Matrix3d R_body_mjcam0;  // camera looks along +x_body, image up = +z_body
+  R_body_mjcam0.col(0) = Eigen::Vector3d(0, -1, 0);
+  R_body_mjcam0.col(1) = Eigen::Vector3d(0, 0, 1);
+  R_body_mjcam0.col(2) = Eigen::Vector3d(-1, 0, 0);
+  const Eigen::Matrix3d R_body_mjcam = R_body_mjcam0 * Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Quaterniond q_body_mjcam(R_body_mjcam);
+  const double z_cam = co.height_m - scenario.robot.wheel_radius_m;
+  const Eigen::Vector3d right_dir = R_body_mjcam.col(0);  // camera x (right) in the body frame
+  const Eigen::Vector3d centre(co.forward_m, 0.0, z_cam);
+  const Eigen::Vector3d p_cam0 = centre - 0.5 * co.baseline_m * right_dir;
+  const Eigen::Vector3d p_cam1 = centre + 0.5 * co.baseline_m * right_dir;
+  for (int k = 0; k < 2; ++k) {
+    const int id = k == 0 ? im.cam0 : im.cam1;
+    const Eigen::Vector3d& p = k == 0 ? p_cam0 : p_cam1;
+    for (int i = 0; i < 3; ++i) m->cam_pos[3 * id + i] = p[i];
+    m->cam_quat[4 * id + 0] = q_body_mjcam.w();
+    m->cam_quat[4 * id + 1] = q_body_mjcam.x();
+    m->cam_quat[4 * id + 2] = q_body_mjcam.y();
+    m->cam_quat[4 * id + 3] = q_body_mjcam.z();
+    m->cam_fovy[id] = co.fovy_deg;
+    m->cam_mode[id] = mjCAMLIGHT_FIXED;
+  }
+  StereoCalibration& cal = sim->calibration_;
+  cal.width = co.width;
+  cal.height = co.height;
+  IntrinsicsFromFovy(co.fovy_deg, co.width, co.height, &cal.fx_px, &cal.fy_px, &cal.cx_px, &cal.cy_px);
+  cal.baseline_m = co.baseline_m;
+  cal.T_body_cam0.linear() = R_body_mjcam * Eigen::Vector3d(1, -1, -1).asDiagonal();
+  cal.T_body_cam0.translation() = p_cam0;
+
+  m->vis.global.offwidth = std::max(m->vis.global.offwidth, co.width);
+  m->vis.global.offheight = std::max(m->vis.global.offheight, co.height);
+  if (!FillTextures(m, scenario.textures.seed, scene, error)) return nullptr;
+
+  im.renderer = OffscreenRenderer::Create(m, co.width, co.height, error);
+  if (!im.renderer) {
+    *error = "cannot render offscreen: " + *error;
+    return nullptr;
+  }
+
+  // Robot at the first waypoint, facing the second.
+  im.d = mj_makeData(m);
+  const int qadr = m->jnt_qposadr[im.root_joint];
+  const Eigen::Vector2d dir = scenario.path[1] - scenario.path[0];
+  const double yaw = std::atan2(dir.y(), dir.x());
+  im.d->qpos[qadr + 0] = scenario.path[0].x();
+  im.d->qpos[qadr + 1] = scenario.path[0].y();
+  im.d->qpos[qadr + 2] = scenario.robot.wheel_radius_m;
+  im.d->qpos[qadr + 3] = std::cos(yaw / 2);
+  im.d->qpos[qadr + 4] = 0;
+  im.d->qpos[qadr + 5] = 0;
+  im.d->qpos[qadr + 6] = std::sin(yaw / 2);
+  mj_forward(m, im.d);
+  im.follower = std::make_unique<PathFollower>(scenario.path, scenario.robot);
+  im.start_step = std::lround(scenario.settle_s / scenario.physics_dt_s);
+  im.warnings_at_start = g_warning_count;
+  return sim;
+}
+
+int Simulator::EstimatedFrames() const {
+  double t = 0.0;
+  const auto& p = scenario_.path;
+  for (size_t i = 1; i < p.size(); ++i) {
+    t += (p[i] - p[i - 1]).norm() / scenario_.robot.speed_mps + scenario_.robot.speed_mps / scenario_.robot.max_accel_mps2;
+    if (i + 1 < p.size() && scenario_.robot.corner_mode == "in_place") {
+      const Eigen::Vector2d a = p[i] - p[i - 1], b = p[i + 1] - p[i];
+      const double turn = std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)));
+      t += turn / (scenario_.robot.turn_rate_dps * M_PI / 180.0) + 1.0;
+    }
+  }
+  return static_cast<int>(t * scenario_.rate_hz) + 1;
+}
+
+bool Simulator::Next(StereoFrame* frame, std::string* error) {
+  error->clear();
+  Impl& im = *impl_;
+  if (im.finished) return false;
+  mjModel* m = im.m;
+  mjData* d = im.d;
+  const Scenario& sc = scenario_;
+  const double dt = sc.physics_dt_s;
+  const int k = im.next_frame;
+  const double t_frame = k / sc.rate_hz;
+
+  // Steps at which this frame is rendered: one, or `motion_blur_samples` spread over the
+  // exposure centred on the frame time; ground truth at the frame time itself.
+  const bool blur = sc.noise.motion_blur_exposure_s > 0.0;
+  const int samples = blur ? sc.noise.motion_blur_samples : 1;
+  std::vector<long> sample_steps(samples);
+  for (int i = 0; i < samples; ++i) {
+    const double off = blur ? sc.noise.motion_blur_exposure_s * (static_cast<double>(i) / (samples - 1) - 0.5) : 0.0;
+    sample_steps[i] = std::max(0l, im.start_step + std::lround((t_frame + off) / dt));
+  }
+  const long gt_step = im.start_step + std::lround(t_frame / dt);
+  const long last_step = std::max(sample_steps.back(), gt_step);
+
+  cv::Mat acc[2];
+  int rendered = 0;
+  bool have_gt = false;
+  const int qadr = m->jnt_qposadr[im.root_joint];
+  const int vadr = m->jnt_dofadr[im.root_joint];
+  while (true) {
+    // Kinematics of the current state, consistent with d->time.
+    mj_step1(m, d);
+    const long step = std::lround(d->time / dt);
+    if (step > im.start_step + std::lround(sc.max_duration_s / dt)) {
+      *error = sc.source_path + ": the robot did not finish its path within max_duration_s = " +
+               std::to_string(sc.max_duration_s) + " s (stuck against a wall, or the path leaves the scene?)";
+      return false;
+    }
+    if (g_warning_count > im.warnings_at_start) {
+      *error = sc.scene_path + ": MuJoCo warning during simulation (see log); the physics are not trustworthy";
+      return false;
+    }
+    if (step >= im.start_step) body_track_.emplace_back(d->xpos[3 * im.body], d->xpos[3 * im.body + 1], d->xpos[3 * im.body + 2]);
+
+    // Render the samples that fall on this step.
+    for (int i = 0; i < samples; ++i) {
+      if (sample_steps[i] != step) continue;
+      for (int c = 0; c < 2; ++c) {
+        cv::Mat rgb, grey;
+        cv::Mat* depth = (c == 0 && !blur) ? &frame->depth_m : nullptr;
+        im.renderer->Render(m, d, c == 0 ? im.cam0 : im.cam1, &rgb, depth);
+        cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+        if (acc[c].empty()) acc[c] = cv::Mat::zeros(grey.size(), CV_32FC1);
+        cv::accumulate(grey, acc[c]);
+      }
+      ++rendered;
+    }
+    if (step == gt_step) {
+      frame->T_world_cam0 = CameraPoseCv(d, im.cam0);
+      frame->T_world_body = BodyPose(d, im.body);
+      if (blur) im.renderer->Render(m, d, im.cam0, nullptr, &frame->depth_m);
+      have_gt = true;
+    }
+    // End of the path: once the controller is done and the robot stands still, no new frame
+    // starts (a frame already under way is completed above).
+    const Eigen::Vector2d pos(d->qpos[qadr], d->qpos[qadr + 1]);
+    const double speed = Eigen::Vector3d(d->qvel[vadr], d->qvel[vadr + 1], d->qvel[vadr + 2]).norm();
+    if (step >= im.start_step && im.follower->done() && speed < kStoppedSpeedMps && rendered == 0) {
+      im.finished = true;
+      return false;
+    }
+
+    // Control: stand still while settling, then follow the path.
+    DriveCommand cmd;
+    if (step >= im.start_step) cmd = im.follower->Update(pos, YawOf(d->qpos + qadr + 3), dt);
+    double wl, wr;
+    WheelSpeeds(cmd, sc.robot.wheel_radius_m, sc.robot.track_m, &wl, &wr);
+    d->ctrl[im.act_left] = wl;
+    d->ctrl[im.act_right] = wr;
+    mj_step2(m, d);
+    if (step >= last_step && have_gt && rendered == samples) break;
+  }
+
+  // Average the exposure samples, then the per-image noise (seeded by frame and camera).
+  for (int c = 0; c < 2; ++c) {
+    acc[c] *= 1.0 / samples;
+    cv::Mat out = ApplyCameraNoise(acc[c], sc.noise, DeriveSeed(sc.seed, static_cast<uint64_t>(k), c));
+    (c == 0 ? frame->left : frame->right) = out;
+  }
+  frame->index = k;
+  frame->time_s = t_frame;
+  ++im.next_frame;
+  return true;
+}
+
+}  // namespace sim

@@ -1,0 +1,74 @@
+// The simulator: a MuJoCo scene with a differential-drive robot that drives a scenario's path
+// through the physics, and a stereo rig on it rendered offscreen (OSMesa) at the scenario's
+// frame rate, with ground-truth pose and depth.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "sim/scenario.h"
+
+namespace sim {
+
+// Rectified stereo calibration the simulator renders with. Pixel centres at integer
+// coordinates (OpenCV); cam1 = cam0 shifted by +baseline_m along cam0's x axis.
+struct StereoCalibration {
+  int width = 0;             // image width (pixels)
+  int height = 0;            // image height (pixels)
+  double fx_px = 0.0;        // focal lengths (pixels)
+  double fy_px = 0.0;
+  double cx_px = 0.0;        // principal point (pixels)
+  double cy_px = 0.0;
+  double baseline_m = 0.0;   // stereo baseline (m)
+  Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();  // cam0 on the robot base
+};
+
+// One stereo frame and its ground truth.
+struct StereoFrame {
+  int index = 0;             // frame number from 0
+  double time_s = 0.0;       // frame time from the first frame (s); mid-exposure with blur
+  cv::Mat left;              // CV_8UC1 grey, cam0
+  cv::Mat right;             // CV_8UC1 grey, cam1
+  cv::Mat depth_m;           // CV_32FC1 z-depth of the left view (m), noise-free
+  Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();  // computer-vision axes
+  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();  // robot base (x forward, z up)
+};
+
+class Simulator {
+ public:
+  // Loads the scene, places the robot at the path's start, builds textures and the renderer.
+  // Returns nullptr and fills *error (naming the scene file) on failure.
+  static std::unique_ptr<Simulator> Create(const Scenario& scenario, std::string* error);
+  ~Simulator();
+
+  // Advances the physics to the next frame and renders it. Returns false at the end of the
+  // path (then *error is empty) or on a failure (then *error says what happened).
+  bool Next(StereoFrame* frame, std::string* error);
+
+  const StereoCalibration& calibration() const { return calibration_; }
+  const Scenario& scenario() const { return scenario_; }
+  const std::string& gl_renderer() const;
+  // Rough number of frames the path will take (for progress displays).
+  int EstimatedFrames() const;
+  // Robot base position (x, y, z in the world, m) after every physics step since frame 0.
+  const std::vector<Eigen::Vector3d>& body_track() const { return body_track_; }
+
+ private:
+  struct Impl;
+  explicit Simulator(const Scenario& scenario);
+  Scenario scenario_;
+  StereoCalibration calibration_;
+  std::vector<Eigen::Vector3d> body_track_;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Intrinsics of a MuJoCo camera with vertical field of view `fovy_deg` rendered at
+// width x height: square pixels, principal point at the image centre.
+void IntrinsicsFromFovy(double fovy_deg, int width, int height, double* fx_px, double* fy_px,
+                        double* cx_px, double* cy_px);
+
+}  // namespace sim

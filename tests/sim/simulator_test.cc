@@ -1,0 +1,230 @@
+// Simulator: the reported calibration and ground truth are the ones it renders with; the
+// robot drives the paper's L through the physics; renders are deterministic.
+#include "sim/simulator.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "sim_test_util.h"
+#include "tests/test_util.h"
+
+namespace {
+
+using vobench_test::MakeScenario;
+using vobench_test::TempDir;
+using vobench_test::WriteScene;
+
+constexpr double kProjectionTolPx = 0.3;     // the bound for marker reprojection
+constexpr double kMarkerDepthTolM = 0.01;    // depth of the marker's front surface vs GT
+constexpr double kMarkerRadiusM = 0.03;
+
+// Small self-lit white spheres at known world points in an otherwise black, empty scene.
+const std::vector<Eigen::Vector3d> kMarkers = {
+    {2.0, 0.0, 1.0},  {2.5, 0.6, 1.3},  {1.6, -0.5, 0.7}, {3.0, -0.9, 1.5},
+    {2.2, 0.45, 0.6}, {1.8, 0.3, 1.25}, {2.8, 0.0, 0.45}, {2.4, -0.7, 1.1}};
+
+std::string MarkerXml() {
+  std::string xml;
+  for (const auto& p : kMarkers) {
+    char buf[256];
+    std::snprintf(buf, sizeof(buf),
+                  "    <geom type='sphere' size='%g' pos='%g %g %g' material='marker' contype='0' conaffinity='0'/>\n",
+                  kMarkerRadiusM, p.x(), p.y(), p.z());
+    xml += buf;
+  }
+  return xml;
+}
+
+// Intensity-weighted centroids of the bright blobs in `image`.
+std::vector<Eigen::Vector2d> BlobCentroids(const cv::Mat& image) {
+  cv::Mat mask, labels, stats, centroids;
+  cv::threshold(image, mask, 5, 255, cv::THRESH_BINARY);
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8);
+  std::vector<Eigen::Vector2d> out;
+  for (int i = 1; i < n; ++i) {
+    double sw = 0, su = 0, sv = 0;
+    for (int r = 0; r < image.rows; ++r)
+      for (int c = 0; c < image.cols; ++c)
+        if (labels.at<int>(r, c) == i) {
+          const double w = image.at<unsigned char>(r, c);
+          sw += w;
+          su += w * c;
+          sv += w * r;
+        }
+    out.emplace_back(su / sw, sv / sw);
+  }
+  return out;
+}
+
+struct ProjectionCase {
+  int width, height;
+  double fovy_deg, pitch_deg, baseline_m;
+};
+
+class ProjectionTest : public ::testing::TestWithParam<ProjectionCase> {};
+
+TEST_P(ProjectionTest, MarkersLandWhereCalibrationAndPoseProjectThem) {
+  const ProjectionCase pc = GetParam();
+  TempDir dir("proj");
+  const std::string scene = WriteScene(dir, MarkerXml(),
+                                       "<material name='marker' rgba='1 1 1 1' emission='1'/>");
+  sim::Scenario s = MakeScenario(scene);
+  s.camera.width = pc.width;
+  s.camera.height = pc.height;
+  s.camera.fovy_deg = pc.fovy_deg;
+  s.camera.pitch_deg = pc.pitch_deg;
+  s.camera.baseline_m = pc.baseline_m;
+  std::string error;
+  auto simulator = sim::Simulator::Create(s, &error);
+  ASSERT_TRUE(simulator) << error;
+  sim::StereoFrame frame;
+  ASSERT_TRUE(simulator->Next(&frame, &error)) << error;
+  ASSERT_EQ(frame.left.cols, pc.width);
+  ASSERT_EQ(frame.left.rows, pc.height);
+  const sim::StereoCalibration& cal = simulator->calibration();
+
+  Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
+  T_cam0_cam1.translation() = Eigen::Vector3d(cal.baseline_m, 0, 0);
+  const Eigen::Isometry3d T_world_cam1 = frame.T_world_cam0 * T_cam0_cam1;
+  int checked = 0;
+  for (int cam = 0; cam < 2; ++cam) {
+    const cv::Mat& image = cam == 0 ? frame.left : frame.right;
+    const Eigen::Isometry3d T_cam_world = (cam == 0 ? frame.T_world_cam0 : T_world_cam1).inverse();
+    const std::vector<Eigen::Vector2d> blobs = BlobCentroids(image);
+    for (const auto& p_world : kMarkers) {
+      const Eigen::Vector3d p = T_cam_world * p_world;
+      ASSERT_GT(p.z(), 0.5);
+      const Eigen::Vector2d uv(cal.fx_px * p.x() / p.z() + cal.cx_px, cal.fy_px * p.y() / p.z() + cal.cy_px);
+      if (uv.x() < 8 || uv.y() < 8 || uv.x() > pc.width - 9 || uv.y() > pc.height - 9) continue;
+      double best = 1e9;
+      for (const auto& b : blobs) best = std::min(best, (b - uv).norm());
+      EXPECT_LT(best, kProjectionTolPx) << "camera " << cam << " marker " << p_world.transpose()
+                                        << " projected at " << uv.transpose();
+      if (cam == 0) {
+        // Ground-truth depth at the marker's centre pixel: its front surface.
+        const double z = frame.depth_m.at<float>(static_cast<int>(std::lround(uv.y())),
+                                                 static_cast<int>(std::lround(uv.x())));
+        EXPECT_NEAR(z, p.z() - kMarkerRadiusM * p.z() / p.norm(), kMarkerDepthTolM);
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 10);
+}
+
+INSTANTIATE_TEST_SUITE_P(Rigs, ProjectionTest,
+                         ::testing::Values(ProjectionCase{320, 240, 55.0, 0.0, 0.09},
+                                           ProjectionCase{400, 300, 60.0, 8.0, 0.12},
+                                           ProjectionCase{321, 199, 45.0, -5.0, 0.3}));
+
+TEST(SimulatorTest, RobotDrivesThePapersLPath) {
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  auto simulator = sim::Simulator::Create(s, &error);
+  ASSERT_TRUE(simulator) << error;
+  sim::StereoFrame frame;
+  int frames = 0;
+  while (simulator->Next(&frame, &error)) ++frames;
+  ASSERT_TRUE(error.empty()) << error;
+  const auto& track = simulator->body_track();
+  ASSERT_GT(track.size(), 100u);
+  double length = 0.0;
+  double corner_dist = 1e9;
+  const Eigen::Vector2d corner = s.path[1];
+  for (size_t i = 0; i < track.size(); ++i) {
+    if (i > 0) length += (track[i] - track[i - 1]).head<2>().norm();
+    corner_dist = std::min(corner_dist, (track[i].head<2>() - corner).norm());
+  }
+  EXPECT_NEAR(length, 16.0, 0.3);
+  EXPECT_LT(corner_dist, 0.1);
+  EXPECT_LT((track.back().head<2>() - s.path.back()).norm(), 0.1);
+  // It really drove: the body stayed on the floor and upright, frames came at the rate.
+  for (const auto& p : track) ASSERT_NEAR(p.z(), s.robot.wheel_radius_m, 0.01);
+  EXPECT_NEAR(frame.time_s, (frames - 1) / s.rate_hz, 1e-9);
+  EXPECT_GT(frames, 300);
+}
+
+TEST(SimulatorTest, SameScenarioAndSeedGiveIdenticalFrames) {
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  s.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.6, 0)};
+  s.noise.motion_blur_exposure_s = 0.03;  // every noise model on
+  std::vector<sim::StereoFrame> runs[2];
+  for (auto& run : runs) {
+    auto simulator = sim::Simulator::Create(s, &error);
+    ASSERT_TRUE(simulator) << error;
+    sim::StereoFrame f;
+    while (simulator->Next(&f, &error)) run.push_back(f);
+    ASSERT_TRUE(error.empty()) << error;
+  }
+  ASSERT_EQ(runs[0].size(), runs[1].size());
+  ASSERT_GT(runs[0].size(), 5u);
+  for (size_t i = 0; i < runs[0].size(); ++i) {
+    EXPECT_EQ(cv::norm(runs[0][i].left, runs[1][i].left, cv::NORM_INF), 0) << i;
+    EXPECT_EQ(cv::norm(runs[0][i].right, runs[1][i].right, cv::NORM_INF), 0) << i;
+    EXPECT_EQ(cv::norm(runs[0][i].depth_m, runs[1][i].depth_m, cv::NORM_INF), 0) << i;
+    EXPECT_TRUE(runs[0][i].T_world_cam0.matrix() == runs[1][i].T_world_cam0.matrix()) << i;
+  }
+  // Another noise seed changes the images, not the ground truth.
+  s.seed = 2;
+  auto simulator = sim::Simulator::Create(s, &error);
+  sim::StereoFrame f;
+  ASSERT_TRUE(simulator->Next(&f, &error));
+  EXPECT_GT(cv::norm(f.left, runs[0][0].left, cv::NORM_L1), 0);
+  EXPECT_TRUE(f.T_world_cam0.matrix() == runs[0][0].T_world_cam0.matrix());
+}
+
+TEST(SimulatorTest, NoiseModelsChangeTheImageAsConfigured) {
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  s.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.3, 0)};
+  s.noise = sim::NoiseOptions();  // all off
+  auto clean_sim = sim::Simulator::Create(s, &error);
+  ASSERT_TRUE(clean_sim) << error;
+  sim::StereoFrame clean;
+  ASSERT_TRUE(clean_sim->Next(&clean, &error));
+  s.noise.pixel_sigma = 4.0;
+  auto noisy_sim = sim::Simulator::Create(s, &error);
+  sim::StereoFrame noisy;
+  ASSERT_TRUE(noisy_sim->Next(&noisy, &error));
+  cv::Mat diff;
+  cv::subtract(noisy.left, clean.left, diff, cv::noArray(), CV_32F);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(diff, mean, stddev);
+  EXPECT_NEAR(stddev[0], 4.0, 0.6);  // clipping at 0/255 shrinks it a little
+  EXPECT_NEAR(mean[0], 0.0, 0.5);
+}
+
+TEST(SimulatorTest, SceneErrorsNameTheFile) {
+  TempDir dir("bad");
+  std::string error;
+  // Malformed MJCF.
+  const std::string broken = dir / "broken.xml";
+  vobench_test::WriteText(broken, "<mujoco><worldbody><geom type='sphere'</worldbody>");
+  sim::Scenario s = MakeScenario(broken);
+  EXPECT_EQ(sim::Simulator::Create(s, &error), nullptr);
+  EXPECT_NE(error.find(broken), std::string::npos) << error;
+  // Valid MJCF without the robot.
+  const std::string empty = dir / "empty.xml";
+  vobench_test::WriteText(empty, "<mujoco><worldbody><geom type='plane' size='1 1 1'/></worldbody></mujoco>");
+  s = MakeScenario(empty);
+  EXPECT_EQ(sim::Simulator::Create(s, &error), nullptr);
+  EXPECT_NE(error.find(empty), std::string::npos) << error;
+  EXPECT_NE(error.find("robot"), std::string::npos) << error;
+}
+
+TEST(SimulatorTest, IntrinsicsFromFovy) {
+  double fx, fy, cx, cy;
+  sim::IntrinsicsFromFovy(90.0, 640, 480, &fx, &fy, &cx, &cy);
+  EXPECT_NEAR(fy, 240.0, 1e-9);
+  EXPECT_NEAR(fx, 240.0, 1e-9);
+  EXPECT_DOUBLE_EQ(cx, 319.5);
+  EXPECT_DOUBLE_EQ(cy, 239.5);
+}
+
+}  // namespace

@@ -1,0 +1,32 @@
+// Shared test helpers: pose matchers and named tolerances.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <gmock/gmock.h>
+
+namespace vobench_test {
+
+// Rotation angle (radians) of R_a^T R_b.
+inline double RotationAngleRad(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
+  const double c = std::clamp(((R_a.transpose() * R_b).trace() - 1.0) / 2.0, -1.0, 1.0);
+  return std::acos(c);
+}
+
+// Matches an Eigen::Isometry3d within tol_rad of rotation and tol_m of translation.
+MATCHER_P3(IsNearPose, expected, tol_rad, tol_m,
+           "is within " + ::testing::PrintToString(tol_rad) + " rad and " +
+               ::testing::PrintToString(tol_m) + " m of the expected pose") {
+  const double dr = RotationAngleRad(expected.linear(), arg.linear());
+  const double dt = (expected.translation() - arg.translation()).norm();
+  *result_listener << "rotation error " << dr << " rad, translation error " << dt << " m";
+  return dr <= tol_rad && dt <= tol_m;
+}
+
+// Directory of the shared real data sets (../shared/data); tests skip when it is absent.
+inline std::string SharedDataDir() { return VOBENCH_SHARED_DATA_DIR; }
+
+}  // namespace vobench_test

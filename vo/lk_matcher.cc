@@ -1,0 +1,103 @@
+#include "vo/lk_matcher.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include <opencv2/video/tracking.hpp>
+
+namespace vo {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+LucasKanadeMatcher::LucasKanadeMatcher(const Options& options) : options_(options) {
+  std::string error;
+  if (!options_.IsValid(&error)) {
+    std::fprintf(stderr, "vo::LucasKanadeMatcher: invalid options: %s\n", error.c_str());
+    std::abort();
+  }
+}
+
+const std::vector<cv::Mat>& LucasKanadeMatcher::Pyramid(const MatchFrame& frame) const {
+  FrameCues& cues = frame.cues;
+  if (cues.lk_pyramid.empty() || cues.lk_window_px != options_.window_px ||
+      cues.lk_max_level != options_.max_level) {
+    cues.lk_pyramid.clear();
+    cv::buildOpticalFlowPyramid(frame.image, cues.lk_pyramid,
+                                cv::Size(options_.window_px, options_.window_px),
+                                options_.max_level);
+    cues.lk_window_px = options_.window_px;
+    cues.lk_max_level = options_.max_level;
+  }
+  return cues.lk_pyramid;
+}
+
+std::vector<Match> LucasKanadeMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
+                                                   MatcherSummary* summary) {
+  MatcherSummary local;
+  MatcherSummary& s = summary != nullptr ? *summary : local;
+  s = MatcherSummary();
+  s.num_prev = static_cast<int>(prev.features.size());
+  s.num_curr = static_cast<int>(curr.features.size());
+  if (s.num_prev == 0 || s.num_curr == 0) return {};
+  if (prev.image.empty() || curr.image.empty() || prev.image.type() != CV_8UC1 ||
+      curr.image.type() != CV_8UC1 || prev.image.size() != curr.image.size()) {
+    s.ok = false;
+    s.message = "LucasKanadeMatcher: needs CV_8UC1 images of the same size in both frames";
+    return {};
+  }
+  auto t0 = std::chrono::steady_clock::now();
+  const std::vector<cv::Mat>& pyr_prev = Pyramid(prev);
+  const std::vector<cv::Mat>& pyr_curr = Pyramid(curr);
+  s.cue_time_ms = MsSince(t0);
+  t0 = std::chrono::steady_clock::now();
+
+  // 1. Forward tracking of every previous feature.
+  std::vector<cv::Point2f> pts_prev, pts_fwd, pts_back;
+  pts_prev.reserve(s.num_prev);
+  for (const Feature& f : prev.features) {
+    pts_prev.emplace_back(static_cast<float>(f.uv_px.x()), static_cast<float>(f.uv_px.y()));
+  }
+  const cv::Size window(options_.window_px, options_.window_px);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  options_.max_iterations, options_.epsilon_px);
+  std::vector<uchar> status_fwd, status_back;
+  std::vector<float> err;
+  cv::calcOpticalFlowPyrLK(pyr_prev, pyr_curr, pts_prev, pts_fwd, status_fwd, err, window,
+                           options_.max_level, criteria, 0, options_.min_eig_threshold);
+  // 2. Forward-backward check.
+  const bool fb_check = options_.max_fb_error_px > 0.0;
+  if (fb_check) {
+    cv::calcOpticalFlowPyrLK(pyr_curr, pyr_prev, pts_fwd, pts_back, status_back, err, window,
+                             options_.max_level, criteria, 0, options_.min_eig_threshold);
+  }
+  // 3. Association with the current features (greedy one-to-one by distance).
+  const double radius = options_.association_radius_px;
+  const PointGrid grid(FeaturePositions(curr.features), radius);
+  std::vector<CandidatePair> candidates;
+  for (int i = 0; i < s.num_prev; ++i) {
+    if (!status_fwd[i]) continue;
+    if (fb_check) {
+      const double fb = std::hypot(pts_back[i].x - pts_prev[i].x, pts_back[i].y - pts_prev[i].y);
+      if (!status_back[i] || !(fb <= options_.max_fb_error_px)) continue;
+    }
+    const Eigen::Vector2d tracked(pts_fwd[i].x, pts_fwd[i].y);
+    grid.ForEachWithin(tracked, radius, [&](int j, double d2) {
+      ++s.num_candidates;
+      candidates.push_back(CandidatePair{i, j, std::sqrt(d2)});
+    });
+  }
+  std::vector<Match> matches =
+      GreedyOneToOne(std::move(candidates), [radius](double d) { return 1.0 - d / radius; });
+  s.match_time_ms = MsSince(t0);
+  s.num_matches = static_cast<int>(matches.size());
+  return matches;
+}
+
+}  // namespace vo
