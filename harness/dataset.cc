@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -13,10 +14,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
-
 #include <opencv2/imgcodecs.hpp>
-#include <yaml-cpp/yaml.h>
+#include <sstream>
 
 namespace harness {
 namespace fs = std::filesystem;
@@ -68,7 +67,8 @@ bool IsRotation(const Eigen::Matrix3d& R, double tolerance) {
 bool WriteBytes(const std::string& path, const std::vector<uchar>& bytes, std::string* error) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) return Fail(error, path + ": cannot open for writing");
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
   out.close();
   if (!out) return Fail(error, path + ": write error");
   return true;
@@ -147,7 +147,8 @@ std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d&
   }
   s += "\n# Camera specific definitions.\n";
   s += "rate_hz: " + FormatDouble(rate_hz) + "\n";
-  s += "resolution: [" + std::to_string(camera.width) + ", " + std::to_string(camera.height) + "]\n";
+  s +=
+      "resolution: [" + std::to_string(camera.width) + ", " + std::to_string(camera.height) + "]\n";
   s += "camera_model: pinhole\n";
   s += "intrinsics: [" + FormatDouble(camera.fx_px) + ", " + FormatDouble(camera.fy_px) + ", " +
        FormatDouble(camera.cx_px) + ", " + FormatDouble(camera.cy_px) + "] #fu, fv, cu, cv\n";
@@ -162,7 +163,8 @@ std::vector<std::string_view> SplitCsv(std::string_view line) {
   size_t start = 0;
   while (true) {
     const size_t comma = line.find(',', start);
-    std::string_view f = line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
+    std::string_view f =
+        line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
     while (!f.empty() && (f.front() == ' ' || f.front() == '\t')) f.remove_prefix(1);
     while (!f.empty() && (f.back() == ' ' || f.back() == '\t')) f.remove_suffix(1);
     fields.push_back(f);
@@ -185,16 +187,21 @@ double NsToSeconds(int64_t t_ns) { return static_cast<double>(t_ns) / 1e9; }
 // ---------------------------------------------------------------------------------------------
 
 bool ParseDatasetFormat(const std::string& name, DatasetFormat* format) {
-  if (name == "kitti") *format = DatasetFormat::kKitti;
-  else if (name == "euroc") *format = DatasetFormat::kEuroc;
-  else return false;
+  if (name == "kitti")
+    *format = DatasetFormat::kKitti;
+  else if (name == "euroc")
+    *format = DatasetFormat::kEuroc;
+  else
+    return false;
   return true;
 }
 
 const char* DatasetFormatName(DatasetFormat format) {
   switch (format) {
-    case DatasetFormat::kKitti: return "kitti";
-    case DatasetFormat::kEuroc: return "euroc";
+    case DatasetFormat::kKitti:
+      return "kitti";
+    case DatasetFormat::kEuroc:
+      return "euroc";
   }
   return "unknown";
 }
@@ -242,8 +249,8 @@ bool DatasetWriter::Open(const std::string& dir, const vo::StereoCamera& camera,
     if (!options_.overwrite)
       return Fail(error, dir_ + ": output folder already exists (set overwrite to replace it)");
   }
-  const fs::path parent = fs::path(dir_).has_parent_path() ? fs::path(dir_).parent_path()
-                                                            : fs::path(".");
+  const fs::path parent =
+      fs::path(dir_).has_parent_path() ? fs::path(dir_).parent_path() : fs::path(".");
   if (!MakeDir(parent.string(), error)) return false;
   RemoveStalePartials(dir_);
 
@@ -356,7 +363,8 @@ bool DatasetWriter::WriteEurocText(std::string* error) const {
   for (int cam = 0; cam < 2; ++cam) {
     const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));
     std::string csv = "#timestamp [ns],filename\n";
-    for (int64_t t_ns : times_ns_) csv += std::to_string(t_ns) + "," + std::to_string(t_ns) + ".png\n";
+    for (int64_t t_ns : times_ns_)
+      csv += std::to_string(t_ns) + "," + std::to_string(t_ns) + ".png\n";
     if (!WriteTextFile(Join(base, "data.csv"), csv, error)) return false;
     if (!WriteTextFile(Join(base, "sensor.yaml"),
                        EurocSensorYaml(comments[cam], T_body_cam[cam], camera_, rate_hz), error))
@@ -393,8 +401,8 @@ bool DatasetWriter::Finish(std::string* error) {
   if (times_s_.empty()) return Fail(error, dir_ + ": no frames were added");
 
   // calib.txt: rectified projection matrices, P1 = K [I | (-baseline_m, 0, 0)].
-  const double P0[12] = {camera_.fx_px, 0, camera_.cx_px, 0,   0, camera_.fy_px,
-                         camera_.cy_px, 0, 0,             0,   1, 0};
+  const double P0[12] = {
+      camera_.fx_px, 0, camera_.cx_px, 0, 0, camera_.fy_px, camera_.cy_px, 0, 0, 0, 1, 0};
   double P1[12];
   std::copy(P0, P0 + 12, P1);
   P1[3] = -(camera_.fx_px * camera_.baseline_m);
@@ -409,7 +417,8 @@ bool DatasetWriter::Finish(std::string* error) {
     std::vector<Eigen::Isometry3d> poses;
     std::vector<StampedPose> tum;
     for (size_t i = 0; i < times_s_.size(); ++i) {
-      poses.push_back(i == 0 ? Eigen::Isometry3d::Identity() : T_cam0first_world * T_world_cam0_[i]);
+      poses.push_back(i == 0 ? Eigen::Isometry3d::Identity()
+                             : T_cam0first_world * T_world_cam0_[i]);
       tum.push_back({times_s_[i], poses.back()});
     }
     if (!WriteKittiPoses(Join(partial_dir_, "poses.txt"), poses, error) ||
@@ -427,7 +436,8 @@ bool DatasetWriter::Finish(std::string* error) {
   std::string old_dir;
   if (fs::exists(dir_, ec)) {
     if (!options_.overwrite)
-      return Fail(error, dir_ + ": output folder appeared while writing (set overwrite to replace it)");
+      return Fail(error,
+                  dir_ + ": output folder appeared while writing (set overwrite to replace it)");
     std::string pattern = dir_ + ".old-XXXXXX";
     std::vector<char> buffer(pattern.begin(), pattern.end());
     buffer.push_back('\0');
@@ -475,8 +485,8 @@ bool ReadKittiCalib(const std::string& path, vo::StereoCamera* camera, std::stri
   }
   for (int k = 0; k < 2; ++k)
     if (P[k].empty())
-      return Fail(error, path + ": no P" + std::to_string(k) +
-                             ": line (expected 'P" + std::to_string(k) + ": ' and 12 numbers)");
+      return Fail(error, path + ": no P" + std::to_string(k) + ": line (expected 'P" +
+                             std::to_string(k) + ": ' and 12 numbers)");
   // Rectified pair: same intrinsics, only the x offset differs.
   for (int idx : {0, 1, 2, 5, 6, 10}) {
     if (std::abs(P[0][idx] - P[1][idx]) > 1e-9 * std::max(1.0, std::abs(P[0][idx])))
@@ -493,8 +503,8 @@ bool ReadKittiCalib(const std::string& path, vo::StereoCamera* camera, std::stri
     return Fail(error, path + ": P0 focal lengths must be > 0");
   camera->baseline_m = (P[0][3] - P[1][3]) / camera->fx_px;
   if (!(camera->baseline_m > 0.0))
-    return Fail(error, path + ": baseline (P0[3] - P1[3]) / fx = " +
-                           FormatDouble(camera->baseline_m) +
+    return Fail(error, path +
+                           ": baseline (P0[3] - P1[3]) / fx = " + FormatDouble(camera->baseline_m) +
                            " m, expected > 0 (P1 column 4 holds -fx * baseline)");
   return true;
 }
@@ -554,8 +564,9 @@ bool KittiReader::Open(const std::string& dir, const Options& options, std::stri
   if (left.empty()) return Fail(error, ImagePath(0, 0) + ": cannot decode the image");
   if (right.empty()) return Fail(error, ImagePath(1, 0) + ": cannot decode the image");
   if (left.size() != right.size())
-    return Fail(error, ImagePath(1, 0) + ": size " + SizeText(right) + " differs from the left image's " +
-                           SizeText(left) + " (" + ImagePath(0, 0) + ")");
+    return Fail(error, ImagePath(1, 0) + ": size " + SizeText(right) +
+                           " differs from the left image's " + SizeText(left) + " (" +
+                           ImagePath(0, 0) + ")");
   camera_.width = left.cols;
   camera_.height = left.rows;
   std::string why;
@@ -604,8 +615,8 @@ bool KittiReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* erro
   frame->right = images[1];
   frame->depth_m = depth_m;
   frame->has_gt = has_ground_truth();
-  frame->T_world_cam0 = frame->has_gt ? T_world_cam0first_ * T_cam0first_cam0_[index]
-                                      : Eigen::Isometry3d::Identity();
+  frame->T_world_cam0 =
+      frame->has_gt ? T_world_cam0first_ * T_cam0first_cam0_[index] : Eigen::Isometry3d::Identity();
   return true;
 }
 
@@ -630,8 +641,9 @@ bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibr
     const YAML::Node root = YAML::Load(text);
     auto require = [&](const char* key, const char* expected) -> YAML::Node {
       const YAML::Node node = root[key];
-      if (!node) throw std::runtime_error(std::string("missing key '") + key + "' (expected " +
-                                          expected + ")");
+      if (!node)
+        throw std::runtime_error(std::string("missing key '") + key + "' (expected " + expected +
+                                 ")");
       return node;
     };
     auto numbers = [&](const YAML::Node& node, const char* key, size_t count) {
@@ -643,8 +655,8 @@ bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibr
       for (const YAML::Node& x : node) {
         v.push_back(x.as<double>());
         if (!std::isfinite(v.back()))
-          throw std::runtime_error(std::string("'") + key + "': value " +
-                                   std::to_string(v.size()) + " is not finite");
+          throw std::runtime_error(std::string("'") + key + "': value " + std::to_string(v.size()) +
+                                   " is not finite");
       }
       return v;
     };
@@ -657,22 +669,25 @@ bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibr
     if (!c.T_body_cam.matrix().row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1)) ||
         !IsRotation(c.T_body_cam.linear(), 1e-5))
       throw std::runtime_error("'T_BS': expected a rigid transform (rotation, last row 0 0 0 1)");
-    const std::vector<double> k = numbers(require("intrinsics", "[fu, fv, cu, cv]"), "intrinsics", 4);
+    const std::vector<double> k =
+        numbers(require("intrinsics", "[fu, fv, cu, cv]"), "intrinsics", 4);
     c.fu_px = k[0];
     c.fv_px = k[1];
     c.cu_px = k[2];
     c.cv_px = k[3];
     if (!(c.fu_px > 0.0) || !(c.fv_px > 0.0))
       throw std::runtime_error("'intrinsics': focal lengths fu, fv must be > 0");
-    const std::vector<double> res = numbers(require("resolution", "[width, height]"), "resolution", 2);
+    const std::vector<double> res =
+        numbers(require("resolution", "[width, height]"), "resolution", 2);
     c.width = static_cast<int>(res[0]);
     c.height = static_cast<int>(res[1]);
     if (c.width <= 0 || c.height <= 0 || c.width != res[0] || c.height != res[1])
       throw std::runtime_error("'resolution': expected two positive integers [width, height]");
     c.camera_model = require("camera_model", "pinhole").as<std::string>();
-    c.distortion_model = require("distortion_model", "radial-tangential | equidistant").as<std::string>();
-    c.distortion_coefficients =
-        numbers(require("distortion_coefficients", "a list of numbers"), "distortion_coefficients", 0);
+    c.distortion_model =
+        require("distortion_model", "radial-tangential | equidistant").as<std::string>();
+    c.distortion_coefficients = numbers(require("distortion_coefficients", "a list of numbers"),
+                                        "distortion_coefficients", 0);
     if (root["rate_hz"]) c.rate_hz = root["rate_hz"].as<double>();
   } catch (const YAML::Exception& e) {
     return Fail(error, (e.mark.line >= 0 ? Where(path, e.mark.line + 1) : path + ": ") + e.msg);
@@ -696,8 +711,8 @@ bool ReadEurocCameraCsv(const std::string& path, const std::string& image_dir,
     const std::vector<std::string_view> f = SplitCsv(lines[i]);
     int64_t t_ns = 0;
     if (f.size() != 2 || !ParseInt64(f[0], &t_ns) || f[1].empty())
-      return Fail(error, Where(path, static_cast<int>(i) + 1) +
-                             "expected '<timestamp ns>,<file name>'");
+      return Fail(error,
+                  Where(path, static_cast<int>(i) + 1) + "expected '<timestamp ns>,<file name>'");
     if (!images->emplace(t_ns, Join(image_dir, std::string(f[1]))).second)
       return Fail(error, Where(path, static_cast<int>(i) + 1) + "duplicate timestamp " +
                              std::to_string(t_ns));
@@ -720,7 +735,8 @@ bool ReadEurocGroundTruth(const std::string& path, std::vector<int64_t>* t_ns,
     std::string_view head = std::string_view(lines[i]).substr(0, comma);
     while (!head.empty() && head.back() == ' ') head.remove_suffix(1);
     if (comma == std::string::npos || !ParseInt64(head, &stamp))
-      return Fail(error, Where(path, line_no) + "expected '<timestamp ns>,p_x,p_y,p_z,q_w,q_x,q_y,q_z,...'");
+      return Fail(error, Where(path, line_no) +
+                             "expected '<timestamp ns>,p_x,p_y,p_z,q_w,q_x,q_y,q_z,...'");
     const std::string_view rest = std::string_view(lines[i]).substr(comma + 1);
     const size_t fields = SplitCsv(rest).size();
     if (fields < 7 || !ParseNumbers(rest, fields, &v, &what))
@@ -813,14 +829,16 @@ bool EurocReader::Rectification(StereoRectification* rectification, std::string*
   const double dk = std::max({std::abs(a.fu_px - b.fu_px), std::abs(a.fv_px - b.fv_px),
                               std::abs(a.cu_px - b.cu_px), std::abs(a.cv_px - b.cv_px)});
   if (dk > kRectifiedIntrinsicsTolerancePx)
-    return Fail(error, where + "cam0 and cam1 intrinsics differ: rectification not implemented yet");
+    return Fail(error,
+                where + "cam0 and cam1 intrinsics differ: rectification not implemented yet");
   const Eigen::Isometry3d T_cam0_cam1 = a.T_body_cam.inverse() * b.T_body_cam;
   const double dr = (T_cam0_cam1.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   const Eigen::Vector3d t = T_cam0_cam1.translation();
   if (dr > kRectifiedRotationTolerance || std::abs(t.y()) > kRectifiedOffsetToleranceM ||
       std::abs(t.z()) > kRectifiedOffsetToleranceM || !(t.x() > 0.0))
-    return Fail(error, where + "cam1 is not at +x of cam0 with the same orientation: "
-                               "rectification not implemented yet");
+    return Fail(error, where +
+                           "cam1 is not at +x of cam0 with the same orientation: "
+                           "rectification not implemented yet");
   StereoRectification r;
   r.camera.width = a.width;
   r.camera.height = a.height;
@@ -857,8 +875,8 @@ bool EurocReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* erro
   frame->depth_m = cv::Mat();
   const long gt = gt_index_[index];
   frame->has_gt = gt >= 0;
-  frame->T_world_cam0 = frame->has_gt ? gt_body_[gt].T_world_cam * cam_[0].T_body_cam
-                                      : Eigen::Isometry3d::Identity();
+  frame->T_world_cam0 =
+      frame->has_gt ? gt_body_[gt].T_world_cam * cam_[0].T_body_cam : Eigen::Isometry3d::Identity();
   return true;
 }
 

@@ -25,13 +25,12 @@
 // Errors: functions return false and fill *error with the file (and line) and what was expected.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
-#include <opencv2/core.hpp>
 
 #include "harness/trajectory_io.h"
 #include "vo/camera.h"
@@ -71,13 +70,13 @@ class DatasetWriter {
  public:
   struct Options {
     DatasetFormat format = DatasetFormat::kKitti;  // kEuroc also writes the mav0/ layout
-    bool overwrite = false;     // replace an existing DIR (on Finish); otherwise refuse
-    bool write_depth = true;    // write depth/%06d.png for frames that carry depth
-    int png_compression = 3;    // zlib level of every PNG, 0 (none) .. 9 (smallest, slowest)
+    bool overwrite = false;   // replace an existing DIR (on Finish); otherwise refuse
+    bool write_depth = true;  // write depth/%06d.png for frames that carry depth
+    int png_compression = 3;  // zlib level of every PNG, 0 (none) .. 9 (smallest, slowest)
+    // EuRoC body frame: the left camera's pose in the body (rotation, metres).
     Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();
-                                // EuRoC body frame: left camera in the body (rotation + metres)
-    double rate_hz = 0.0;       // rate written to sensor.yaml (Hz, >= 0); 0 = from the median
-                                // frame interval, rounded to 1 mHz
+    double rate_hz = 0.0;  // rate written to sensor.yaml (Hz, >= 0); 0 = from the median
+                           // frame interval, rounded to 1 mHz
 
     bool IsValid(std::string* error) const;
   };
@@ -127,8 +126,8 @@ int64_t TimeToNs(double time_s);
 class KittiReader {
  public:
   struct Options {
-    std::string poses_path;    // ground-truth file (KITTI poses); empty = DIR/poses.txt if it exists
-                               // (the KITTI benchmark keeps it apart: poses/NN.txt)
+    std::string poses_path;  // ground-truth file (KITTI poses); empty = DIR/poses.txt if it exists
+                             // (the KITTI benchmark keeps it apart: poses/NN.txt)
     bool require_poses = false;  // fail Open() when there is no ground truth
     bool load_depth = true;      // read depth/%06d.png when the folder exists
   };
@@ -176,12 +175,12 @@ bool ReadKittiCalib(const std::string& path, vo::StereoCamera* camera, std::stri
 // Calibration of one camera as sensor.yaml gives it (raw, possibly distorted).
 struct EurocCameraCalibration {
   Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();  // T_BS: camera in the body
-  double fu_px = 0.0;  // focal length x (pixels)
-  double fv_px = 0.0;  // focal length y (pixels)
-  double cu_px = 0.0;  // principal point x (pixels)
-  double cv_px = 0.0;  // principal point y (pixels)
-  std::string camera_model;                     // "pinhole"
-  std::string distortion_model;                 // "radial-tangential" (k1 k2 p1 p2) or "equidistant"
+  double fu_px = 0.0;                                            // focal length x (pixels)
+  double fv_px = 0.0;                                            // focal length y (pixels)
+  double cu_px = 0.0;                                            // principal point x (pixels)
+  double cv_px = 0.0;                                            // principal point y (pixels)
+  std::string camera_model;                                      // "pinhole"
+  std::string distortion_model;  // "radial-tangential" (k1 k2 p1 p2) or "equidistant"
   std::vector<double> distortion_coefficients;  // as listed in the file
   int width = 0;                                // resolution (pixels)
   int height = 0;

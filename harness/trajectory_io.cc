@@ -87,8 +87,7 @@ std::vector<std::string_view> SplitFields(std::string_view s) {
 
 }  // namespace
 
-bool ParseNumbers(std::string_view text, size_t n, std::vector<double>* values,
-                  std::string* what) {
+bool ParseNumbers(std::string_view text, size_t n, std::vector<double>* values, std::string* what) {
   std::string scratch;
   if (!what) what = &scratch;
   const std::vector<std::string_view> fields = SplitFields(text);
@@ -100,13 +99,13 @@ bool ParseNumbers(std::string_view text, size_t n, std::vector<double>* values,
   values->resize(n);
   for (size_t i = 0; i < n; ++i) {
     if (!ParseDouble(fields[i], &(*values)[i])) {
-      *what = "field " + std::to_string(i + 1) + " ('" + std::string(fields[i]) +
-              "') is not a number";
+      *what =
+          "field " + std::to_string(i + 1) + " ('" + std::string(fields[i]) + "') is not a number";
       return false;
     }
     if (!std::isfinite((*values)[i])) {
-      *what = "field " + std::to_string(i + 1) + " ('" + std::string(fields[i]) +
-              "') is not finite";
+      *what =
+          "field " + std::to_string(i + 1) + " ('" + std::string(fields[i]) + "') is not finite";
       return false;
     }
   }
@@ -243,8 +242,9 @@ bool ReadKittiPoses(const std::string& path, std::vector<Eigen::Isometry3d>* pos
     const Eigen::Matrix3d R = T.linear();
     const double orth_err = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
     if (orth_err > kKittiRotationTolerance || R.determinant() < 0.0) {
-      SetError(error, Where(path, line_no) + "expected a rotation in the first 3 columns (|R^T R - I| = " +
-                          FormatDouble(orth_err) + ", det = " + FormatDouble(R.determinant()) + ")");
+      SetError(error,
+               Where(path, line_no) + "expected a rotation in the first 3 columns (|R^T R - I| = " +
+                   FormatDouble(orth_err) + ", det = " + FormatDouble(R.determinant()) + ")");
       return false;
     }
     out.push_back(T);
@@ -290,7 +290,8 @@ bool ReadKittiTimes(const std::string& path, std::vector<double>* times_s, std::
 
 bool AssociateOptions::IsValid(std::string* error) const {
   if (!std::isfinite(max_difference_s) || max_difference_s <= 0.0) {
-    SetError(error, "max_difference_s must be finite and > 0, got " + FormatDouble(max_difference_s));
+    SetError(error,
+             "max_difference_s must be finite and > 0, got " + FormatDouble(max_difference_s));
     return false;
   }
   if (!std::isfinite(offset_s)) {

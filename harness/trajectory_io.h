@@ -8,12 +8,11 @@
 // a write -> read round trip is exact and identical input gives byte-identical files.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 namespace harness {
 
@@ -21,7 +20,7 @@ namespace harness {
 // z forward) into the trajectory's reference frame, called "world" here: whatever frame the
 // file's poses are expressed in (for a KITTI poses.txt that is the first left camera).
 struct StampedPose {
-  double time_s = 0.0;  // time stamp (seconds)
+  double time_s = 0.0;                                            // time stamp (seconds)
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  // p_world = T_world_cam * p_cam
 };
 

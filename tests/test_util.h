@@ -10,10 +10,13 @@
 
 namespace vobench_test {
 
-// Rotation angle (radians) of R_a^T R_b.
+// Rotation angle (radians) of R_a^T R_b; atan2 of sin and cos keeps full precision near 0
+// (acos of the trace cannot resolve angles below ~2e-8 rad).
 inline double RotationAngleRad(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
-  const double c = std::clamp(((R_a.transpose() * R_b).trace() - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c);
+  const Eigen::Matrix3d R = R_a.transpose() * R_b;
+  const double c = (R.trace() - 1.0) / 2.0;
+  const double s = 0.5 * Eigen::Vector3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1)).norm();
+  return std::atan2(s, c);
 }
 
 // Matches an Eigen::Isometry3d within tol_rad of rotation and tol_m of translation.

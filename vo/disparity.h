@@ -16,10 +16,9 @@
 #pragma once
 
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "vo/camera.h"
 #include "vo/types.h"
@@ -38,26 +37,26 @@ const char* ToString(DisparityAlgorithm algorithm);
 
 struct DisparityOptions {
   DisparityAlgorithm algorithm = DisparityAlgorithm::kBlockMatching;  // correlation method
-  int min_disparity_px = 0;  // smallest disparity searched (pixels), >= 0
-  int num_disparities = 64;  // size of the search range (pixels), multiple of 16, >= 16;
-                             // disparities searched: [min_disparity_px, min + num - 1]
-  int block_size = 9;  // correlation window side (pixels), odd; BM: 5..255, SGBM: 1..255
-  int prefilter_cap = 31;  // clip of the x-Sobel prefiltered intensities (grey levels), 1..63
+  int min_disparity_px = 0;   // smallest disparity searched (pixels), >= 0
+  int num_disparities = 64;   // size of the search range (pixels), multiple of 16, >= 16;
+                              // disparities searched: [min_disparity_px, min + num - 1]
+  int block_size = 9;         // correlation window side (pixels), odd; BM: 5..255, SGBM: 1..255
+  int prefilter_cap = 31;     // clip of the x-Sobel prefiltered intensities (grey levels), 1..63
   int uniqueness_ratio = 15;  // the best cost must beat the second best (away from +-1 px)
                               // by this margin (percent), 0..100; 0 disables
-  double min_texture = 0.5;  // confidence (texture) filter, SVS style: the mean absolute
-                             // horizontal gradient |I(x+1) - I(x-1)| / 2 of the left image
-                             // over the correlation window (grey levels per pixel), >= 0;
-                             // pixels below are invalid. 0 disables. 0.5 rejects windows
-                             // flatter than sensor noise of sigma ~1 grey level; higher values
-                             // cost density on Middlebury without lowering the error rate
+  double min_texture = 0.5;   // confidence (texture) filter, SVS style: the mean absolute
+                              // horizontal gradient |I(x+1) - I(x-1)| / 2 of the left image
+                              // over the correlation window (grey levels per pixel), >= 0;
+                              // pixels below are invalid. 0 disables. 0.5 rejects windows
+                              // flatter than sensor noise of sigma ~1 grey level; higher values
+                              // cost density on Middlebury without lowering the error rate
   double left_right_max_diff_px = 1.0;  // left-right check: a pixel is kept only when the
                                         // right-view disparity at x - d agrees within this
                                         // (pixels), > 0; < 0 disables the check
-  bool full_width = true;  // pad the images on the left by the search range so pixels in the
-                           // leftmost num_disparities columns also get estimates (only
-                           // matches inside the right image are kept); false = OpenCV's
-                           // behaviour, that band stays invalid
+  bool full_width = true;         // pad the images on the left by the search range so pixels in the
+                                  // leftmost num_disparities columns also get estimates (only
+                                  // matches inside the right image are kept); false = OpenCV's
+                                  // behaviour, that band stays invalid
   int speckle_window_size = 100;  // connected regions of similar disparity smaller than this
                                   // (pixels) are invalidated; 0 disables
   double speckle_range_px = 1.0;  // neighbours belong to one region when their disparities
@@ -119,21 +118,21 @@ enum class DisparitySampling {
 
 struct DepthSamplingOptions {
   DisparitySampling sampling = DisparitySampling::kBilinear;  // see DisparitySampling
-  int search_radius_px = 1;  // kNearest fallback: radius (pixels, Chebyshev) searched for a
-                             // valid pixel, >= 0; 0 = the nearest pixel only
+  int search_radius_px = 1;    // kNearest fallback: radius (pixels, Chebyshev) searched for a
+                               // valid pixel, >= 0; 0 = the nearest pixel only
   double max_spread_px = 1.0;  // kBilinear: largest max - min disparity among the valid
                                // neighbours that is still interpolated (pixels), >= 0
-  double min_depth_m = 0.1;   // points closer than this get no depth (metres), > 0
-  double max_depth_m = 50.0;  // points farther than this get no depth (metres), > min_depth_m
+  double min_depth_m = 0.1;    // points closer than this get no depth (metres), > 0
+  double max_depth_m = 50.0;   // points farther than this get no depth (metres), > min_depth_m
 
   bool IsValid(std::string* error) const;
 };
 
 // Outcome of AttachDepth.
 struct AttachDepthResult {
-  bool ok = false;          // false: bad disparity map, camera or options; features untouched
-  std::string message;      // empty when ok
-  int num_with_depth = 0;   // features that now have depth
+  bool ok = false;            // false: bad disparity map, camera or options; features untouched
+  std::string message;        // empty when ok
+  int num_with_depth = 0;     // features that now have depth
   int num_without_depth = 0;  // features left with disparity_px = -1 and p_cam0 = NaN
 };
 

@@ -13,10 +13,9 @@
 #pragma once
 
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "vo/types.h"
 
@@ -29,32 +28,38 @@ enum class DetectorType {
 
 const char* ToString(DetectorType type);
 
+// Harris & Stephens (1988). With aperture 3 and block_size <= 31 the response is computed by a
+// fused integer implementation (same values as cv::cornerHarris, about twice as fast);
+// otherwise by cv::cornerHarris. See HarrisResponse().
 struct HarrisOptions {
-  int block_size = 3;     // side of the window summing the structure tensor (pixels), >= 2
-  int aperture_size = 3;  // Sobel aperture of the image derivatives: 3, 5 or 7
-  double k = 0.04;        // Harris constant in R = det(M) - k trace(M)^2, in (0, 0.25)
-  double quality_level = 0.01;  // relative threshold: keep R >= quality_level * max R of the
-                                // image, in [0, 1)
+  int block_size = 3;           // side of the window summing the structure tensor (pixels), >= 2
+  int aperture_size = 3;        // Sobel aperture of the image derivatives: 3, 5 or 7
+  double k = 0.04;              // Harris constant in R = det(M) - k trace(M)^2, in (0, 0.25)
+  double quality_level = 0.01;  // relative threshold: keep R >= quality_level * R of the
+                                // strongest corner inside the margin, in [0, 1)
   double min_response = 1e-7;   // absolute threshold on R (OpenCV cornerHarris scaling, i.e.
                                 // derivatives normalised to grey/255), >= 0; a uniform image
                                 // has R = 0 everywhere and gives no corners
   double nms_radius_px = 5.0;   // non-maximum suppression: no two corners closer than this
-                                // (pixels, Euclidean), >= 1; strongest kept first
-  bool subpixel = false;        // refine positions with cv::cornerSubPix (gradient-orthogonality)
-  int subpixel_half_window_px = 2;  // cornerSubPix search window half side (pixels), >= 1
-  int subpixel_max_iterations = 20;  // cornerSubPix iteration limit, >= 1
+                                // (pixels, Euclidean, integer positions), >= 1; greedy,
+                                // strongest kept first
+  bool subpixel = false;        // refine positions with cv::cornerSubPix (gradient-orthogonality);
+                                // a corner moves by at most subpixel_half_window_px
+  int subpixel_half_window_px = 2;    // cornerSubPix search window half side (pixels), >= 1
+  int subpixel_max_iterations = 20;   // cornerSubPix iteration limit, >= 1
   double subpixel_epsilon_px = 0.01;  // cornerSubPix stop when a step is below this (pixels)
 
   bool IsValid(std::string* error) const;
 };
 
 struct SiftOptions {
-  int octave_layers = 3;            // layers per octave (Lowe: 3), >= 1
+  int octave_layers = 3;             // layers per octave (Lowe: 3), >= 1
   double contrast_threshold = 0.04;  // DoG contrast threshold (OpenCV units), > 0
-  double edge_threshold = 10.0;     // principal-curvature ratio limit against edges, > 1
-  double sigma = 1.6;               // Gaussian sigma of the first octave (pixels), > 0
-  bool unique_positions = true;     // keep one keypoint per position (SIFT emits one per
-                                    // dominant orientation; the strongest is kept)
+  double edge_threshold = 10.0;      // principal-curvature ratio limit against edges, > 1
+  double sigma = 1.6;                // Gaussian sigma of the first octave (pixels), > 0
+  bool unique_positions = true;      // keep one keypoint per position (SIFT emits one per
+                                     // dominant orientation; the one with the smallest angle
+                                     // is kept, its descriptor goes with it)
 
   bool IsValid(std::string* error) const;
 };
@@ -99,6 +104,13 @@ class FeatureDetector {
 // Factory on options.type. Returns nullptr (and fills *error when given) for invalid options.
 std::unique_ptr<FeatureDetector> CreateFeatureDetector(const DetectorOptions& options,
                                                        std::string* error = nullptr);
+
+// Harris response R = det(M) - k trace(M)^2 per pixel (CV_32F, size of `image`), with
+// cv::cornerHarris's scaling (derivatives scaled by 1 / (2^(aperture-1) * block * 255), block
+// sums unnormalised). Equal to cv::cornerHarris(image, R, block_size, aperture_size, k) up to
+// float rounding, except within block_size/2 px of the edge of `image`, which are 0 on the fast
+// path (aperture 3, block <= 31). False for an empty or non-CV_8UC1 image or invalid options.
+bool HarrisResponse(const cv::Mat& image, const HarrisOptions& options, cv::Mat* response);
 
 // Keeps features in the order given (strongest first), taking at most max_per_bucket per cell
 // of a bucket_cols x bucket_rows grid over [margin, size - margin) and at most max_features

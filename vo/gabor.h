@@ -29,17 +29,21 @@
 // sum of logs and normalised as a weighted mean over the F usable filters:
 //   S_ij = exp(−β · Σ_k w_k |Δφ_k| / Σ_k w_k) ∈ [e^{−βπ}, 1].
 // β = phase_exponent: β = 1 is the geometric mean of the F factors of eq. (5) (c = the F-th
-// root), β = F is eq. (5) literally with c = 1. A filter is usable at a pair when both
+// root), β = F is eq. (5) literally with c = 1. The default β = 3 was chosen on the 640×480
+// synthetic pairs of svd_matcher_test (~500 corners, two motions): the geometric mean is too
+// flat to separate true pairs (S ≈ 0.78) from unrelated ones (S ≈ 0.2–0.3) inside the SVD
+// (precision 0.49 at the harder motion with the matcher's cue thresholds off, 0.79 at β = 3),
+// while β = F makes G so peaked that true pairs fall below the minimum-weight acceptance
+// (recall 0.12–0.35, against 0.61–0.96 at β = 3). A filter is usable at a pair when both
 // responses have amplitude >= min_amplitude (phase is meaningless where the response is ~0)
 // and lie inside the image; w_k = 1 (PhaseWeighting::kUniform) or the geometric mean of the
 // two amplitudes (kAmplitude: strong, reliable responses count more). With no usable filter
 // S = exp(−β · unknown_phase_diff_rad), by default π/2: the mean |Δφ| of unrelated phases.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "vo/types.h"
 
@@ -53,10 +57,10 @@ enum class PhaseWeighting {
 struct GaborOptions {
   int num_orientations = 4;  // n: θ_k = π (k−1) / n; paper: 4; in [1, 16]
   std::vector<double> wavelengths_px = {4.0, 6.0, 8.0, 12.0};
-      // λ of the plane wave (pixels, full resolution), each >= 2.5 (above Nyquist), at most 8
-      // of them. Default: a half-octave ladder from 4 px (finest phase that survives the
-      // ~0.5 px corner jitter: 1 px error = π/2 rad) to 12 px (about the 11-px NCC window), so
-      // the phases describe the neighbourhood the NCC compares and a bit beyond
+  // λ of the plane wave (pixels, full resolution), each >= 2.5 (above Nyquist), at most 8
+  // of them. Default: a half-octave ladder from 4 px (finest phase that survives the
+  // ~0.5 px corner jitter: 1 px error = π/2 rad) to 12 px (about the 11-px NCC window), so
+  // the phases describe the neighbourhood the NCC compares and a bit beyond
   double sigma_per_wavelength = 0.56;  // σx / λ (envelope spread along the wave); 0.56 = one
                                        // octave bandwidth; in [0.2, 2]
   double aspect = 1.0;  // γ = σx / σy; 1 = isotropic (all orientations share one compact disc
@@ -68,14 +72,14 @@ struct GaborOptions {
                                             // half-resolution image (4× fewer taps); a
                                             // value > every λ disables it; >= 5 (λ/2 must stay
                                             // >= 2.5)
-  bool subpixel_phase_correction = true;  // apply the sub-pixel offset of the feature (and of
-                                          // the half-resolution sampling point) to the phase,
-                                          // linearly: φ −= 2π (δ·n_θ) / λ
+  bool subpixel_phase_correction = true;    // apply the sub-pixel offset of the feature (and of
+                                            // the half-resolution sampling point) to the phase,
+                                            // linearly: φ −= 2π (δ·n_θ) / λ
   PhaseWeighting weighting = PhaseWeighting::kUniform;  // see header comment
-  double min_amplitude = 1.0;  // a filter's phase is used only where |g| >= this (grey levels
-                               // of an equivalent sinusoid); >= 0
-  double phase_exponent = 1.0;  // β in S = exp(−β · mean |Δφ|); 1 = geometric mean of eq. (5);
-                                // in (0, 64]
+  double min_amplitude = 1.0;   // a filter's phase is used only where |g| >= this (grey levels
+                                // of an equivalent sinusoid); >= 0
+  double phase_exponent = 3.0;  // β in S = exp(−β · mean |Δφ|); 1 = geometric mean of the
+                                // factors of eq. (5), F = eq. (5) with c = 1; in (0, 64]
   double unknown_phase_diff_rad = 1.5707963267948966;  // mean |Δφ| assumed when no filter is
                                                        // usable at a pair (rad, [0, π]); π/2 =
                                                        // that of unrelated phases
@@ -89,8 +93,8 @@ struct GaborOptions {
 // Phases and amplitudes of every filter at every feature of one image. Filter index
 // k = orientation + num_orientations · wavelength_index.
 struct GaborResponses {
-  GaborOptions options;        // the bank that produced them
-  int num_filters = 0;         // F
+  GaborOptions options;          // the bank that produced them
+  int num_filters = 0;           // F
   std::vector<float> phase;      // size() × F, radians in (−π, π]
   std::vector<float> amplitude;  // size() × F, |g| (grey levels); < 0 where the kernel window
                                  // crosses the image border (filter unusable there)
@@ -127,12 +131,13 @@ class GaborBank {
     double wavelength_px = 0.0;  // full-resolution λ
     int level = 0;               // 0 = full, 1 = half resolution
     int radius = 0;              // disc radius (pixels at `level`)
-    std::vector<int> row_dy;     // per tap row: dy
-    std::vector<int> row_dx0;    // per tap row: first dx (the row spans dx0..−dx0)
-    std::vector<float> taps;     // Σ_rows (2·|dx0|+1) × lanes
+    std::vector<int> tap_dx;     // per tap: column offset (pixels at `level`)
+    std::vector<int> tap_dy;     // per tap: row offset
+    std::vector<float> taps;     // num_taps × lanes
   };
 
-  void Evaluate(const cv::Mat& level_image, const Scale& scale, int x, int y, float* re,
+  // eq. (4) at the pixel `center` points to; offsets[t] = tap t's offset in floats.
+  void Evaluate(const float* center, const int* offsets, const Scale& scale, float* re,
                 float* im) const;
 
   GaborOptions options_;

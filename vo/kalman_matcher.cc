@@ -1,12 +1,11 @@
 #include "vo/kalman_matcher.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-
-#include <Eigen/Dense>
 
 namespace vo {
 namespace {

@@ -23,10 +23,9 @@
 // new tracks; unmatched previous tracks end. Reset() forgets everything.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "vo/matcher.h"
 #include "vo/ncc.h"
@@ -54,12 +53,12 @@ class KalmanMatcher : public FrameMatcher {
 
  private:
   struct Track {
-    Eigen::Vector4d x = Eigen::Vector4d::Zero();      // (u, v, du, dv): px, px/frame
-    Eigen::Matrix4d P = Eigen::Matrix4d::Identity();  // its covariance
-    Eigen::Vector2d g = Eigen::Vector2d::Zero();      // gradient estimate (grey/px)
-    double g_var = 0.0;                               // variance of each gradient component
+    Eigen::Vector4d x = Eigen::Vector4d::Zero();        // (u, v, du, dv): px, px/frame
+    Eigen::Matrix4d P = Eigen::Matrix4d::Identity();    // its covariance
+    Eigen::Vector2d g = Eigen::Vector2d::Zero();        // gradient estimate (grey/px)
+    double g_var = 0.0;                                 // variance of each gradient component
     Eigen::Vector2d last_uv = Eigen::Vector2d::Zero();  // last measured position (px)
-    int age = 0;                                      // updates so far
+    int age = 0;                                        // updates so far
   };
 
   Track NewTrack(const Eigen::Vector2d& uv, const Eigen::Vector2f& gradient) const;

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-
 #include <opencv2/video/tracking.hpp>
 
 namespace vo {

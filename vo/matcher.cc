@@ -64,6 +64,10 @@ bool SvdMatcherOptions::IsValid(std::string* error) const {
     msg << "SvdMatcherOptions::min_entry must be in [0, min_weight], got " << min_entry;
   } else if (!(min_pairing >= 0.0 && min_pairing <= 1.0)) {
     msg << "SvdMatcherOptions::min_pairing must be in [0, 1], got " << min_pairing;
+  } else if (!(min_ncc >= 0.0 && min_ncc <= 1.0)) {
+    msg << "SvdMatcherOptions::min_ncc must be in [0, 1], got " << min_ncc;
+  } else if (!(max_phase_diff_rad >= 0.0 && max_phase_diff_rad <= 3.14159265358979323846)) {
+    msg << "SvdMatcherOptions::max_phase_diff_rad must be in [0, pi], got " << max_phase_diff_rad;
   } else if (max_component_size < 2) {
     msg << "SvdMatcherOptions::max_component_size must be >= 2, got " << max_component_size;
   } else if (!(guard_growth > 1.0) || !std::isfinite(guard_growth)) {
@@ -98,8 +102,7 @@ bool LucasKanadeMatcherOptions::IsValid(std::string* error) const {
   } else if (!(epsilon_px > 0.0)) {
     msg << "LucasKanadeMatcherOptions::epsilon_px must be > 0, got " << epsilon_px;
   } else if (!(min_eig_threshold >= 0.0)) {
-    msg << "LucasKanadeMatcherOptions::min_eig_threshold must be >= 0, got "
-        << min_eig_threshold;
+    msg << "LucasKanadeMatcherOptions::min_eig_threshold must be >= 0, got " << min_eig_threshold;
   } else if (!std::isfinite(max_fb_error_px)) {
     msg << "LucasKanadeMatcherOptions::max_fb_error_px must be finite, got " << max_fb_error_px;
   } else if (!(association_radius_px > 0.0) || !std::isfinite(association_radius_px)) {
@@ -175,8 +178,8 @@ std::unique_ptr<FrameMatcher> CreateFrameMatcher(const MatcherOptions& options,
       return std::make_unique<SvdMatcher>(options.svd, SvdMatcher::Cues::kProximity, options.ncc,
                                           options.gabor);
     case MatcherType::kSvdNcc:
-      return std::make_unique<SvdMatcher>(options.svd, SvdMatcher::Cues::kProximityNcc,
-                                          options.ncc, options.gabor);
+      return std::make_unique<SvdMatcher>(options.svd, SvdMatcher::Cues::kProximityNcc, options.ncc,
+                                          options.gabor);
     case MatcherType::kSvdNccGabor:
       return std::make_unique<SvdMatcher>(options.svd, SvdMatcher::Cues::kProximityNccGabor,
                                           options.ncc, options.gabor);
@@ -230,8 +233,8 @@ PointGrid::PointGrid(std::vector<Eigen::Vector2d> points, double cell_px)
   }
   // Keep the grid bounded even for a tiny cell over a huge extent.
   constexpr double kMaxCellsPerAxis = 4096.0;
-  cell_px_ = std::max({cell_px_, (max_x - min_x_) / kMaxCellsPerAxis,
-                       (max_y - min_y_) / kMaxCellsPerAxis});
+  cell_px_ = std::max(
+      {cell_px_, (max_x - min_x_) / kMaxCellsPerAxis, (max_y - min_y_) / kMaxCellsPerAxis});
   cols_ = static_cast<int>(std::floor((max_x - min_x_) / cell_px_)) + 1;
   rows_ = static_cast<int>(std::floor((max_y - min_y_) / cell_px_)) + 1;
   std::vector<int> cell_of(points_.size());

@@ -2,27 +2,30 @@
 // its per-frame cue cache), every matcher's Options, and the factory.
 //
 // A matcher maps (previous frame, current frame) to ONE-TO-ONE matches: no previous index and
-// no current index appears twice. Matchers (MatcherType):
-//   kSvdProximity  Scott & Longuet-Higgins (1991): G_ij = exp(−d²/2σ²), P = U Vᵀ   svd_matcher.h
-//   kSvdNcc        Kwolek eq. (1): G_ij = C_ij · exp(−d²/2σ²)                      svd_matcher.h
-//   kSvdNccGabor   Kwolek III-C: G_ij = proximity · NCC · Gabor phase (default)    svd_matcher.h
-//   kNccMutual     NCC in a search radius + mutual consistency (Nistér 2004)        ncc_mutual_matcher.h
-//   kLucasKanade   pyramidal LK tracking + association to current features          lk_matcher.h
-//   kKalman        constant-velocity Kalman corner tracker (Kwolek VI), stateful    kalman_matcher.h
-//   kSiftRatio     SIFT descriptors, Lowe's ratio test + mutual check               sift_ratio_matcher.h
+// no current index appears twice. Matchers (MatcherType), header in brackets:
+//   kSvdProximity  Scott & Longuet-Higgins (1991): G_ij = exp(−d²/2σ²), P = U Vᵀ [svd_matcher]
+//   kSvdNcc        Kwolek eq. (1): G_ij = C_ij · exp(−d²/2σ²)                     [svd_matcher]
+//   kSvdNccGabor   Kwolek III-C: proximity · NCC · Gabor phase (the default)      [svd_matcher]
+//   kNccMutual     NCC in a search radius + mutual check (Nistér 2004)     [ncc_mutual_matcher]
+//   kLucasKanade   pyramidal LK tracking + association to current features         [lk_matcher]
+//   kKalman        constant-velocity Kalman corner tracker (Kwolek VI)         [kalman_matcher]
+//   kSiftRatio     SIFT descriptors, Lowe's ratio test + mutual check      [sift_ratio_matcher]
+// Cues are cached per frame (MatchFrame::cues): keep the current MatchFrame and pass it as
+// `prev` to the next call (move it, or keep it in a ring of frames), and its NCC patches,
+// Gabor phases and LK pyramid are not computed again. kSiftRatio reads
+// MatchFrame::descriptors, e.g. FeatureSet::descriptors from features.h.
 // Adding one = a .h/.cc pair, a test, an enum value, a `case` in CreateFrameMatcher().
 #pragma once
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "vo/gabor.h"
 #include "vo/ncc.h"
@@ -53,24 +56,24 @@ bool ParseMatcherType(const std::string& name, MatcherType* type);
 struct FrameCues {
   std::shared_ptr<const NccPatches> ncc;        // NCC patches of every feature (or null)
   std::shared_ptr<const GaborResponses> gabor;  // Gabor phases/amplitudes (or null)
-  std::vector<cv::Mat> lk_pyramid;  // cv::buildOpticalFlowPyramid output (or empty)
-  int lk_window_px = 0;             // window the pyramid was built for
-  int lk_max_level = -1;            // max level the pyramid was built for
+  std::vector<cv::Mat> lk_pyramid;              // cv::buildOpticalFlowPyramid output (or empty)
+  int lk_window_px = 0;                         // window the pyramid was built for
+  int lk_max_level = -1;                        // max level the pyramid was built for
   std::shared_ptr<const std::vector<Eigen::Vector2f>> gradients;  // Kalman: mean gradients
-  int gradient_window_px = 0;       // window the gradients were averaged over
+  int gradient_window_px = 0;  // window the gradients were averaged over
 
   void Clear() { *this = FrameCues(); }
 };
 
 // One frame as the matchers see it.
 struct MatchFrame {
-  int64_t frame_id = -1;  // optional identity (e.g. the frame counter); -1 = unknown. The
-                          // stateful Kalman matcher uses it to recognise its last frame
-  cv::Mat image;          // left image, CV_8UC1 (a shallow, reference-counted header; the
-                          // pixels must not be modified while the frame is in use)
+  int64_t frame_id = -1;          // optional identity (e.g. the frame counter); -1 = unknown. The
+                                  // stateful Kalman matcher uses it to recognise its last frame
+  cv::Mat image;                  // left image, CV_8UC1 (a shallow, reference-counted header; the
+                                  // pixels must not be modified while the frame is in use)
   std::vector<Feature> features;  // features of `image`; matches index into this vector
-  cv::Mat descriptors;  // optional: one row per feature (SIFT: CV_32F, 128 columns); needed
-                        // by kSiftRatio only, may be empty otherwise
+  cv::Mat descriptors;     // optional: one row per feature (SIFT: CV_32F, 128 columns); needed
+                           // by kSiftRatio only, may be empty otherwise
   mutable FrameCues cues;  // cache filled by the matchers; call ClearCues() after changing
                            // `image` or any feature position
 
@@ -84,17 +87,20 @@ const GaborResponses& FrameGaborResponses(const MatchFrame& frame, const GaborBa
 
 // What one MatchFrames() call did.
 struct MatcherSummary {
-  bool ok = true;           // false for invalid input (e.g. kSiftRatio without descriptors)
-  std::string message;      // why not ok; empty when ok
-  int num_prev = 0;         // features in the previous frame
-  int num_curr = 0;         // features in the current frame
-  int num_candidates = 0;   // pairs whose cost/similarity was evaluated
-  int num_matches = 0;      // matches returned
-  int num_components = 0;   // SVD matchers: connected components solved
-  int largest_component = 0;  // SVD matchers: rows + columns of the largest one solved
-  int num_guard_splits = 0;   // SVD matchers: times the component-size guard raised the bound
-  double cue_time_ms = 0.0;   // computing per-frame cues (0 when cached)
-  double match_time_ms = 0.0; // everything else
+  bool ok = true;              // false for invalid input (e.g. kSiftRatio without descriptors)
+  std::string message;         // why not ok; empty when ok
+  int num_prev = 0;            // features in the previous frame
+  int num_curr = 0;            // features in the current frame
+  int num_candidates = 0;      // pairs whose cost/similarity was evaluated
+  int num_matches = 0;         // matches returned
+  int num_components = 0;      // SVD matchers: connected components solved
+  int largest_component = 0;   // SVD matchers: rows + columns of the largest one solved
+  int num_guard_splits = 0;    // SVD matchers: times the component-size guard raised the bound
+  int num_rank_deficient = 0;  // SVD matchers: blocks with (numerically) zero singular values
+  int num_svd_fallbacks = 0;   // SVD matchers: blocks whose Gram eigensolver failed, solved
+                               // by an SVD instead
+  double cue_time_ms = 0.0;    // computing per-frame cues (0 when cached)
+  double match_time_ms = 0.0;  // everything else
 };
 
 // The plug-in point.
@@ -129,16 +135,22 @@ struct SvdMatcherOptions {
   double min_weight = 0.02;    // minimum-weight acceptance: i↔j needs G_ij >= this, in [0, 1]
                                // (an outlier with no true partner stays unmatched)
   double min_pairing = 0.3;    // and P_ij >= this (P = U Vᵀ, entries in [−1, 1]), in [0, 1]
+  double min_ncc = 0.8;        // and C_ij >= this (eq. (2) scale; 0.8 is ρ >= 0.6) for the
+                               // NCC variants, in [0, 1]; 0 = the paper's rule alone
+  double max_phase_diff_rad = 0.8;  // and the (weighted) mean wrapped phase difference of
+                                    // the Gabor bank <= this, i.e. S_ij >= exp(−β · this), for
+                                    // kSvdNccGabor (rad, [0, π]; π = the paper's rule alone);
+                                    // unrelated phases average π/2
   bool dense = false;  // reference mode: G over all n×m pairs (no cutoff, no dropping) and one
                        // BDCSVD of the whole matrix, as in the paper; slow (~135 ms at 500×500)
-  int max_component_size = 120;  // guard: a component with more rows + columns than this is
+  int max_component_size = 200;  // guard: a component with more rows + columns than this is
                                  // split by raising its entry bound (× guard_growth, repeated);
-                                 // >= 2
+                                 // >= 2. 200 keeps every block <= ~100×100 (~2 ms)
   double guard_growth = 2.0;     // factor the guard raises the entry bound by, > 1
-  double guard_max_entry = 0.5;  // the guard stops raising at this bound and solves what is
+  double guard_max_entry = 0.9;  // the guard stops raising at this bound and solves what is
                                  // left densely, in (0, 1]
-  int jacobi_max_size = 16;      // components with min(rows, cols) <= this use JacobiSVD,
-                                 // larger ones BDCSVD; >= 2
+  int jacobi_max_size = 16;      // blocks whose Gram eigensolver fails (never seen) fall back
+                                 // to JacobiSVD up to min(rows, cols) = this, BDCSVD above; >= 2
 
   bool IsValid(std::string* error) const;
 };
@@ -154,14 +166,14 @@ struct NccMutualMatcherOptions {
 
 // kLucasKanade (Bouguet's pyramidal LK, cv::calcOpticalFlowPyrLK), lk_matcher.h.
 struct LucasKanadeMatcherOptions {
-  int window_px = 21;          // LK integration window side (pixels), odd, >= 5
-  int max_level = 3;           // pyramid levels above the image, 0..8
-  int max_iterations = 30;     // per-level iteration limit, >= 1
-  double epsilon_px = 0.01;    // per-level stop when an update is below this (pixels), > 0
-  double min_eig_threshold = 1e-4;  // OpenCV's minimum eigenvalue of the normalised spatial
-                                    // gradient matrix; weaker points are lost, >= 0
-  double max_fb_error_px = 1.0;  // forward-backward check: the point tracked back must land
-                                 // within this of where it started (pixels); <= 0 disables
+  int window_px = 21;                  // LK integration window side (pixels), odd, >= 5
+  int max_level = 3;                   // pyramid levels above the image, 0..8
+  int max_iterations = 30;             // per-level iteration limit, >= 1
+  double epsilon_px = 0.01;            // per-level stop when an update is below this (pixels), > 0
+  double min_eig_threshold = 1e-4;     // OpenCV's minimum eigenvalue of the normalised spatial
+                                       // gradient matrix; weaker points are lost, >= 0
+  double max_fb_error_px = 1.0;        // forward-backward check: the point tracked back must land
+                                       // within this of where it started (pixels); <= 0 disables
   double association_radius_px = 2.0;  // a tracked point is associated with the nearest
                                        // current feature within this (pixels), > 0
 
@@ -170,29 +182,31 @@ struct LucasKanadeMatcherOptions {
 
 // kKalman (Kwolek section VI), kalman_matcher.h.
 struct KalmanMatcherOptions {
-  double measurement_noise_px = 1.0;    // std of a corner position measurement (pixels), > 0
-  double process_noise_px = 2.0;        // std of the per-frame velocity change (pixels/frame),
-                                        // white-acceleration model, > 0
+  double measurement_noise_px = 1.0;      // std of a corner position measurement (pixels), > 0
+  double process_noise_px = 2.0;          // std of the per-frame velocity change (pixels/frame),
+                                          // white-acceleration model, > 0
   double initial_velocity_std_px = 15.0;  // std of the unknown velocity of a new track
                                           // (pixels/frame), > 0
-  double gate_chi2 = 9.21;      // position gate on the Mahalanobis d² (χ², 2 dof; 9.21 = 99 %)
+  double gate_chi2 = 9.21;  // position gate on the Mahalanobis d² (χ², 2 dof; 9.21 = 99 %)
   double max_search_radius_px = 60.0;  // hard cap of the candidate search (pixels), > 0
-  int gradient_window_px = 5;   // the gradient vector of a corner is the mean Sobel gradient
-                                // over this window (pixels), odd, >= 3
-  double gradient_noise = 8.0;  // std of a gradient measurement (grey/pixel), > 0
+  int gradient_window_px = 5;          // the gradient vector of a corner is the mean Sobel gradient
+                                       // over this window (pixels), odd, >= 3
+  double gradient_noise = 8.0;         // std of a gradient measurement (grey/pixel), > 0
   double gradient_process_noise = 4.0;  // std of the per-frame gradient change (grey/pixel), > 0
-  double min_ncc = 0.6;         // candidates need C >= this (eq. (2) scale), [0, 1]
-  double ncc_scale = 0.1;       // the NCC term is ((1 − C) / ncc_scale)², > 0
-  double max_cost = 20.0;       // accept an assignment only when the summed cost (position +
-                                // gradient + NCC terms) is <= this, > 0
+  double min_ncc = 0.85;   // candidates need C >= this (eq. (2) scale; 0.85 is ρ >= 0.7),
+                           // [0, 1]
+  double ncc_scale = 0.1;  // the NCC term is ((1 − C) / ncc_scale)², > 0
+  double max_cost = 6.0;   // accept an assignment only when the summed cost (position +
+                           // gradient + NCC terms, each a squared normalised deviation)
+                           // is <= this, > 0
 
   bool IsValid(std::string* error) const;
 };
 
 // kSiftRatio (Lowe 2004), sift_ratio_matcher.h.
 struct SiftRatioMatcherOptions {
-  double ratio = 0.8;        // Lowe's ratio: accept when d1 < ratio · d2, in (0, 1]
-  bool mutual = true;        // also require prev to be the current feature's nearest neighbour
+  double ratio = 0.8;             // Lowe's ratio: accept when d1 < ratio · d2, in (0, 1]
+  bool mutual = true;             // also require prev to be the current feature's nearest neighbour
   double search_radius_px = 0.0;  // only candidates within this image distance (pixels);
                                   // 0 = the whole image, >= 0
 

@@ -149,8 +149,7 @@ double NccPatches::Correlation(int i, const NccPatches& other, int j) const {
   if (status_[i] != NccStatus::kOk || other.status_[j] != NccStatus::kOk) return 0.0;
   CheckOrDie(stride_ == other.stride_, "NccPatches: patch sets of different window sizes");
   const double rho = DotLanes(data_.data() + static_cast<size_t>(i) * stride_,
-                              other.data_.data() + static_cast<size_t>(j) * other.stride_,
-                              stride_);
+                              other.data_.data() + static_cast<size_t>(j) * other.stride_, stride_);
   return std::clamp(rho, -1.0, 1.0);
 }
 

@@ -19,12 +19,11 @@
 // Options::min_stddev; ρ is 0/0 there).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "vo/types.h"
 
@@ -79,8 +78,8 @@ class NccPatches {
 
  private:
   NccOptions options_;
-  int stride_ = 0;              // floats per patch: W² rounded up to a multiple of 8 (zero tail)
-  std::vector<float> data_;     // size() × stride_, row-major patches, zero-mean, unit L2 norm
+  int stride_ = 0;           // floats per patch: W² rounded up to a multiple of 8 (zero tail)
+  std::vector<float> data_;  // size() × stride_, row-major patches, zero-mean, unit L2 norm
   std::vector<NccStatus> status_;
 };
 

@@ -1,13 +1,13 @@
 #include "vo/svd_matcher.h"
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <numeric>
-
-#include <Eigen/SVD>
 
 namespace vo {
 namespace {
@@ -19,13 +19,47 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// P = U Vᵀ of a dense block (S → I, Scott & Longuet-Higgins).
-Eigen::MatrixXd OrthogonalFactor(const Eigen::MatrixXd& G, int jacobi_max_size) {
+// Eigenvalues of the Gram matrix below this fraction of the largest (singular values below
+// 1e-6 of the largest) count as zero. Above it the eigenvectors are accurate to ~1e-4 (double
+// precision over the squared condition number), far below what moves a row/column maximum.
+constexpr double kGramRankTol = 1e-12;
+
+// P = U Vᵀ of a dense block (S → I, Scott & Longuet-Higgins): the orthogonal factor of G,
+// from the Gram matrix of the smaller side (a symmetric eigensolver, ~3× faster than an SVD
+// of the same size): for a tall G, GᵀG = V S² Vᵀ and P = G V S⁻¹ Vᵀ; for a wide one,
+// G Gᵀ = U S² Uᵀ and P = U S⁻¹ Uᵀ G. For a rank-deficient block S → I is applied to the
+// nonzero singular values only, P = G (GᵀG)^{+½}: unique, where a full SVD would pair the
+// left and right null vectors arbitrarily (implementation-defined). *rank = their number.
+Eigen::MatrixXd OrthogonalFactor(const Eigen::MatrixXd& G, int jacobi_max_size, int* rank,
+                                 bool* used_svd) {
+  *used_svd = false;
   if (G.rows() == 1 || G.cols() == 1) {
     // A single row/column: U = ±1, V = g/|g| (or the transpose): P = g / |g|.
     const double norm = G.norm();
+    *rank = norm > 0.0 ? 1 : 0;
     return norm > 0.0 ? Eigen::MatrixXd(G / norm) : Eigen::MatrixXd(G);
   }
+  const bool tall = G.rows() >= G.cols();
+  const Eigen::MatrixXd gram =
+      tall ? Eigen::MatrixXd(G.transpose() * G) : Eigen::MatrixXd(G * G.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram);
+  if (eig.info() == Eigen::Success) {
+    const Eigen::VectorXd& lambda = eig.eigenvalues();  // ascending
+    const double floor = kGramRankTol * lambda(lambda.size() - 1);
+    Eigen::VectorXd inv_s(lambda.size());
+    *rank = 0;
+    for (Eigen::Index k = 0; k < lambda.size(); ++k) {
+      const bool nonzero = lambda(k) > floor;
+      inv_s(k) = nonzero ? 1.0 / std::sqrt(lambda(k)) : 0.0;
+      *rank += nonzero ? 1 : 0;
+    }
+    const Eigen::MatrixXd& Q = eig.eigenvectors();
+    const Eigen::MatrixXd W = Q * inv_s.asDiagonal() * Q.transpose();
+    return tall ? Eigen::MatrixXd(G * W) : Eigen::MatrixXd(W * G);
+  }
+  // The eigensolver did not converge (not seen in practice): a full SVD.
+  *used_svd = true;
+  *rank = static_cast<int>(std::min(G.rows(), G.cols()));
   if (std::min(G.rows(), G.cols()) <= jacobi_max_size) {
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(G, Eigen::ComputeThinU | Eigen::ComputeThinV);
     return svd.matrixU() * svd.matrixV().transpose();
@@ -37,8 +71,9 @@ Eigen::MatrixXd OrthogonalFactor(const Eigen::MatrixXd& G, int jacobi_max_size) 
 // Mutual row/column maxima of P with the minimum-weight acceptance. Ties go to the smaller
 // index. Appends (row_ids[a], col_ids[b], P_ab) matches.
 void AcceptMutualMaxima(const Eigen::MatrixXd& P, const Eigen::MatrixXd& G,
-                        const std::vector<int>& row_ids, const std::vector<int>& col_ids,
-                        const SvdMatcherOptions& options, std::vector<Match>* matches) {
+                        const SvdAcceptMatrix* acceptable, const std::vector<int>& row_ids,
+                        const std::vector<int>& col_ids, const SvdMatcherOptions& options,
+                        std::vector<Match>* matches) {
   const int r = static_cast<int>(P.rows()), c = static_cast<int>(P.cols());
   std::vector<int> col_best(c, 0);
   for (int b = 0; b < c; ++b) {
@@ -53,10 +88,11 @@ void AcceptMutualMaxima(const Eigen::MatrixXd& P, const Eigen::MatrixXd& G,
     for (int b = 1; b < c; ++b) {
       if (P(a, b) > P(a, best)) best = b;
     }
-    if (col_best[best] != a) continue;                     // not the max of its column
-    if (G(a, best) < options.min_weight) continue;         // minimum-weight acceptance
-    if (P(a, best) < options.min_pairing) continue;        // weak pairing
-    if (!(G(a, best) > 0.0)) continue;                     // never pair through a zero entry
+    if (col_best[best] != a) continue;               // not the max of its column
+    if (G(a, best) < options.min_weight) continue;   // minimum-weight acceptance
+    if (P(a, best) < options.min_pairing) continue;  // weak pairing
+    if (!(G(a, best) > 0.0)) continue;               // never pair through a zero entry
+    if (acceptable != nullptr && !(*acceptable)(a, best)) continue;  // cue thresholds
     matches->push_back(Match{row_ids[a], col_ids[best], P(a, best)});
   }
 }
@@ -74,8 +110,15 @@ int FindRoot(std::vector<int>& parent, int x) {
 
 std::vector<Match> SvdPairSparse(int rows, int cols, std::vector<SvdEntry> entries,
                                  const SvdMatcherOptions& options, MatcherSummary* summary) {
+  for (const SvdEntry& e : entries) {
+    if (e.row < 0 || e.row >= rows || e.col < 0 || e.col >= cols) {
+      std::fprintf(stderr, "vo::SvdPairSparse: entry (%d, %d) outside a %d x %d matrix\n", e.row,
+                   e.col, rows, cols);
+      std::abort();
+    }
+  }
   std::vector<Match> matches;
-  int num_components = 0, largest = 0, guard_splits = 0;
+  int num_components = 0, largest = 0, guard_splits = 0, num_svd = 0, num_rank_deficient = 0;
   // Drop entries below the bound (step 2).
   entries.erase(std::remove_if(entries.begin(), entries.end(),
                                [&](const SvdEntry& e) {
@@ -93,9 +136,11 @@ std::vector<Match> SvdPairSparse(int rows, int cols, std::vector<SvdEntry> entri
   stack.push_back(Work{std::move(entries), options.min_entry});
 
   // Node ids: rows 0..rows−1, columns rows..rows+cols−1.
-  std::vector<int> parent(static_cast<size_t>(rows) + cols);
-  std::vector<int> comp_of_root(parent.size(), -1);
-  std::vector<int> local_row(rows, -1), local_col(cols, -1);
+  const size_t num_rows = static_cast<size_t>(std::max(rows, 0));
+  const size_t num_cols = static_cast<size_t>(std::max(cols, 0));
+  std::vector<int> parent(num_rows + num_cols, 0);
+  std::vector<int> comp_of_root(num_rows + num_cols, -1);
+  std::vector<int> local_row(num_rows, -1), local_col(num_cols, -1);
   while (!stack.empty()) {
     Work work = std::move(stack.back());
     stack.pop_back();
@@ -156,9 +201,17 @@ std::vector<Match> SvdPairSparse(int rows, int cols, std::vector<SvdEntry> entri
 
       // Step 4: dense SVD of the block, then the mutual maxima inside it.
       Eigen::MatrixXd G = Eigen::MatrixXd::Zero(row_ids.size(), col_ids.size());
-      for (const SvdEntry& e : comp) G(local_row[e.row], local_col[e.col]) = e.value;
-      const Eigen::MatrixXd P = OrthogonalFactor(G, options.jacobi_max_size);
-      AcceptMutualMaxima(P, G, row_ids, col_ids, options, &matches);
+      SvdAcceptMatrix acceptable = SvdAcceptMatrix::Zero(row_ids.size(), col_ids.size());
+      for (const SvdEntry& e : comp) {
+        G(local_row[e.row], local_col[e.col]) = e.value;
+        acceptable(local_row[e.row], local_col[e.col]) = e.acceptable ? 1 : 0;
+      }
+      bool used_svd = false;
+      int rank = 0;
+      const Eigen::MatrixXd P = OrthogonalFactor(G, options.jacobi_max_size, &rank, &used_svd);
+      num_svd += used_svd ? 1 : 0;
+      num_rank_deficient += rank < std::min(G.rows(), G.cols()) ? 1 : 0;
+      AcceptMutualMaxima(P, G, &acceptable, row_ids, col_ids, options, &matches);
       ++num_components;
       largest = std::max(largest, size);
       for (int id : row_ids) local_row[id] = -1;
@@ -171,11 +224,14 @@ std::vector<Match> SvdPairSparse(int rows, int cols, std::vector<SvdEntry> entri
     summary->num_components = num_components;
     summary->largest_component = largest;
     summary->num_guard_splits = guard_splits;
+    summary->num_svd_fallbacks = num_svd;
+    summary->num_rank_deficient = num_rank_deficient;
   }
   return matches;
 }
 
-std::vector<Match> SvdPairDense(const Eigen::MatrixXd& G, const SvdMatcherOptions& options) {
+std::vector<Match> SvdPairDense(const Eigen::MatrixXd& G, const SvdMatcherOptions& options,
+                                const SvdAcceptMatrix* acceptable) {
   std::vector<Match> matches;
   if (G.rows() == 0 || G.cols() == 0) return matches;
   // G = U S Vᵀ, S → I: P = U Vᵀ (one BDCSVD of the whole matrix, as in the paper).
@@ -184,7 +240,7 @@ std::vector<Match> SvdPairDense(const Eigen::MatrixXd& G, const SvdMatcherOption
   std::vector<int> row_ids(G.rows()), col_ids(G.cols());
   std::iota(row_ids.begin(), row_ids.end(), 0);
   std::iota(col_ids.begin(), col_ids.end(), 0);
-  AcceptMutualMaxima(P, G, row_ids, col_ids, options, &matches);
+  AcceptMutualMaxima(P, G, acceptable, row_ids, col_ids, options, &matches);
   return matches;
 }
 
@@ -192,8 +248,7 @@ SvdMatcher::SvdMatcher(const Options& options, Cues cues, const NccOptions& ncc,
                        const GaborOptions& gabor)
     : options_(options), cues_(cues), ncc_(ncc) {
   std::string error;
-  if (!options_.IsValid(&error) ||
-      (cues_ != Cues::kProximity && !ncc_.IsValid(&error))) {
+  if (!options_.IsValid(&error) || (cues_ != Cues::kProximity && !ncc_.IsValid(&error))) {
     std::fprintf(stderr, "vo::SvdMatcher: invalid options: %s\n", error.c_str());
     std::abort();
   }
@@ -239,16 +294,26 @@ std::vector<Match> SvdMatcher::MatchFrames(const MatchFrame& prev, const MatchFr
   t0 = std::chrono::steady_clock::now();
 
   const double inv_two_sigma2 = 1.0 / (2.0 * options_.sigma_px * options_.sigma_px);
-  // G_ij of one pair: proximity × C_ij (eq. (1)) × S_ij (eq. (5)); stops early once below
-  // `bound` (the factors are <= 1, so later ones cannot raise it).
-  auto weight = [&](int i, int j, double d2, double bound) {
+  const double min_phase_similarity =
+      use_gabor ? std::exp(-bank_->options().phase_exponent * options_.max_phase_diff_rad) : 0.0;
+  // G_ij of one pair: proximity × C_ij (eq. (1)) × S_ij (eq. (5)); stops early (returns 0)
+  // once below `bound` (the factors are <= 1, so later ones cannot raise it). *acceptable:
+  // the cue thresholds min_ncc / max_phase_diff_rad hold.
+  auto weight = [&](int i, int j, double d2, double bound, bool* acceptable) {
+    *acceptable = true;
     double g = std::exp(-d2 * inv_two_sigma2);  // proximity: exp(−d²/2σ²)
     if (g < bound) return 0.0;
     if (use_ncc) {
-      g *= ncc_prev->Score(i, *ncc_curr, j);  // eq. (2)
+      const double c = ncc_prev->Score(i, *ncc_curr, j);  // eq. (2)
+      *acceptable = c >= options_.min_ncc;
+      g *= c;
       if (g < bound || g <= 0.0) return 0.0;
     }
-    if (use_gabor) g *= GaborPhaseSimilarity(*gabor_prev, i, *gabor_curr, j);  // eq. (5)
+    if (use_gabor) {
+      const double phase = GaborPhaseSimilarity(*gabor_prev, i, *gabor_curr, j);  // eq. (5)
+      *acceptable = *acceptable && phase >= min_phase_similarity;
+      g *= phase;
+    }
     return g;
   };
 
@@ -256,16 +321,19 @@ std::vector<Match> SvdMatcher::MatchFrames(const MatchFrame& prev, const MatchFr
   if (options_.dense) {
     // Reference: all n×m pairs, no cutoff, no dropping.
     Eigen::MatrixXd G(s.num_prev, s.num_curr);
+    SvdAcceptMatrix acceptable(s.num_prev, s.num_curr);
     for (int i = 0; i < s.num_prev; ++i) {
       for (int j = 0; j < s.num_curr; ++j) {
-        G(i, j) = weight(i, j, (prev.features[i].uv_px - curr.features[j].uv_px).squaredNorm(),
-                         0.0);
+        bool ok = true;
+        G(i, j) =
+            weight(i, j, (prev.features[i].uv_px - curr.features[j].uv_px).squaredNorm(), 0.0, &ok);
+        acceptable(i, j) = ok ? 1 : 0;
       }
     }
     s.num_candidates = s.num_prev * s.num_curr;
     s.num_components = 1;
     s.largest_component = s.num_prev + s.num_curr;
-    matches = SvdPairDense(G, options_);
+    matches = SvdPairDense(G, options_, &acceptable);
   } else {
     // Step 1: candidates within the cutoff radius, from a grid over the current features.
     const double radius = options_.cutoff_sigmas * options_.sigma_px;
@@ -275,8 +343,9 @@ std::vector<Match> SvdMatcher::MatchFrames(const MatchFrame& prev, const MatchFr
     for (int i = 0; i < s.num_prev; ++i) {
       grid.ForEachWithin(prev.features[i].uv_px, radius, [&](int j, double d2) {
         ++s.num_candidates;
-        const double g = weight(i, j, d2, options_.min_entry);
-        if (g > 0.0 && g >= options_.min_entry) entries.push_back(SvdEntry{i, j, g});
+        bool ok = true;
+        const double g = weight(i, j, d2, options_.min_entry, &ok);
+        if (g > 0.0 && g >= options_.min_entry) entries.push_back(SvdEntry{i, j, g, ok});
       });
     }
     matches = SvdPairSparse(s.num_prev, s.num_curr, std::move(entries), options_, &s);

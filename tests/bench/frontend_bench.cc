@@ -4,13 +4,13 @@
 //
 // Input: Middlebury tsukuba (im3/im4) resized to 320x240 when the shared data folder is
 // present, otherwise a synthetic random texture shifted by 8 px.
-#include <cstdio>
-#include <string>
-
 #include <benchmark/benchmark.h>
+
+#include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "vo/disparity.h"
 #include "vo/features.h"

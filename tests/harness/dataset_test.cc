@@ -1,5 +1,7 @@
 #include "harness/dataset.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -8,13 +10,10 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "harness/trajectory_io.h"
 
@@ -24,8 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-constexpr double kCalibTolerance = 1e-9;     // text round trip of calibration numbers
-constexpr double kPoseTolerance = 1e-9;      // per matrix entry: text round trip + compositions
+constexpr double kCalibTolerance = 1e-9;  // text round trip of calibration numbers
+constexpr double kPoseTolerance = 1e-9;   // per matrix entry: text round trip + compositions
 constexpr double kDepthToleranceM = 0.5e-3 + 1e-5;  // whole millimetres; float resolution at 65 m
 constexpr int kNumFrames = 5;
 
@@ -73,10 +72,9 @@ std::vector<DatasetFrame> MakeSequence(int n, bool with_gt, bool with_depth) {
     f.has_gt = with_gt;
     if (with_gt) {
       f.T_world_cam0.setIdentity();
-      f.T_world_cam0.linear() =
-          (Eigen::AngleAxisd(0.1 * i + 0.3, Eigen::Vector3d::UnitY()) *
-           Eigen::AngleAxisd(0.02 * i, Eigen::Vector3d::UnitX()))
-              .toRotationMatrix();
+      f.T_world_cam0.linear() = (Eigen::AngleAxisd(0.1 * i + 0.3, Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(0.02 * i, Eigen::Vector3d::UnitX()))
+                                    .toRotationMatrix();
       f.T_world_cam0.translation() = Eigen::Vector3d(12.0 + 0.5 * i, -3.0 + 0.1 * i * i, 1.25);
     }
     frames.push_back(f);
@@ -159,15 +157,16 @@ TEST_F(DatasetTest, KittiRoundTrip) {
   const std::string dir = WriteSequence("seq", frames);
 
   // The layout, exactly.
-  for (const char* name : {"calib.txt", "times.txt", "poses.txt", "groundtruth_tum.txt",
-                           "T_world_cam0first.txt", "image_0/000000.png", "image_1/000004.png",
-                           "depth/000004.png"})
+  for (const char* name :
+       {"calib.txt", "times.txt", "poses.txt", "groundtruth_tum.txt", "T_world_cam0first.txt",
+        "image_0/000000.png", "image_1/000004.png", "depth/000004.png"})
     EXPECT_TRUE(fs::is_regular_file(fs::path(dir) / name)) << name;
   EXPECT_FALSE(fs::exists(fs::path(dir) / "mav0"));
   EXPECT_EQ(ReadAll(fs::path(dir) / "calib.txt"),
             "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1 0\n"
             "P1: 52.25 0 31.5 -6.53125 0 51.75 23.5 0 0 0 1 0\n");
-  EXPECT_THAT(ReadAll(fs::path(dir) / "poses.txt"), ::testing::StartsWith("1 0 0 0 0 1 0 0 0 0 1 0\n"));
+  EXPECT_THAT(ReadAll(fs::path(dir) / "poses.txt"),
+              ::testing::StartsWith("1 0 0 0 0 1 0 0 0 0 1 0\n"));
 
   KittiReader reader;
   std::string error;
@@ -175,8 +174,7 @@ TEST_F(DatasetTest, KittiRoundTrip) {
   ExpectSameCamera(reader.camera(), TestCamera());
   ASSERT_EQ(reader.size(), frames.size());
   ASSERT_TRUE(reader.has_ground_truth());
-  EXPECT_THAT(reader.T_world_cam0first(),
-              IsNearTransform(frames[0].T_world_cam0, kPoseTolerance));
+  EXPECT_THAT(reader.T_world_cam0first(), IsNearTransform(frames[0].T_world_cam0, kPoseTolerance));
   for (size_t i = 0; i < frames.size(); ++i) {
     DatasetFrame f;
     ASSERT_TRUE(reader.ReadFrame(i, &f, &error)) << error;
@@ -186,9 +184,9 @@ TEST_F(DatasetTest, KittiRoundTrip) {
     ASSERT_TRUE(f.has_gt);
     EXPECT_THAT(f.T_world_cam0, IsNearTransform(frames[i].T_world_cam0, kPoseTolerance));
     // poses.txt is relative to the first left camera.
-    EXPECT_THAT(reader.poses()[i],
-                IsNearTransform(frames[0].T_world_cam0.inverse() * frames[i].T_world_cam0,
-                                kPoseTolerance));
+    EXPECT_THAT(
+        reader.poses()[i],
+        IsNearTransform(frames[0].T_world_cam0.inverse() * frames[i].T_world_cam0, kPoseTolerance));
     // Depth: millimetres, 0 where there was none or it did not fit.
     ASSERT_EQ(f.depth_m.type(), CV_32FC1);
     ASSERT_EQ(f.depth_m.size(), frames[i].depth_m.size());
@@ -214,8 +212,7 @@ TEST_F(DatasetTest, KittiRoundTrip) {
   }
   const std::vector<StampedPose> gt = reader.GroundTruth();
   ASSERT_EQ(gt.size(), frames.size());
-  EXPECT_THAT(gt.back().T_world_cam,
-              IsNearTransform(frames.back().T_world_cam0, kPoseTolerance));
+  EXPECT_THAT(gt.back().T_world_cam, IsNearTransform(frames.back().T_world_cam0, kPoseTolerance));
 }
 
 TEST_F(DatasetTest, KittiWithoutGroundTruthOrDepth) {
@@ -297,19 +294,18 @@ TEST_F(DatasetTest, EurocRoundTrip) {
 }
 
 TEST_F(DatasetTest, EurocGroundTruthAtAnotherRateIsAssociated) {
-  const std::string dir = WriteSequence("euroc_rate", MakeSequence(3, false, false),
-                                        [] {
-                                          DatasetWriter::Options o;
-                                          o.format = DatasetFormat::kEuroc;
-                                          return o;
-                                        }());
+  const std::string dir = WriteSequence("euroc_rate", MakeSequence(3, false, false), [] {
+    DatasetWriter::Options o;
+    o.format = DatasetFormat::kEuroc;
+    return o;
+  }());
   // Ground truth at 200 Hz starting 1 ms after the first frame (frames at 30 Hz from 100 s):
   // frame k pairs with the 200 Hz sample nearest to it, i.e. row round((k / 30 - 0.001) * 200).
   fs::create_directories(dir + "/mav0/state_groundtruth_estimate0");
   std::string csv = "#timestamp, p_RS_R_x [m], ...\n";
   for (int r = 0; r < 40; ++r)
-    csv += std::to_string(100001000000LL + 5000000LL * r) + "," + std::to_string(r) +
-           ",0,0,1,0,0,0\n";
+    csv +=
+        std::to_string(100001000000LL + 5000000LL * r) + "," + std::to_string(r) + ",0,0,1,0,0,0\n";
   WriteAll(dir + "/mav0/state_groundtruth_estimate0/data.csv", csv);
   EurocReader reader;
   std::string error;
@@ -468,15 +464,18 @@ TEST_F(KittiMalformedTest, MissingCalib) {
 }
 
 TEST_F(KittiMalformedTest, MalformedP0Line) {
-  WriteAll(dir_ + "/calib.txt", "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1\nP1: 52.25 0 31.5 -6.53125 0 "
-                                "51.75 23.5 0 0 0 1 0\n");
+  WriteAll(dir_ + "/calib.txt",
+           "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1\nP1: 52.25 0 31.5 -6.53125 0 "
+           "51.75 23.5 0 0 0 1 0\n");
   EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/calib.txt:1: P0: expected 12 numbers, got 11"));
 }
 
 TEST_F(KittiMalformedTest, NanInCalibration) {
-  WriteAll(dir_ + "/calib.txt", "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1 0\nP1: 52.25 0 nan "
-                                "-6.53125 0 51.75 23.5 0 0 0 1 0\n");
-  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/calib.txt:2: P1: field 3 ('nan') is not finite"));
+  WriteAll(dir_ + "/calib.txt",
+           "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1 0\nP1: 52.25 0 nan "
+           "-6.53125 0 51.75 23.5 0 0 0 1 0\n");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/calib.txt:2: P1: field 3 ('nan') is not finite"));
 }
 
 TEST_F(KittiMalformedTest, MissingP1) {
@@ -588,7 +587,8 @@ TEST_F(EurocMalformedTest, WellFormedReadsCleanly) { EXPECT_EQ(OpenAndReadAll(),
 
 TEST_F(EurocMalformedTest, MalformedDataCsvLine) {
   WriteAll(dir_ + "/mav0/cam1/data.csv", "#timestamp [ns],filename\n100000000000\n");
-  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/mav0/cam1/data.csv:2: expected '<timestamp ns>,"));
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/mav0/cam1/data.csv:2: expected '<timestamp ns>,"));
 }
 
 TEST_F(EurocMalformedTest, MissingSensorYaml) {

@@ -1,5 +1,7 @@
 #include "harness/trajectory_io.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -9,9 +11,6 @@
 #include <random>
 #include <string>
 #include <vector>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "tests/test_util.h"
 
@@ -74,8 +73,8 @@ std::vector<StampedPose> RandomTrajectory(int n, unsigned seed) {
 TEST(FormatDoubleTest, ShortestTextReadsBackExactly) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1e6, 1e6);
-  std::vector<double> values = {0.0, 1.0, -1.0, 0.1, 1e-300, 5e-324, 1.7976931348623157e308,
-                                1305031102.175304, -2.5e-5};
+  std::vector<double> values = {
+      0.0, 1.0, -1.0, 0.1, 1e-300, 5e-324, 1.7976931348623157e308, 1305031102.175304, -2.5e-5};
   for (int i = 0; i < 1000; ++i) values.push_back(u(rng) * std::pow(10.0, i % 20 - 10));
   for (double v : values) {
     double back = 0.0;
@@ -102,8 +101,7 @@ TEST_F(TrajectoryIoTest, TumRoundTrip) {
   ASSERT_EQ(back.size(), poses.size());
   for (size_t i = 0; i < poses.size(); ++i) {
     EXPECT_EQ(back[i].time_s, poses[i].time_s);
-    EXPECT_THAT(back[i].T_world_cam,
-                IsNearTransform(poses[i].T_world_cam, kRoundTripTolerance));
+    EXPECT_THAT(back[i].T_world_cam, IsNearTransform(poses[i].T_world_cam, kRoundTripTolerance));
   }
 }
 
@@ -194,7 +192,8 @@ TEST_F(TrajectoryIoTest, KittiPosesReadsKittiGroundTruthStyle) {
 }
 
 TEST_F(TrajectoryIoTest, KittiPosesMalformedRowsNameFileAndLine) {
-  const std::string short_row = WriteFile("short.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1\n");
+  const std::string short_row =
+      WriteFile("short.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1\n");
   const std::string not_rotation = WriteFile("scaled.txt", "2 0 0 0 0 1 0 0 0 0 1 0\n");
   const std::string reflection = WriteFile("mirror.txt", "-1 0 0 0 0 1 0 0 0 0 1 0\n");
   std::vector<Eigen::Isometry3d> poses;

@@ -2,15 +2,15 @@
 // (texture, left-right check), input validation, AttachDepth, and Middlebury accuracy.
 #include "vo/disparity.h"
 
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <string>
-#include <sys/stat.h>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "tests/test_util.h"
 
@@ -191,7 +191,8 @@ TEST(DisparityTest, ConstantIntegerShiftIsRecovered) {
     ASSERT_TRUE(r.ok) << r.message;
     ASSERT_EQ(r.disparity_px.type(), CV_32FC1);
     ASSERT_EQ(r.disparity_px.size(), p.left.size());
-    const double good = GoodFraction(r.disparity_px, p.gt_px, Interior(o, kShiftPx), kSubpixelTolPx);
+    const double good =
+        GoodFraction(r.disparity_px, p.gt_px, Interior(o, kShiftPx), kSubpixelTolPx);
     std::printf("[ constant %.0f px, %s ] good fraction %.4f\n", kShiftPx, ToString(o.algorithm),
                 good);
     EXPECT_GT(good, kMinGoodFraction) << ToString(o.algorithm);
@@ -329,12 +330,12 @@ TEST(DisparityTest, LeftRightCheckRemovesOccludedBand) {
     ASSERT_TRUE(off.ok && on.ok);
     const double valid_off = ValidFraction(off.disparity_px, s.occluded);
     const double valid_on = ValidFraction(on.disparity_px, s.occluded);
-    std::printf("[ occlusion, %s ] valid in band: without check %.3f (wrong %.3f), "
-                "with check %.3f (wrong %.3f)\n",
-                ToString(o.algorithm), valid_off,
-                WrongFraction(off.disparity_px, s.pair.gt_px, s.occluded, kBadPixelThresholdPx),
-                valid_on,
-                WrongFraction(on.disparity_px, s.pair.gt_px, s.occluded, kBadPixelThresholdPx));
+    std::printf(
+        "[ occlusion, %s ] valid in band: without check %.3f (wrong %.3f), "
+        "with check %.3f (wrong %.3f)\n",
+        ToString(o.algorithm), valid_off,
+        WrongFraction(off.disparity_px, s.pair.gt_px, s.occluded, kBadPixelThresholdPx), valid_on,
+        WrongFraction(on.disparity_px, s.pair.gt_px, s.occluded, kBadPixelThresholdPx));
     if (o.algorithm == DisparityAlgorithm::kBlockMatching) {
       EXPECT_GT(valid_off, kMinValidWithoutCheck);
     }
@@ -399,12 +400,12 @@ TEST(AttachDepthTest, SamplesBacksprojectsAndDrops) {
   disparity.at<float>(5, 0) = 30.0f;  // depth 1.33 m, isolated
 
   std::vector<Feature> features = {
-      At(2.25, 2.5),   // 0: bilinear inside the 2x2 block -> 10.25
-      At(6.0, 1.0),    // 1: exactly on a valid pixel -> 4
-      At(6.0, 4.0),    // 2: too far
-      At(0.0, 3.0),    // 3: nothing valid within 1 px
-      At(1.0, 5.0),    // 4: pixel invalid; nearest valid within 1 px is (0, 5) -> 30
-      At(-3.0, 2.0),   // 5: outside the image
+      At(2.25, 2.5),  // 0: bilinear inside the 2x2 block -> 10.25
+      At(6.0, 1.0),   // 1: exactly on a valid pixel -> 4
+      At(6.0, 4.0),   // 2: too far
+      At(0.0, 3.0),   // 3: nothing valid within 1 px
+      At(1.0, 5.0),   // 4: pixel invalid; nearest valid within 1 px is (0, 5) -> 30
+      At(-3.0, 2.0),  // 5: outside the image
       At(std::numeric_limits<double>::quiet_NaN(), 2.0),  // 6: not finite
   };
   DepthSamplingOptions options;  // bilinear, radius 1, 0.1 .. 50 m
@@ -543,20 +544,19 @@ TEST_P(MiddleburyTest, BadPixelRateAndDensity) {
                 p.name, ToString(o.algorithm), o.num_disparities, kBadPixelThresholdPx,
                 100.0 * s.bad_rate, 100.0 * s.density);
     EXPECT_LT(s.bad_rate, kMaxBadRate) << p.name << " " << ToString(o.algorithm);
-    EXPECT_GT(s.density, o.algorithm == DisparityAlgorithm::kBlockMatching ? kMinDensityBm
-                                                                           : kMinDensitySgbm)
+    EXPECT_GT(s.density,
+              o.algorithm == DisparityAlgorithm::kBlockMatching ? kMinDensityBm : kMinDensitySgbm)
         << p.name << " " << ToString(o.algorithm);
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Pairs, MiddleburyTest,
-                         ::testing::Values(MiddleburyPair{"tsukuba", "im3.png", "im4.png",
-                                                          "disp3.pgm", 16.0},
-                                           MiddleburyPair{"venus", "im2.png", "im6.png",
-                                                          "disp2.pgm", 8.0}),
-                         [](const ::testing::TestParamInfo<MiddleburyPair>& info) {
-                           return std::string(info.param.name);
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Pairs, MiddleburyTest,
+    ::testing::Values(MiddleburyPair{"tsukuba", "im3.png", "im4.png", "disp3.pgm", 16.0},
+                      MiddleburyPair{"venus", "im2.png", "im6.png", "disp2.pgm", 8.0}),
+    [](const ::testing::TestParamInfo<MiddleburyPair>& info) {
+      return std::string(info.param.name);
+    });
 
 }  // namespace
 }  // namespace vo

@@ -2,13 +2,13 @@
 // limit, bucketing, border margin, SIFT repeatability, invalid inputs.
 #include "vo/features.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
 
 #include "tests/test_util.h"
 
@@ -124,6 +124,34 @@ TEST(DetectorOptionsTest, InvalidOptionsGiveNoDetector) {
   DetectorOptions harris;
   harris.sift.sigma = -1.0;
   EXPECT_TRUE(harris.IsValid(nullptr));
+}
+
+TEST(HarrisTest, ResponseMatchesOpenCv) {
+  // Relative to the largest response: float rounding of sums of ~1e6 integer terms.
+  constexpr double kRelativeTol = 1e-5;
+  cv::Mat image = Texture(160, 120, 3);
+  cv::rectangle(image, cv::Rect(40, 30, 50, 40), cv::Scalar(255), cv::FILLED);
+  for (int aperture : {3, 5}) {
+    for (int block : {2, 3, 4, 5, 7}) {
+      HarrisOptions options;
+      options.aperture_size = aperture;
+      options.block_size = block;
+      cv::Mat ours, reference;
+      ASSERT_TRUE(HarrisResponse(image, options, &ours));
+      cv::cornerHarris(image, reference, block, aperture, options.k, cv::BORDER_REFLECT_101);
+      ASSERT_EQ(ours.type(), CV_32FC1);
+      ASSERT_EQ(ours.size(), image.size());
+      const cv::Rect inside(block, block, image.cols - 2 * block, image.rows - 2 * block);
+      double max_ref = 0.0;
+      cv::minMaxLoc(cv::abs(reference(inside)), nullptr, &max_ref);
+      EXPECT_LE(cv::norm(ours(inside), reference(inside), cv::NORM_INF), kRelativeTol * max_ref)
+          << "aperture " << aperture << " block " << block;
+    }
+  }
+  cv::Mat response;
+  EXPECT_FALSE(HarrisResponse(cv::Mat(), HarrisOptions(), &response));
+  EXPECT_FALSE(HarrisResponse(cv::Mat(10, 10, CV_32F), HarrisOptions(), &response));
+  EXPECT_FALSE(HarrisResponse(image, HarrisOptions(), nullptr));
 }
 
 TEST(HarrisTest, FindsRectangleCorners) {
@@ -270,8 +298,8 @@ TEST(HarrisTest, BucketingSpreadsFeatures) {
     EXPECT_LE(n, options.max_per_bucket);
     EXPECT_GT(n, 0);  // every cell has texture, faint or not
   }
-  EXPECT_EQ(static_cast<int>(bucketed.size()), std::min(options.max_features,
-                                                        options.max_per_bucket * 12));
+  EXPECT_EQ(static_cast<int>(bucketed.size()),
+            std::min(options.max_features, options.max_per_bucket * 12));
   ExpectHouseOrder(bucketed);
 }
 
@@ -390,11 +418,11 @@ TEST(FeatureDetectorTest, InvalidOrFeaturelessImagesGiveNoFeatures) {
   cv::cvtColor(texture, colour, cv::COLOR_GRAY2BGR);
   texture.convertTo(as_float, CV_32F);
   const std::vector<cv::Mat> images = {
-      cv::Mat(),                                      // empty
-      colour,                                         // CV_8UC3
-      as_float,                                       // CV_32F
-      texture(cv::Rect(0, 0, 20, 20)).clone(),        // no room inside a 12-px margin
-      cv::Mat(240, 320, CV_8UC1, cv::Scalar(77)),     // uniform
+      cv::Mat(),                                   // empty
+      colour,                                      // CV_8UC3
+      as_float,                                    // CV_32F
+      texture(cv::Rect(0, 0, 20, 20)).clone(),     // no room inside a 12-px margin
+      cv::Mat(240, 320, CV_8UC1, cv::Scalar(77)),  // uniform
   };
   for (DetectorType type : {DetectorType::kHarris, DetectorType::kSift}) {
     DetectorOptions options;
@@ -420,8 +448,7 @@ TEST(SelectFeaturesTest, LimitsAndBuckets) {
   DetectorOptions options;
   options.border_margin_px = 0;
   options.max_features = 4;
-  EXPECT_EQ(SelectFeatures(features, cv::Size(100, 100), options),
-            (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(SelectFeatures(features, cv::Size(100, 100), options), (std::vector<int>{0, 1, 2, 3}));
   options.max_features = 0;
   options.bucket_cols = options.bucket_rows = 2;
   options.max_per_bucket = 3;

@@ -1,0 +1,361 @@
+#include "vo/bundle_adjustment.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "tests/test_util.h"
+#include "vo/ransac.h"  // vo::SplitMix64
+
+namespace vo {
+namespace {
+
+using vobench_test::IsNearPose;
+
+constexpr int kNumFrames = 5;
+constexpr int kNumPoints = 200;
+constexpr double kPixelSigma = 0.5;  // per pixel coordinate
+// The rms reported is per image observation (2D error norm), so the noise level is √2 σ.
+const double kNoiseRmsPx = std::sqrt(2.0) * kPixelSigma;
+// Noise-free observations: LM converges to the exact solution; the limit is the solver's
+// stopping tolerances, not rounding.
+constexpr double kExactTolRad = 1e-6;
+constexpr double kExactTolM = 1e-6;
+constexpr double kExactRmsPx = 1e-6;
+// 0.5 px noise, 5 frames, 200 points at 2–10 m: the poses are good to a few millimetres
+// and milliradians.
+constexpr double kNoisyTolRad = 2e-3;
+constexpr double kNoisyTolM = 1e-2;
+
+double Normal(SplitMix64* rng) {
+  const double u1 = 1.0 - rng->Uniform();
+  const double u2 = rng->Uniform();
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+StereoCamera TestCamera() {
+  StereoCamera cam;
+  cam.width = 320;
+  cam.height = 240;
+  cam.fx_px = cam.fy_px = 300.0;
+  cam.cx_px = 159.5;
+  cam.cy_px = 119.5;
+  cam.baseline_m = 0.12;
+  return cam;
+}
+
+bool InImage(const StereoCamera& cam, const Eigen::Vector2d& uv) {
+  return uv.x() >= 0.0 && uv.y() >= 0.0 && uv.x() <= cam.width - 1.0 && uv.y() <= cam.height - 1.0;
+}
+
+struct Scene {
+  BundleAdjustmentProblem truth;  // true poses and points, the noisy observations
+  BundleAdjustmentProblem start;  // perturbed poses (all but the first) and points
+};
+
+// 5 frames moving 0.15 m forward with 2° of yaw each; 200 points at 2–10 m in front, observed
+// in stereo wherever they project into both images.
+Scene MakeScene(uint64_t seed, double sigma_px) {
+  const StereoCamera cam = TestCamera();
+  SplitMix64 rng(seed);
+  Scene s;
+  for (int i = 0; i < kNumFrames; ++i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(0.035 * i, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    T.translation() = Eigen::Vector3d(0.01 * i, 0.0, 0.15 * i);
+    s.truth.T_world_cam0.push_back(T);
+  }
+  while (static_cast<int>(s.truth.points_world.size()) < kNumPoints) {
+    const Eigen::Vector3d p(6.0 * rng.Uniform() - 3.0, 3.0 * rng.Uniform() - 1.5,
+                            2.0 + 8.0 * rng.Uniform());
+    std::vector<BaObservation> obs;
+    for (int i = 0; i < kNumFrames; ++i) {
+      const Eigen::Vector3d p_cam0 = s.truth.T_world_cam0[i].inverse() * p;
+      BaObservation o;
+      Eigen::Vector2d l, r;
+      if (!cam.ProjectLeft(p_cam0, &l) || !cam.ProjectRight(p_cam0, &r) || !InImage(cam, l) ||
+          !InImage(cam, r))
+        continue;
+      o.frame_index = i;
+      o.point_index = static_cast<int>(s.truth.points_world.size());
+      const double v_noise = sigma_px * Normal(&rng);  // rectified: one v for both images
+      o.uv_left_px = l + Eigen::Vector2d(sigma_px * Normal(&rng), v_noise);
+      o.has_right = true;
+      o.uv_right_px = r + Eigen::Vector2d(sigma_px * Normal(&rng), v_noise);
+      obs.push_back(o);
+    }
+    if (obs.size() < 2) continue;
+    s.truth.points_world.push_back(p);
+    s.truth.observations.insert(s.truth.observations.end(), obs.begin(), obs.end());
+  }
+  s.start = s.truth;
+  for (int i = 1; i < kNumFrames; ++i) {
+    Eigen::Isometry3d& T = s.start.T_world_cam0[i];
+    const Eigen::Vector3d axis(Normal(&rng), Normal(&rng), Normal(&rng));
+    T.linear() = (Eigen::AngleAxisd(0.02, axis.normalized()) * T.linear()).eval();
+    T.translation() += 0.05 * Eigen::Vector3d(Normal(&rng), Normal(&rng), Normal(&rng));
+  }
+  for (Eigen::Vector3d& p : s.start.points_world)
+    p += 0.1 * Eigen::Vector3d(Normal(&rng), Normal(&rng), Normal(&rng));
+  return s;
+}
+
+// Plain rms reprojection error (pixels) of given poses and points against the observations.
+double Rms(const StereoCamera& cam, const BundleAdjustmentProblem& obs_from,
+           const std::vector<Eigen::Isometry3d>& poses,
+           const std::vector<Eigen::Vector3d>& points) {
+  double sq = 0.0;
+  int count = 0;
+  for (const BaObservation& o : obs_from.observations) {
+    const Eigen::Vector3d p = poses[o.frame_index].inverse() * points[o.point_index];
+    Eigen::Vector2d l, r;
+    cam.ProjectLeft(p, &l);
+    cam.ProjectRight(p, &r);
+    sq += (l - o.uv_left_px).squaredNorm() + (r - o.uv_right_px).squaredNorm();
+    count += 2;
+  }
+  return std::sqrt(sq / count);
+}
+
+TEST(BundleAdjustmentTest, NoiseFreeRecoversGroundTruth) {
+  const Scene s = MakeScene(1, 0.0);
+  BundleAdjustmentOptions options;
+  options.max_num_iterations = 50;
+  options.function_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-14;
+  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start, options);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_GT(r.rms_reprojection_before_px, 5.0);
+  EXPECT_LT(r.rms_reprojection_after_px, kExactRmsPx);
+  EXPECT_LT(r.final_cost, r.initial_cost);
+  for (int i = 0; i < kNumFrames; ++i)
+    EXPECT_THAT(r.T_world_cam0[i], IsNearPose(s.truth.T_world_cam0[i], kExactTolRad, kExactTolM))
+        << "frame " << i;
+  for (int j = 0; j < kNumPoints; ++j)
+    EXPECT_LT((r.points_world[j] - s.truth.points_world[j]).norm(), 1e-5) << "point " << j;
+  EXPECT_EQ(r.num_outliers, 0);
+  EXPECT_EQ(r.num_points_optimized, kNumPoints);
+}
+
+TEST(BundleAdjustmentTest, NoisyReducesErrorToTheNoiseLevel) {
+  const StereoCamera cam = TestCamera();
+  const Scene s = MakeScene(2, kPixelSigma);
+  const BundleAdjustmentSummary r = RunBundleAdjustment(cam, s.start);
+  ASSERT_TRUE(r.ok()) << r.message;
+  // Residual-level checks: the optimum is at least as good as the truth, and near the noise
+  // level (slightly below it: 3 of every ~4·frames residuals per point are absorbed by it).
+  const double rms_truth = Rms(cam, s.truth, s.truth.T_world_cam0, s.truth.points_world);
+  EXPECT_NEAR(rms_truth, kNoiseRmsPx, 0.05);
+  EXPECT_GT(r.rms_reprojection_before_px, 10.0 * kNoiseRmsPx);
+  EXPECT_LE(r.rms_reprojection_after_px, rms_truth + 1e-6);
+  EXPECT_GT(r.rms_reprojection_after_px, 0.7 * kNoiseRmsPx);
+  EXPECT_NEAR(r.rms_reprojection_after_px, Rms(cam, s.truth, r.T_world_cam0, r.points_world),
+              1e-12);
+  for (int i = 0; i < kNumFrames; ++i)
+    EXPECT_THAT(r.T_world_cam0[i], IsNearPose(s.truth.T_world_cam0[i], kNoisyTolRad, kNoisyTolM))
+        << "frame " << i;
+  EXPECT_EQ(r.num_outliers, 0);  // 3 px threshold is 6σ per coordinate
+}
+
+TEST(BundleAdjustmentTest, FixedOldestPoseStaysBitIdentical) {
+  Scene s = MakeScene(3, kPixelSigma);
+  // A pose that does not survive a matrix → quaternion → matrix round trip bit for bit.
+  s.start.T_world_cam0[0].linear() =
+      Eigen::AngleAxisd(1e-3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  s.start.T_world_cam0[0].translation() = Eigen::Vector3d(0.1, 1.0 / 3.0, -0.7);
+  for (int fixed = 1; fixed <= 2; ++fixed) {
+    BundleAdjustmentOptions options;
+    options.num_fixed_poses = fixed;
+    const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start, options);
+    ASSERT_TRUE(r.ok()) << r.message;
+    for (int i = 0; i < fixed; ++i)
+      EXPECT_TRUE(r.T_world_cam0[i].matrix() == s.start.T_world_cam0[i].matrix()) << "pose " << i;
+    EXPECT_FALSE(r.T_world_cam0[fixed].matrix() == s.start.T_world_cam0[fixed].matrix());
+  }
+}
+
+TEST(BundleAdjustmentTest, HuberIgnoresGrossOutliers) {
+  const StereoCamera cam = TestCamera();
+  Scene s = MakeScene(4, kPixelSigma);
+  // Corrupt 5% of the observations by 20–50 px (a wrong match in a track).
+  SplitMix64 rng(99);
+  std::vector<bool> corrupted(s.start.observations.size(), false);
+  for (size_t k = 0; k < s.start.observations.size(); ++k) {
+    if (rng.Uniform() >= 0.05) continue;
+    const double angle = 2.0 * M_PI * rng.Uniform();
+    const Eigen::Vector2d shift =
+        (20.0 + 30.0 * rng.Uniform()) * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    s.start.observations[k].uv_left_px += shift;
+    s.start.observations[k].uv_right_px += shift;
+    corrupted[k] = true;
+  }
+  const BundleAdjustmentSummary huber = RunBundleAdjustment(cam, s.start);
+  BundleAdjustmentOptions plain;
+  plain.loss = RobustLoss::kNone;
+  const BundleAdjustmentSummary squared = RunBundleAdjustment(cam, s.start, plain);
+  ASSERT_TRUE(huber.ok() && squared.ok());
+  double err_huber = 0.0, err_squared = 0.0;
+  for (int i = 0; i < kNumFrames; ++i) {
+    EXPECT_THAT(huber.T_world_cam0[i],
+                IsNearPose(s.truth.T_world_cam0[i], kNoisyTolRad, kNoisyTolM))
+        << "frame " << i;
+    err_huber +=
+        (huber.T_world_cam0[i].translation() - s.truth.T_world_cam0[i].translation()).norm();
+    err_squared +=
+        (squared.T_world_cam0[i].translation() - s.truth.T_world_cam0[i].translation()).norm();
+  }
+  EXPECT_LT(err_huber, err_squared);
+  // Every corrupted observation is flagged; almost nothing else is.
+  int missed = 0, false_flags = 0;
+  for (size_t k = 0; k < corrupted.size(); ++k) {
+    if (corrupted[k] && !huber.observation_is_outlier[k]) ++missed;
+    if (!corrupted[k] && huber.observation_is_outlier[k]) ++false_flags;
+  }
+  EXPECT_EQ(missed, 0);
+  EXPECT_LE(false_flags, 2);
+  EXPECT_LT(huber.rms_inlier_reprojection_after_px, 1.1 * kNoiseRmsPx);
+}
+
+TEST(BundleAdjustmentTest, DenseAndSparseSchurAgree) {
+  const Scene s = MakeScene(5, kPixelSigma);
+  BundleAdjustmentOptions dense;
+  dense.linear_solver = BaLinearSolver::kDenseSchur;
+  BundleAdjustmentOptions sparse;
+  sparse.linear_solver = BaLinearSolver::kSparseSchur;
+  const BundleAdjustmentSummary a = RunBundleAdjustment(TestCamera(), s.start, dense);
+  const BundleAdjustmentSummary b = RunBundleAdjustment(TestCamera(), s.start, sparse);
+  ASSERT_TRUE(a.ok()) << a.message;
+  ASSERT_TRUE(b.ok()) << b.message;
+  EXPECT_EQ(a.linear_solver, "DENSE_SCHUR");
+  EXPECT_THAT(b.linear_solver, ::testing::StartsWith("SPARSE_SCHUR"));
+  // Same minimum, reached through different factorisations.
+  EXPECT_NEAR(a.final_cost, b.final_cost, 1e-6 * a.final_cost);
+  for (int i = 0; i < kNumFrames; ++i)
+    EXPECT_THAT(a.T_world_cam0[i], IsNearPose(b.T_world_cam0[i], 1e-6, 1e-6));
+}
+
+TEST(BundleAdjustmentTest, Deterministic) {
+  const Scene s = MakeScene(6, kPixelSigma);
+  const BundleAdjustmentSummary a = RunBundleAdjustment(TestCamera(), s.start);
+  const BundleAdjustmentSummary b = RunBundleAdjustment(TestCamera(), s.start);
+  ASSERT_TRUE(a.ok());
+  EXPECT_EQ(a.final_cost, b.final_cost);
+  for (int i = 0; i < kNumFrames; ++i)
+    EXPECT_TRUE(a.T_world_cam0[i].matrix() == b.T_world_cam0[i].matrix());
+  EXPECT_EQ(a.points_world, b.points_world);
+}
+
+TEST(BundleAdjustmentTest, SingleFramePointsAreKeptByDefault) {
+  const StereoCamera cam = TestCamera();
+  Scene s = MakeScene(7, 0.0);
+  // A point seen in the last frame only, started 10 cm off.
+  const Eigen::Vector3d p_cam0(0.2, -0.1, 4.0);
+  const Eigen::Vector3d p_world = s.truth.T_world_cam0[4] * p_cam0;
+  BaObservation o;
+  o.frame_index = 4;
+  o.point_index = static_cast<int>(s.start.points_world.size());
+  cam.ProjectLeft(p_cam0, &o.uv_left_px);
+  cam.ProjectRight(p_cam0, &o.uv_right_px);
+  o.has_right = true;
+  s.start.points_world.push_back(p_world + Eigen::Vector3d(0.1, 0.0, 0.0));
+  s.start.observations.push_back(o);
+  const BundleAdjustmentSummary kept = RunBundleAdjustment(cam, s.start);
+  ASSERT_TRUE(kept.ok());
+  EXPECT_TRUE(kept.point_optimized.back());
+  EXPECT_LT((kept.points_world.back() - p_world).norm(), 1e-4);
+  BundleAdjustmentOptions two_frames;
+  two_frames.min_frames_per_point = 2;
+  const BundleAdjustmentSummary left_out = RunBundleAdjustment(cam, s.start, two_frames);
+  ASSERT_TRUE(left_out.ok());
+  EXPECT_FALSE(left_out.point_optimized.back());
+  EXPECT_EQ(left_out.points_world.back(), s.start.points_world.back());
+  EXPECT_EQ(left_out.num_points_optimized, kNumPoints);
+}
+
+TEST(BundleAdjustmentTest, LeftOnlyObservationsAreUsed) {
+  Scene s = MakeScene(8, 0.0);
+  for (size_t k = 0; k < s.start.observations.size(); k += 3)
+    s.start.observations[k].has_right = false;
+  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_LT(r.rms_reprojection_after_px, 1e-4);
+  for (int i = 0; i < kNumFrames; ++i)
+    EXPECT_THAT(r.T_world_cam0[i], IsNearPose(s.truth.T_world_cam0[i], 1e-5, 1e-5));
+}
+
+TEST(BundleAdjustmentTest, PointBehindTheCameraIsLeftOutAndFlagged) {
+  Scene s = MakeScene(9, 0.0);
+  const int j = s.start.observations[0].point_index;
+  s.start.points_world[j] = s.start.T_world_cam0[0] * Eigen::Vector3d(0.0, 0.0, -2.0);
+  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_TRUE(r.observation_is_outlier[0]);
+}
+
+TEST(BundleAdjustmentTest, InvalidInputs) {
+  const Scene s = MakeScene(10, 0.0);
+  BundleAdjustmentProblem bad = s.start;
+  bad.observations[0].point_index = kNumPoints;
+  EXPECT_EQ(RunBundleAdjustment(TestCamera(), bad).status,
+            BundleAdjustmentSummary::Status::kInvalidInput);
+  BundleAdjustmentOptions options;
+  options.num_fixed_poses = kNumFrames + 1;
+  EXPECT_EQ(RunBundleAdjustment(TestCamera(), s.start, options).status,
+            BundleAdjustmentSummary::Status::kInvalidInput);
+  options = BundleAdjustmentOptions();
+  options.loss_scale_px = 0.0;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_THAT(error, ::testing::HasSubstr("loss_scale_px"));
+  BundleAdjustmentProblem empty = s.start;
+  empty.observations.clear();
+  EXPECT_EQ(RunBundleAdjustment(TestCamera(), empty).status,
+            BundleAdjustmentSummary::Status::kInvalidInput);
+}
+
+TEST(BundleAdjustmentTest, MakeWindowProblemFromTracks) {
+  const StereoCamera cam = TestCamera();
+  const Scene s = MakeScene(11, 0.0);
+  // Feed the scene's frames to a TrackManager: feature k of frame i = the k-th point visible
+  // in frame i, matched to the previous frame's feature of the same point.
+  TrackManager tracks;
+  std::map<int64_t, Eigen::Isometry3d> poses;
+  std::vector<int> prev_point_of_feature;
+  for (int i = 0; i < kNumFrames; ++i) {
+    std::vector<Feature> features;
+    std::vector<int> point_of_feature;
+    for (const BaObservation& o : s.truth.observations) {
+      if (o.frame_index != i) continue;
+      Feature f;
+      f.uv_px = o.uv_left_px;
+      f.disparity_px = o.uv_left_px.x() - o.uv_right_px.x();
+      f.p_cam0 = cam.Backproject(f.uv_px.x(), f.uv_px.y(), f.disparity_px);
+      features.push_back(f);
+      point_of_feature.push_back(o.point_index);
+    }
+    std::vector<Match> matches;
+    for (size_t c = 0; c < point_of_feature.size(); ++c)
+      for (size_t p = 0; p < prev_point_of_feature.size(); ++p)
+        if (prev_point_of_feature[p] == point_of_feature[c])
+          matches.push_back({static_cast<int>(p), static_cast<int>(c), 1.0});
+    ASSERT_TRUE(tracks.AddFrame(100 + i, &features, matches).ok());
+    poses[100 + i] = s.truth.T_world_cam0[i];
+    prev_point_of_feature = point_of_feature;
+  }
+  std::vector<int64_t> frame_ids, track_ids;
+  const BundleAdjustmentProblem p = MakeWindowProblem(tracks, poses, &frame_ids, &track_ids);
+  EXPECT_THAT(frame_ids, ::testing::ElementsAre(100, 101, 102, 103, 104));
+  ASSERT_EQ(p.points_world.size(), track_ids.size());
+  // Every point is seen in consecutive frames in this scene, so tracks = points (the scene
+  // keeps points seen in >= 2 frames; a point that leaves and re-enters would split).
+  EXPECT_GE(p.points_world.size(), static_cast<size_t>(kNumPoints));
+  EXPECT_EQ(p.observations.size(), s.truth.observations.size());
+  const BundleAdjustmentSummary r = RunBundleAdjustment(cam, p);
+  ASSERT_TRUE(r.ok());
+  EXPECT_LT(r.rms_reprojection_before_px, 1e-6);  // exact observations, true poses
+}
+
+}  // namespace
+}  // namespace vo

@@ -1,0 +1,147 @@
+// Windowed sparse bundle adjustment of a stereo head with Ceres. Kwolek, PAPER.md
+// "refinement", section V: minimise the squared reprojection error, eq. (8),
+//   min over poses P_i and points X_j of  Σ_i Σ_j d(P_i X_j, x_ij)²,
+// over the last few frames (paper: 3–5, 10 wished for), pose as quaternion + translation
+// (7 parameters). For a stereo head eq. (8) projects every point into BOTH the left and the
+// right camera (cam1 = cam0 + baseline along x, camera.h).
+//
+// Parametrisation. Each frame i has ONE 7-double parameter block holding T_world_cam0 (the
+// camera's pose in the world, p_world = T_world_cam0 * p_cam0): [qx qy qz qw tx ty tz], the
+// unit quaternion q_world_cam0 in Eigen's order (x, y, z, w) and t_world_cam0 (metres), on
+// ceres::ProductManifold<EigenQuaternionManifold, EuclideanManifold<3>> (6 tangent
+// dimensions). Each point j has a 3-double block p_world (metres). A point is projected as
+// p_cam0 = R_world_cam0ᵀ (p_world − t_world_cam0).
+//
+// Residuals. One residual block per observation (frame i, point j): 4 residuals
+// [u_l, v_l, u_r, v_r] − observed (pixels) for a stereo observation, 2 for a left-only one,
+// through a robust loss (Huber or Cauchy, scale loss_scale_px) applied to the whole block,
+// so a stereo observation is down-weighted as one. Derivatives by ceres::AutoDiffCostFunction.
+//
+// Gauge. The num_fixed_poses oldest poses (default 1: the oldest of the window) are held
+// constant (Problem::SetParameterBlockConstant); the stereo baseline fixes the scale.
+//
+// Solver. Levenberg-Marquardt with the Schur complement (points eliminated first: ordering
+// group 0 = points, group 1 = poses): SPARSE_SCHUR when Ceres was built with a sparse library
+// (Debian's Ceres 2.1 has SuiteSparse and Eigen sparse), else DENSE_SCHUR; num_threads = 1 so
+// the result is deterministic.
+//
+// Points seen in a single frame are kept by default (min_frames_per_point = 1): one stereo
+// observation gives 4 residuals for the point's 3 unknowns, so the point is well posed, but it
+// carries no information about the poses (its cost is one small block of the Schur
+// elimination). Set min_frames_per_point = 2 to leave such points out.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "vo/camera.h"
+#include "vo/tracks.h"
+
+namespace vo {
+
+enum class RobustLoss {
+  kNone,    // plain squared error
+  kHuber,   // ceres::HuberLoss: quadratic up to the scale, linear beyond
+  kCauchy,  // ceres::CauchyLoss: log(1 + s/scale²), stronger down-weighting of outliers
+};
+
+enum class BaLinearSolver {
+  kAuto,         // SPARSE_SCHUR when a sparse library is available, else DENSE_SCHUR
+  kSparseSchur,  // ceres SPARSE_SCHUR (SuiteSparse, else Eigen sparse); kInvalidInput if none
+  kDenseSchur,   // ceres DENSE_SCHUR
+};
+
+const char* ToString(RobustLoss loss);
+const char* ToString(BaLinearSolver solver);
+
+struct BundleAdjustmentOptions {
+  int max_num_iterations = 20;           // Levenberg-Marquardt iteration limit, >= 1
+  double function_tolerance = 1e-6;      // stop when the relative cost change is below (>= 0)
+  double gradient_tolerance = 1e-10;     // stop when the max-norm of the gradient is below (>= 0)
+  double parameter_tolerance = 1e-8;     // stop when the relative step is below (>= 0)
+  RobustLoss loss = RobustLoss::kHuber;  // robust loss on each observation's residual block
+  double loss_scale_px = 1.0;         // scale of the robust loss (pixels, residual-block norm), > 0
+  double outlier_threshold_px = 3.0;  // after the solve, an observation whose left or right
+                                      // reprojection error exceeds this (pixels) is flagged
+                                      // as an outlier, > 0
+  int num_fixed_poses = 1;            // the first (oldest) poses held constant, >= 1 (gauge)
+  int min_frames_per_point = 1;       // points observed in fewer frames are left out (returned
+                                      // unchanged, not optimised), >= 1
+  BaLinearSolver linear_solver = BaLinearSolver::kAuto;  // see BaLinearSolver
+  double min_depth_m = 1e-3;  // observations whose initial depth (z in cam0) is below this
+                              // (metres) are left out and flagged as outliers, > 0
+
+  bool IsValid(std::string* error) const;
+};
+
+// One image observation of point `point_index` in frame `frame_index`.
+struct BaObservation {
+  int frame_index = -1;  // index into BundleAdjustmentProblem::T_world_cam0
+  int point_index = -1;  // index into BundleAdjustmentProblem::points_world
+  Eigen::Vector2d uv_left_px = Eigen::Vector2d::Zero();   // left image (pixels)
+  bool has_right = false;                                 // right observation present
+  Eigen::Vector2d uv_right_px = Eigen::Vector2d::Zero();  // right image (pixels), if has_right
+};
+
+// Initial values and measurements. Frames are ordered oldest first; the first
+// num_fixed_poses frames are held constant.
+struct BundleAdjustmentProblem {
+  std::vector<Eigen::Isometry3d> T_world_cam0;  // per frame: p_world = T_world_cam0 * p_cam0
+  std::vector<Eigen::Vector3d> points_world;    // per point (metres, world frame)
+  std::vector<BaObservation> observations;
+};
+
+struct BundleAdjustmentSummary {
+  enum class Status {
+    kOk,            // the solver returned a usable solution (converged or hit the limit)
+    kInvalidInput,  // bad options or camera, indices out of range, non-finite numbers, fewer
+                    // poses than num_fixed_poses, no usable observation, no sparse library
+    kSolverFailed,  // Ceres reported a failure; the outputs hold the initial values
+  };
+  Status status = Status::kInvalidInput;
+  std::string message;        // empty when kOk; Ceres' message otherwise
+  bool converged = false;     // Ceres reported CONVERGENCE (not the iteration limit)
+  double initial_cost = 0.0;  // Ceres cost ½ Σ ρ(|r|²) at the start (pixels², robustified)
+  double final_cost = 0.0;    // the same at the end
+  double rms_reprojection_before_px = 0.0;        // sqrt(Σ|e|² / #image observations) over the
+                                                  // observations used, left and right counted
+                                                  // separately, plain (not robustified), initial
+  double rms_reprojection_after_px = 0.0;         // the same for the refined values
+  double rms_inlier_reprojection_after_px = 0.0;  // the same over non-outlier observations
+  int num_iterations = 0;       // Levenberg-Marquardt iterations (successful + unsuccessful)
+  int num_residual_blocks = 0;  // observations in the problem
+  int num_points_optimized = 0;
+  std::string linear_solver;  // Ceres linear solver used, e.g. "SPARSE_SCHUR (SUITE_SPARSE)"
+  std::vector<Eigen::Isometry3d> T_world_cam0;  // refined poses (the fixed ones are copied
+                                                // from the input bit for bit)
+  std::vector<Eigen::Vector3d> points_world;    // refined points (left-out ones unchanged)
+  std::vector<bool> point_optimized;            // per point: was in the problem
+  std::vector<bool> observation_is_outlier;     // per observation: left out, or a final left or
+                                                // right error above outlier_threshold_px
+  int num_outliers = 0;
+
+  bool ok() const { return status == Status::kOk; }
+};
+
+const char* ToString(BundleAdjustmentSummary::Status status);
+
+// Refines poses and points (see the header comment). Never throws.
+BundleAdjustmentSummary RunBundleAdjustment(
+    const StereoCamera& cam, const BundleAdjustmentProblem& problem,
+    const BundleAdjustmentOptions& options = BundleAdjustmentOptions());
+
+// Builds the window problem from a TrackManager: frames = the window's frames that have an
+// entry in T_world_cam0_by_frame (oldest first), points = tracks with at least one
+// observation with depth in those frames; each point starts at the observation with the
+// largest disparity (the most precise depth) mapped to the world. Observations with depth are
+// stereo (right = (u − d, v)), those without are left-only. frame_ids / track_ids (optional)
+// receive the frame id of each pose and the track id of each point.
+BundleAdjustmentProblem MakeWindowProblem(
+    const TrackManager& tracks, const std::map<int64_t, Eigen::Isometry3d>& T_world_cam0_by_frame,
+    std::vector<int64_t>* frame_ids = nullptr, std::vector<int64_t>* track_ids = nullptr);
+
+}  // namespace vo
