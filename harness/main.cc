@@ -6,7 +6,14 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+#include <sstream>
+
+#include "harness/match_eval.h"
+#include "harness/plots.h"
+#include "harness/progress.h"
 #include "harness/render.h"
+#include "harness/trajectory_io.h"
 
 namespace {
 
@@ -41,6 +48,105 @@ int RunRender(const std::string& scenario_arg, const std::string& out, const std
   return 0;
 }
 
+// Comma-separated integers ("1,2,3,5,8").
+bool ParseIntList(const std::string& text, std::vector<int>* out) {
+  out->clear();
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      size_t used = 0;
+      const int v = std::stoi(item, &used);
+      if (used != item.size()) return false;
+      out->push_back(v);
+    } catch (...) {
+      return false;
+    }
+  }
+  return !out->empty();
+}
+
+int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg,
+                 const std::string& matchers_arg, std::string out, int max_frames, bool quiet) {
+  std::string error;
+  sim::Scenario scenario;
+  if (!harness::ResolveScenario(scenario_arg, &scenario, &error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 2;
+  }
+  harness::MatchEvalOptions options;
+  if (!ParseIntList(strides_arg, &options.strides)) {
+    std::fprintf(stderr, "vobench match-eval: --strides: expected comma-separated integers, got '%s'\n", strides_arg.c_str());
+    return 2;
+  }
+  if (!matchers_arg.empty()) {
+    options.matchers.clear();
+    std::stringstream ss(matchers_arg);
+    std::string name;
+    while (std::getline(ss, name, ',')) {
+      vo::MatcherType t;
+      if (!vo::ParseMatcherType(name, &t)) {
+        std::fprintf(stderr, "vobench match-eval: --matchers: unknown matcher '%s' (svd_proximity, svd_ncc, svd_ncc_gabor, ncc_mutual, lucas_kanade, kalman, sift_ratio)\n", name.c_str());
+        return 2;
+      }
+      options.matchers.push_back(t);
+    }
+  }
+  if (!options.IsValid(&error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 2;
+  }
+  if (out.empty()) out = "out/match_eval/" + scenario.name;
+
+  // Simulate the scenario into memory: images, ground-truth depth and poses.
+  auto simulator = sim::Simulator::Create(scenario, &error);
+  if (!simulator) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
+  std::vector<harness::GroundTruthFrame> frames;
+  {
+    harness::Progress progress("simulate " + scenario.name, simulator->EstimatedFrames(), !quiet);
+    sim::StereoFrame f;
+    while ((max_frames <= 0 || static_cast<int>(frames.size()) < max_frames) && simulator->Next(&f, &error)) {
+      frames.push_back({f.left, f.right, f.depth_m, f.T_world_cam0});
+      progress.Update(static_cast<int>(frames.size()));
+    }
+    if (!error.empty()) {
+      std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+      return 1;
+    }
+    progress.Finish(static_cast<int>(frames.size()));
+  }
+  std::vector<harness::MatchEvalRow> rows;
+  harness::Progress progress("match-eval", 1, !quiet);
+  if (!harness::EvaluateMatchers(frames, harness::ToStereoCamera(simulator->calibration()), options, &rows, &error,
+                                 [&](int done, int total) {
+                                   progress.set_total(total);
+                                   progress.Update(done);
+                                 })) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
+  progress.Finish(static_cast<int>(rows.size()));
+  std::filesystem::create_directories(out);
+  const std::string csv = out + "/match_eval.csv";
+  if (!harness::WriteMatchEvalCsv(csv, rows, &error) ||
+      !harness::WriteTextFile(out + "/scenario.yaml", sim::ScenarioToYaml(scenario), &error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
+  if (!harness::RunPlot({"match-eval", csv, out + "/match_eval.png"}, &error))
+    std::fprintf(stderr, "vobench match-eval: warning: no plot: %s\n", error.c_str());
+  std::printf("%-14s %6s %6s %8s %8s %9s %7s %7s %9s\n", "matcher", "stride", "pairs", "matches", "correct",
+              "precision", "recall", "F1", "ms/pair");
+  for (const auto& r : rows)
+    std::printf("%-14s %6d %6d %8ld %8ld %9.4f %7.4f %7.4f %9.2f\n", r.matcher.c_str(), r.stride, r.pairs, r.matches,
+                r.correct, r.precision, r.recall, r.f1, r.ms_per_pair);
+  std::printf("wrote %s and %s/match_eval.png\n", csv.c_str(), out.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -58,9 +164,20 @@ int main(int argc, char** argv) {
   render->add_flag("--overwrite", overwrite, "Replace an existing output folder");
   render->add_flag("-q,--quiet", quiet, "No progress display");
 
+  std::string me_scenario = "l_hallway", me_strides = "1,2,3,5,8", me_matchers, me_out;
+  int me_max_frames = 0;
+  CLI::App* match_eval = app.add_subcommand("match-eval", "Matcher precision/recall/F1 per stride against the simulator's ground truth");
+  match_eval->add_option("scenario", me_scenario, "Scenario YAML file or built-in name")->capture_default_str();
+  match_eval->add_option("--strides", me_strides, "Frame strides, comma-separated")->capture_default_str();
+  match_eval->add_option("--matchers", me_matchers, "Matchers, comma-separated (default: all seven)");
+  match_eval->add_option("--out,-o", me_out, "Output folder (default out/match_eval/<scenario>)");
+  match_eval->add_option("--max-frames", me_max_frames, "Use only the first N frames (0 = all)");
+  match_eval->add_flag("-q,--quiet", quiet, "No progress display");
+
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   spdlog::set_pattern("[%l] %v");
   if (*render) return RunRender(scenario, out, format, overwrite, quiet);
+  if (*match_eval) return RunMatchEval(me_scenario, me_strides, me_matchers, me_out, me_max_frames, quiet);
   return 0;
 }

@@ -13,6 +13,8 @@ class Progress {
   Progress(std::string label, int total, bool enabled = true);
   // Reports that `done` items are finished.
   void Update(int done);
+  // Changes the expected total (e.g. once it is known).
+  void set_total(int total) { total_ = total; }
   // Final line with the count and the rate.
   void Finish(int done);
 

@@ -279,6 +279,10 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
   const long gt_step = im.start_step + std::lround(t_frame / dt);
   const long last_step = std::max(sample_steps.back(), gt_step);
 
+  // Fresh buffers: callers may keep the previous frame's images (cv::Mat shares data).
+  frame->left = cv::Mat();
+  frame->right = cv::Mat();
+  frame->depth_m = cv::Mat();
   cv::Mat acc[2];
   int rendered = 0;
   bool have_gt = false;

@@ -638,12 +638,109 @@ void PaintWall(Canvas& cv, double width_m, uint64_t seed, const TextureOptions& 
   }
 }
 
+// Random inner content of a poster or picture: blocks, discs, bars, text-like rows of blobs.
+void DrawPosterContent(Canvas& cv, const cv::Rect& r, Rng& rng) {
+  const int items = rng.Int(4, 12);
+  for (int i = 0; i < items; ++i) {
+    const int kind = rng.Int(0, 3);
+    const int w = std::max(2, static_cast<int>(r.width * rng.Uniform(0.1, 0.6)));
+    const int h = std::max(2, static_cast<int>(r.height * rng.Uniform(0.06, 0.4)));
+    const int x = r.x + rng.Int(0, std::max(0, r.width - w));
+    const int y = r.y + rng.Int(0, std::max(0, r.height - h));
+    const Colour c = RandomColour(rng, 0.0, 0.8, 20.0, 240.0);
+    if (kind == 0) {
+      Fill(cv, cv::Rect(x, y, w, h), c);
+    } else if (kind == 1) {
+      const int rad = std::max(2, std::min(w, h) / 2);
+      cv::circle(cv.img, cv::Point(x + w / 2, y + h / 2), rad, S(c), cv::FILLED);
+    } else if (kind == 2) {
+      const Colour c1 = RandomColour(rng, 0.0, 0.6, 30.0, 230.0);
+      const bool vertical = rng.Chance(0.5);
+      FillGradient(cv, cv::Rect(x, y, w, h), c, c1, vertical);
+    } else {
+      // Text-like rows: short dark dashes of random lengths.
+      const int line_h = std::max(2, cv.L(0.012));
+      for (int yy = y; yy + line_h < y + h; yy += 2 * line_h) {
+        int xx = x;
+        while (xx < x + w) {
+          const int len = std::max(2, static_cast<int>(line_h * rng.Uniform(1.0, 5.0)));
+          Fill(cv, cv::Rect(xx, yy, std::min(len, x + w - xx), line_h), Grey(rng.Uniform(10.0, 70.0)));
+          xx += len + std::max(1, static_cast<int>(line_h * rng.Uniform(0.6, 1.6)));
+        }
+      }
+    }
+  }
+}
+
 void FillWallSegment(Canvas& cv, double a_m, double b_m, double density, Rng& rng) {
-  (void)cv;
-  (void)a_m;
-  (void)b_m;
-  (void)density;
-  (void)rng;
+  // Walk along the segment placing objects at random gaps; kinds and sizes vary so that every
+  // object's corners look different from its neighbours'.
+  double x = a_m + rng.Uniform(0.1, 0.5);
+  while (x < b_m - 0.2) {
+    const int kind = rng.Int(0, 11);
+    double w = 0.0;
+    if (kind <= 3 || kind >= 10) {  // poster / notice board / framed picture
+      w = rng.Uniform(0.35, 1.2);
+      const double h = rng.Uniform(0.3, 0.9);
+      const double y = rng.Uniform(0.9, std::max(0.95, cv.height_m - 0.35 - h));
+      if (x + w > b_m - 0.05) break;
+      const cv::Rect r = cv.R(x, y, w, h);
+      SoftShadow(cv, r, cv.L(0.01), cv.L(0.01), cv.L(0.01), 0.25f);
+      const int frame = kind == 2 || kind == 10 ? cv.L(0.03) : 0;  // framed picture
+      if (frame > 0) Fill(cv, r, RandomColour(rng, 0.1, 0.5, 30.0, 120.0));
+      const cv::Rect inner(r.x + frame, r.y + frame, std::max(1, r.width - 2 * frame),
+                           std::max(1, r.height - 2 * frame));
+      Fill(cv, inner, kind == 3 ? Colour(60, 110, 150) : RandomColour(rng, 0.0, 0.5, 150.0, 250.0));
+      if (kind == 3) {  // cork board with pinned sheets
+        const int sheets = rng.Int(3, 9);
+        for (int k = 0; k < sheets; ++k) {
+          const int sw = std::max(3, static_cast<int>(inner.width * rng.Uniform(0.15, 0.4)));
+          const int sh = std::max(3, static_cast<int>(inner.height * rng.Uniform(0.2, 0.5)));
+          const int sx = inner.x + rng.Int(0, std::max(0, inner.width - sw));
+        const int sy = inner.y + rng.Int(0, std::max(0, inner.height - sh));
+        const cv::Rect sr(sx, sy, sw, sh);
+          Fill(cv, sr, RandomColour(rng, 0.0, 0.3, 200.0, 250.0));
+          DrawPosterContent(cv, cv::Rect(sr.x + 2, sr.y + 2, std::max(1, sr.width - 4), std::max(1, sr.height - 4)), rng);
+        }
+      } else {
+        DrawPosterContent(cv, inner, rng);
+      }
+    } else if (kind == 4) {  // light switch / socket pair
+      w = rng.Uniform(0.08, 0.2);
+      const double y = rng.Chance(0.5) ? rng.Uniform(1.0, 1.2) : rng.Uniform(0.25, 0.4);
+      const cv::Rect r = cv.R(x, y, w, 0.09);
+      Fill(cv, r, Grey(rng.Uniform(215.0, 245.0)));
+      Bevel(cv, r, 1, 15.f, -25.f);
+      Fill(cv, cv::Rect(r.x + r.width / 3, r.y + r.height / 3, std::max(1, r.width / 6), std::max(1, r.height / 3)), Grey(120));
+    } else if (kind == 5) {  // radiator: vertical fins
+      w = rng.Uniform(0.6, 1.4);
+      if (x + w > b_m - 0.05) break;
+      const double h = rng.Uniform(0.4, 0.6);
+      const cv::Rect r = cv.R(x, rng.Uniform(0.15, 0.25), w, h);
+      Fill(cv, r, Grey(rng.Uniform(200.0, 235.0)));
+      const int fin = std::max(2, cv.L(rng.Uniform(0.04, 0.07)));
+      for (int fx = r.x + fin / 2; fx < r.br().x; fx += fin)
+        Fill(cv, cv::Rect(fx, r.y, std::max(1, fin / 4), r.height), Grey(rng.Uniform(140.0, 175.0)));
+    } else if (kind == 6) {  // sign: coloured plate with a pictogram
+      w = rng.Uniform(0.2, 0.45);
+      const double h = rng.Uniform(0.12, 0.3);
+      const cv::Rect r = cv.R(x, rng.Uniform(1.6, std::max(1.65, cv.height_m - 0.3 - h)), w, h);
+      const Colour c = RandomColour(rng, 0.5, 0.9, 60.0, 180.0);
+      Fill(cv, r, c);
+      const cv::Point ctr(r.x + r.width / 3, r.y + r.height / 2);
+      cv::circle(cv.img, ctr, std::max(2, r.height / 4), S(Grey(245)), cv::FILLED);
+      Fill(cv, cv::Rect(r.x + r.width / 2, r.y + r.height / 3, std::max(1, r.width / 3), std::max(1, r.height / 3)), Grey(245));
+    } else if (kind == 7) {  // extinguisher / box
+      w = rng.Uniform(0.15, 0.35);
+      const double h = rng.Uniform(0.3, 0.6);
+      const cv::Rect r = cv.R(x, rng.Uniform(0.3, 0.9), w, h);
+      Fill(cv, r, RandomColour(rng, 0.6, 0.9, 90.0, 170.0));
+      Bevel(cv, r, std::max(1, cv.L(0.01)), 25.f, -35.f);
+    } else {  // bare wall
+      w = rng.Uniform(0.1, 0.4) / std::max(0.2, density);
+    }
+    x += w + rng.Uniform(0.05, 0.35) / std::max(0.2, density);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -693,13 +790,96 @@ void PaintPlainCeiling(Canvas& cv, uint64_t seed) {
   }
 }
 
+// Tiles with grout; every tile its own shade, noise and wear, so the grid never repeats.
 void PaintFloor(Canvas& cv, uint64_t seed, const TextureOptions& o) {
-  (void)o;
-  PaintPlainFloor(cv, seed);
+  Rng rng(DeriveSeed(seed, 41));
+  const double base = rng.Uniform(110.0, 170.0);
+  const double hue = rng.Uniform(0.0, 360.0);
+  cv.img.setTo(S(Grey(base * 0.55)));  // grout
+  const double tile = o.floor_tile_m;
+  const int grout = std::max(1, cv.L(o.grout_width_m));
+  const double w = cv.img.cols / cv.ppm, h = cv.img.rows / cv.ppm;
+  int index = 0;
+  for (double ty = 0.0; ty < h; ty += tile) {
+    for (double tx = 0.0; tx < w; tx += tile, ++index) {
+      Rng t(DeriveSeed(seed, 4100 + index));
+      const cv::Rect r = cv.R(tx, ty, tile, tile);
+      const cv::Rect in(r.x + grout, r.y + grout, std::max(1, r.width - grout), std::max(1, r.height - grout));
+      // One draw per statement: argument evaluation order is unspecified in C++.
+      const double sat = t.Uniform(0.02, 0.12);
+      const double shade = base + t.Uniform(-28.0, 28.0);
+      Fill(cv, in, Hsv(hue, sat, shade));
+      const uint64_t noise_seed = t.Fork();
+      const double cell_x = t.Uniform(0.03, 0.12);
+      const double cell_y = t.Uniform(0.03, 0.12);
+      const double amp = t.Uniform(6.0, 16.0);
+      AddNoise(cv, in, noise_seed, cv.L(cell_x), cv.L(cell_y), static_cast<float>(amp),
+               static_cast<float>(o.grain_amplitude));
+      const int wear = t.Int(0, 3);
+      for (int k = 0; k < wear; ++k) {
+        const double cx = tx + t.Uniform(0.0, tile), cy = ty + t.Uniform(0.0, tile);
+        const double rx = t.Uniform(0.02, 0.12), ry = t.Uniform(0.01, 0.06);
+        const double angle = t.Uniform(0.0, 180.0);
+        const double tone = t.Uniform(-50.0, 30.0);
+        SoftBlob(cv, cv.P(cx, cy), cv::Size(cv.L(rx), cv.L(ry)), angle, Grey(base + tone), 0.5f, cv.L(0.01));
+      }
+    }
+  }
+  // Scuffs and marks across tiles.
+  const int marks = static_cast<int>(std::lround(o.detail_density * 3.0 * w * h));
+  for (int i = 0; i < marks; ++i) {
+    const double mx = rng.Uniform(0.0, w);
+    const double my = rng.Uniform(0.0, h);
+    const cv::Point a = cv.P(mx, my);
+    const double len = rng.Uniform(0.03, 0.2), ang = rng.Uniform(0.0, 2 * M_PI);
+    const cv::Point b(a.x + cv.L(len * std::cos(ang), 0), a.y + cv.L(len * std::sin(ang), 0));
+    const double tone = rng.Uniform(20.0, 80.0);
+    cv::line(cv.img, a, b, S(Grey(tone)), std::max(1, cv.L(0.004)));
+  }
 }
+
+// Suspended ceiling: panels on a T-bar grid, each panel its own speckle; lights, vents and
+// sprinklers in irregular cells.
 void PaintCeiling(Canvas& cv, uint64_t seed, const TextureOptions& o) {
-  (void)o;
-  PaintPlainCeiling(cv, seed);
+  Rng rng(DeriveSeed(seed, 51));
+  const double base = rng.Uniform(205.0, 230.0);
+  cv.img.setTo(S(Grey(base - 45.0)));  // T-bar grid
+  const double panel = o.ceiling_panel_m;
+  const int bar = std::max(1, cv.L(o.ceiling_grid_width_m));
+  const double w = cv.img.cols / cv.ppm, h = cv.img.rows / cv.ppm;
+  const double ox = rng.Uniform(0.0, panel), oy = rng.Uniform(0.0, panel);
+  int index = 0;
+  for (double py = -oy; py < h; py += panel) {
+    for (double px = -ox; px < w; px += panel, ++index) {
+      Rng t(DeriveSeed(seed, 5100 + index));
+      const cv::Rect r = cv.R(px, py, panel, panel);
+      const cv::Rect in(r.x + bar, r.y + bar, std::max(1, r.width - bar), std::max(1, r.height - bar));
+      Fill(cv, in, Grey(base + t.Uniform(-12.0, 8.0)));
+      const uint64_t noise_seed = t.Fork();
+      const double amp = t.Uniform(4.0, 10.0);
+      AddNoise(cv, in, noise_seed, cv.L(0.02), cv.L(0.02), static_cast<float>(amp), 6.f);
+      const double u = t.Uniform();
+      if (u < 0.16) {  // light fixture: bright panel with a frame and louvres
+        Fill(cv, in, Grey(252));
+        Bevel(cv, in, std::max(1, cv.L(0.02)), -30.f, -50.f);
+        const int louvres = t.Int(2, 5);
+        for (int k = 1; k < louvres; ++k)
+          Fill(cv, cv::Rect(in.x, in.y + k * in.height / louvres, in.width, std::max(1, cv.L(0.008))), Grey(200));
+      } else if (u < 0.24) {  // vent: dark slots
+        const cv::Rect v(in.x + in.width / 4, in.y + in.height / 4, std::max(2, in.width / 2), std::max(2, in.height / 2));
+        Fill(cv, v, Grey(150));
+        for (int yy = v.y; yy < v.br().y; yy += std::max(2, cv.L(0.025)))
+          Fill(cv, cv::Rect(v.x, yy, v.width, std::max(1, cv.L(0.01))), Grey(70));
+      } else if (u < 0.34) {  // sprinkler / smoke detector
+        const int cx = in.x + t.Int(0, std::max(0, in.width - 1));
+        const int cy = in.y + t.Int(0, std::max(0, in.height - 1));
+        const cv::Point c(cx, cy);
+        const double radius = t.Uniform(0.02, 0.05);
+        const double tone = t.Uniform(90.0, 250.0);
+        cv::circle(cv.img, c, std::max(2, cv.L(radius)), S(Grey(tone)), cv::FILLED);
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -1,0 +1,141 @@
+#!/usr/bin/python3
+"""Plots for vobench reports (matplotlib, Agg backend, PNG).
+
+  plot.py match-eval CSV PNG          precision / recall / F1 vs stride, one line per matcher
+  plot.py trajectory GT_TUM EST_TUM PNG [--outline hallway_l]
+                                      top-down trajectory, estimate vs ground truth
+  plot.py errors RUN_DIR PNG          translation / rotation error along the path (per_frame.csv)
+  plot.py timing RUN_DIR PNG          per-stage time per frame (per_frame.csv)
+"""
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+# Hallway outlines (x, y polygons in the world, metres), as in scenes/*.xml.
+OUTLINES = {
+    "hallway_l": [(-1.5, -1), (9, -1), (9, 10), (7, 10), (7, 1), (-1.5, 1), (-1.5, -1)],
+    "corridor_plain": [(-1.5, -1), (14, -1), (14, 1), (-1.5, 1), (-1.5, -1)],
+}
+
+
+def read_csv(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def match_eval(csv_path, png):
+    rows = read_csv(csv_path)
+    matchers = []
+    for r in rows:
+        if r["matcher"] not in matchers:
+            matchers.append(r["matcher"])
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    for name in matchers:
+        rs = sorted((r for r in rows if r["matcher"] == name), key=lambda r: int(r["stride"]))
+        s = [int(r["stride"]) for r in rs]
+        style = "-o" if name.startswith("svd") else "--s"
+        for ax, key in zip(axes, ("precision", "recall", "f1")):
+            ax.plot(s, [float(r[key]) for r in rs], style, label=name, linewidth=2 if name == "svd_ncc_gabor" else 1)
+    for ax, key in zip(axes, ("precision", "recall", "F1")):
+        ax.set_xlabel("frame stride (larger = less overlap)")
+        ax.set_ylabel(key)
+        ax.grid(True, alpha=0.3)
+        ax.set_ylim(0, 1.02)
+    axes[0].legend(fontsize=8, loc="lower left")
+    fig.suptitle("Matcher quality against simulator ground truth (correct = within 2 px)")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+
+
+def read_tum(path):
+    out = []
+    with open(path) as f:
+        for line in f:
+            if line.strip() and not line.startswith("#"):
+                out.append([float(v) for v in line.split()])
+    return out
+
+
+def trajectory(gt_path, est_path, png, outline=None):
+    gt, est = read_tum(gt_path), read_tum(est_path)
+    fig, ax = plt.subplots(figsize=(6.5, 6.5))
+    if outline in OUTLINES:
+        xs, ys = zip(*OUTLINES[outline])
+        ax.plot(xs, ys, color="0.6", linewidth=1, label="hallway walls")
+    ax.plot([p[1] for p in gt], [p[2] for p in gt], "k-", linewidth=2, label="ground truth")
+    ax.plot([p[1] for p in est], [p[2] for p in est], "r--", linewidth=1.5, label="VO estimate")
+    ax.plot(gt[0][1], gt[0][2], "go", label="start")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title("Top-down trajectory (world frame)")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+
+
+def errors(run_dir, png):
+    rows = read_csv(run_dir + "/per_frame.csv")
+    d = [float(r["gt_distance_m"]) for r in rows]
+    fig, (a, b) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
+    a.plot(d, [float(r["translation_error_m"]) for r in rows], "b-")
+    a.set_ylabel("translation error (m)")
+    b.plot(d, [float(r["rotation_error_deg"]) for r in rows], "m-")
+    b.set_ylabel("rotation error (deg)")
+    b.set_xlabel("distance travelled (m)")
+    for ax in (a, b):
+        ax.grid(True, alpha=0.3)
+    lost = [float(r["gt_distance_m"]) for r in rows if r["status"] == "lost"]
+    for x in lost:
+        a.axvline(x, color="r", alpha=0.2)
+    fig.suptitle("Error along the path (estimate vs ground truth, from the first frame)")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+
+
+def timing(run_dir, png):
+    rows = read_csv(run_dir + "/per_frame.csv")
+    stages = [k for k in rows[0].keys() if k.endswith("_ms") and k != "total_ms"]
+    f = [int(r["frame"]) for r in rows]
+    fig, ax = plt.subplots(figsize=(9, 4))
+    bottom = [0.0] * len(rows)
+    for s in stages:
+        v = [float(r[s]) for r in rows]
+        ax.bar(f, v, bottom=bottom, width=1.0, label=s[:-3])
+        bottom = [x + y for x, y in zip(bottom, v)]
+    ax.set_xlabel("frame")
+    ax.set_ylabel("time (ms)")
+    ax.legend(fontsize=8, ncol=4)
+    ax.grid(True, alpha=0.3)
+    ax.set_title("Per-stage VO time per frame")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__)
+        return 2
+    cmd = argv[1]
+    if cmd == "match-eval":
+        match_eval(argv[2], argv[3])
+    elif cmd == "trajectory":
+        outline = argv[argv.index("--outline") + 1] if "--outline" in argv else None
+        trajectory(argv[2], argv[3], argv[4], outline)
+    elif cmd == "errors":
+        errors(argv[2], argv[3])
+    elif cmd == "timing":
+        timing(argv[2], argv[3])
+    else:
+        print(__doc__)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,688 @@
+#include "vo/odometry.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "tests/test_util.h"
+
+namespace vo {
+namespace {
+
+using vobench_test::IsNearPose;
+using vobench_test::RotationAngleRad;
+
+// Named tolerances.
+constexpr double kSeamTolRad = 1e-6;  // exact features and matches: the pipeline must be exact
+constexpr double kSeamTolM = 1e-6;
+constexpr double kDeg = M_PI / 180.0;
+
+// The simulator's hallway rig (DESIGN.md / the harness): 320x240, fx ≈ 230 px, 0.09 m.
+StereoCamera HallwayCamera() {
+  StereoCamera cam;
+  cam.width = 320;
+  cam.height = 240;
+  cam.fx_px = cam.fy_px = 230.0;
+  cam.cx_px = 159.5;
+  cam.cy_px = 119.5;
+  cam.baseline_m = 0.09;
+  return cam;
+}
+
+Eigen::Isometry3d MakePose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R;
+  T.translation() = t;
+  return T;
+}
+
+bool AllFinite(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
+
+// ---- (1) The seam: exact features and matches ---------------------------------------------
+
+// Ground truth T_world_cam0 of frame i (world = first camera, cv axes: y down, so a yaw is a
+// rotation about y): forward motion with a varying speed and a turn that starts at frame 5,
+// plus a little vertical bobbing.
+Eigen::Isometry3d SeamPose(int i) {
+  double yaw = 0.0;
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  for (int k = 1; k <= i; ++k) {
+    const double speed = 0.04 + 0.01 * std::sin(0.7 * k);  // metres per frame
+    yaw += k >= 5 ? 3.0 * kDeg : 0.2 * kDeg;
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    t += R * Eigen::Vector3d(0.0, 0.003 * std::cos(1.3 * k), speed);
+  }
+  return MakePose(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix() *
+                      Eigen::AngleAxisd(0.01 * std::sin(0.5 * i), Eigen::Vector3d::UnitX())
+                          .toRotationMatrix(),
+                  t);
+}
+
+// Points 1–10 m around the path (a ring, so the turning camera always sees some).
+std::vector<Eigen::Vector3d> SeamWorldPoints() {
+  SplitMix64 rng(42);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 3000; ++i) {
+    const double azimuth = 2.0 * M_PI * rng.Uniform();
+    const double range = 1.0 + 9.0 * rng.Uniform();
+    points.emplace_back(range * std::sin(azimuth), -1.5 + 3.0 * rng.Uniform(),
+                        range * std::cos(azimuth));
+  }
+  return points;
+}
+
+struct SeamFrame {
+  std::vector<Feature> features;
+  std::vector<int> point_ids;  // per feature
+};
+
+// Exact projections of the visible points into frame i (at most 250, in a frame-dependent
+// order so feature indices differ between frames).
+SeamFrame MakeSeamFrame(const StereoCamera& cam, const std::vector<Eigen::Vector3d>& points,
+                        int i) {
+  const Eigen::Isometry3d T_cam_world = SeamPose(i).inverse();
+  SeamFrame frame;
+  SplitMix64 rng(1000 + i);
+  std::vector<int> order(points.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+  for (size_t k = order.size() - 1; k > 0; --k) std::swap(order[k], order[rng.UniformIndex(k + 1)]);
+  for (int id : order) {
+    const Eigen::Vector3d p = T_cam_world * points[id];
+    Eigen::Vector2d l, r;
+    if (p.z() < 0.8 || !cam.ProjectLeft(p, &l) || !cam.ProjectRight(p, &r)) continue;
+    if (l.x() < 5 || l.y() < 5 || l.x() > cam.width - 6 || l.y() > cam.height - 6 || r.x() < 0) {
+      continue;
+    }
+    Feature f;
+    f.uv_px = l;
+    f.disparity_px = l.x() - r.x();
+    f.response = 1.0;
+    frame.features.push_back(f);
+    frame.point_ids.push_back(id);
+    if (frame.features.size() >= 250) break;
+  }
+  return frame;
+}
+
+// Matches by point id; `outlier_every` > 0 corrupts every n-th match into a wrong pairing.
+std::vector<Match> SeamMatches(const SeamFrame& prev, const SeamFrame& curr, int outlier_every) {
+  std::vector<int> curr_of_point(100000, -1);
+  for (size_t c = 0; c < curr.point_ids.size(); ++c) curr_of_point[curr.point_ids[c]] = c;
+  std::vector<Match> matches;
+  for (size_t p = 0; p < prev.point_ids.size(); ++p) {
+    const int c = curr_of_point[prev.point_ids[p]];
+    if (c >= 0) matches.push_back(Match{static_cast<int>(p), c, 1.0});
+  }
+  if (outlier_every > 0) {  // rotate the current indices of every n-th match (stays one-to-one)
+    std::vector<int> picked;
+    for (size_t k = 0; k < matches.size(); k += outlier_every) picked.push_back(k);
+    for (size_t k = 0; k + 1 < picked.size(); ++k) {
+      std::swap(matches[picked[k]].curr, matches[picked[k + 1]].curr);
+    }
+  }
+  return matches;
+}
+
+struct SeamCase {
+  bool use_ba;
+  int outlier_every;
+  double prior_weight;
+};
+
+class OdometrySeamTest : public ::testing::TestWithParam<SeamCase> {};
+
+TEST_P(OdometrySeamTest, ExactMatchesReproduceTheTrajectory) {
+  const StereoCamera cam = HallwayCamera();
+  OdometryOptions options;
+  options.estimate_initial_orientation = false;  // world = first camera = ground truth world
+  options.use_bundle_adjustment = GetParam().use_ba;
+  options.prior_weight = GetParam().prior_weight;
+  std::string error;
+  std::unique_ptr<StereoOdometry> vo = StereoOdometry::Create(cam, options, &error);
+  ASSERT_NE(vo, nullptr) << error;
+
+  const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  SeamFrame prev;
+  for (int i = 0; i < 20; ++i) {
+    SeamFrame curr = MakeSeamFrame(cam, points, i);
+    ASSERT_GE(curr.features.size(), 100u) << "frame " << i;
+    const std::vector<Match> matches =
+        i == 0 ? std::vector<Match>() : SeamMatches(prev, curr, GetParam().outlier_every);
+    const OdometryResult r = vo->ProcessFeatures(curr.features, matches, 0.1 * i);
+    EXPECT_EQ(r.status, i == 0 ? TrackingStatus::kInitializing : TrackingStatus::kTracking)
+        << "frame " << i << ": " << r.message;
+    EXPECT_THAT(r.T_world_cam0, IsNearPose(SeamPose(i), kSeamTolRad, kSeamTolM)) << "frame " << i;
+    if (i > 0) {
+      EXPECT_THAT(r.T_prev_curr,
+                  IsNearPose(Eigen::Isometry3d(SeamPose(i - 1).inverse() * SeamPose(i)),
+                             kSeamTolRad, kSeamTolM));
+      EXPECT_EQ(r.ba_ran, GetParam().use_ba);
+      EXPECT_EQ(r.num_matches, static_cast<int>(matches.size()));
+      EXPECT_EQ(vo->last_inlier_mask().size(), matches.size());
+      if (GetParam().outlier_every == 0) EXPECT_EQ(r.num_inliers, r.num_matches);
+      if (GetParam().outlier_every > 0) EXPECT_LT(r.num_inliers, r.num_matches);
+    }
+    prev = std::move(curr);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Variants, OdometrySeamTest,
+    ::testing::Values(SeamCase{false, 0, 0.5},  // RANSAC/Horn alone
+                      SeamCase{true, 0, 0.5},   // + windowed BA
+                      SeamCase{true, 0, 1.0},   // full inlier ratio: the prior gets no weight
+                      SeamCase{true, 5, 0.5},   // 20 % wrong matches: BA starts off the truth
+                      SeamCase{false, 5, 0.0}),  // ... without BA the prior must be off
+    [](const ::testing::TestParamInfo<SeamCase>& info) {
+      return std::string(info.param.use_ba ? "Ba" : "NoBa") + "Outliers" +
+             std::to_string(info.param.outlier_every) + "Prior" +
+             std::to_string(static_cast<int>(10 * info.param.prior_weight));
+    });
+
+TEST(OdometrySeamTest, FeaturesWithoutDepthAreDroppedAndMatchesReindexed) {
+  const StereoCamera cam = HallwayCamera();
+  OdometryOptions options;
+  options.estimate_initial_orientation = false;
+  StereoOdometry vo(cam, options);
+  const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  SeamFrame f0 = MakeSeamFrame(cam, points, 0);
+  SeamFrame f1 = MakeSeamFrame(cam, points, 1);
+  const std::vector<Match> matches = SeamMatches(f0, f1, 0);
+  // Every third feature of frame 0 loses its depth: its matches must be skipped.
+  for (size_t k = 0; k < f0.features.size(); k += 3) f0.features[k].disparity_px = -1.0;
+  const OdometryResult r0 = vo.ProcessFeatures(f0.features, {}, 0.0);
+  EXPECT_EQ(r0.num_features, static_cast<int>(f0.features.size()));
+  EXPECT_LT(r0.num_features_with_depth, r0.num_features);
+  const OdometryResult r1 = vo.ProcessFeatures(f1.features, matches, 0.1);
+  EXPECT_EQ(r1.status, TrackingStatus::kTracking) << r1.message;
+  EXPECT_LT(r1.num_matches, static_cast<int>(matches.size()));
+  EXPECT_EQ(r1.num_inliers, r1.num_matches);
+  EXPECT_THAT(r1.T_world_cam0, IsNearPose(SeamPose(1), kSeamTolRad, kSeamTolM));
+  // Track ids are written into the last features; tracked ones continue frame 0's tracks.
+  int tracked = 0;
+  for (const Feature& f : vo.last_features()) tracked += f.track_age == 1;
+  EXPECT_EQ(tracked, r1.num_inliers);
+}
+
+TEST(OdometrySeamTest, TooFewMatchesIsLostThenReinitialises) {
+  const StereoCamera cam = HallwayCamera();
+  OdometryOptions options;
+  options.estimate_initial_orientation = false;
+  StereoOdometry vo(cam, options);
+  const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  std::vector<SeamFrame> frames;
+  for (int i = 0; i < 6; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
+  vo.ProcessFeatures(frames[0].features, {}, 0.0);
+  vo.ProcessFeatures(frames[1].features, SeamMatches(frames[0], frames[1], 0), 0.1);
+  // Frame 2: only 5 matches → lost, pose = constant velocity prediction.
+  std::vector<Match> few = SeamMatches(frames[1], frames[2], 0);
+  few.resize(5);
+  const OdometryResult r2 = vo.ProcessFeatures(frames[2].features, few, 0.2);
+  EXPECT_EQ(r2.status, TrackingStatus::kLost);
+  EXPECT_THAT(r2.message, ::testing::HasSubstr("motion failed"));
+  const Eigen::Isometry3d velocity = SeamPose(0).inverse() * SeamPose(1);
+  EXPECT_THAT(r2.T_world_cam0, IsNearPose(Eigen::Isometry3d(SeamPose(1) * velocity), 1e-6, 1e-6));
+  // Frame 3: its matches refer to the lost frame 2 → re-initialised at the prediction.
+  const OdometryResult r3 =
+      vo.ProcessFeatures(frames[3].features, SeamMatches(frames[2], frames[3], 0), 0.3);
+  EXPECT_EQ(r3.status, TrackingStatus::kRecovered) << r3.message;
+  EXPECT_THAT(r3.T_world_cam0, IsNearPose(Eigen::Isometry3d(r2.T_world_cam0 * velocity), 1e-6,
+                                          1e-6));
+  // Frame 4: tracking again, with the exact relative motion.
+  const OdometryResult r4 =
+      vo.ProcessFeatures(frames[4].features, SeamMatches(frames[3], frames[4], 0), 0.4);
+  EXPECT_EQ(r4.status, TrackingStatus::kTracking) << r4.message;
+  EXPECT_THAT(r4.T_prev_curr, IsNearPose(Eigen::Isometry3d(SeamPose(3).inverse() * SeamPose(4)),
+                                         kSeamTolRad, kSeamTolM));
+}
+
+// ---- A rendered corridor (ray-cast textured box) -------------------------------------------
+
+// A straight corridor in the hallway frame (x along, y left, z up): floor z = 0, ceiling
+// z = kHeight, walls y = ±kHalfWidth, end walls x = kXMin / kXMax. Every face carries its
+// own random texture (blurred noise at two scales, 1 cm texels); pixels are ray-cast (2 × 2
+// supersampled) and the texture sampled bilinearly, so stereo and motion are exact up to
+// sampling.
+class CorridorRenderer {
+ public:
+  static constexpr double kXMin = -3.0, kXMax = 12.0, kHalfWidth = 1.2, kHeight = 2.6;
+  static constexpr double kTexel = 0.01;  // metres per texel
+
+  CorridorRenderer() {
+    // Face k: axis (0 = x, 1 = y, 2 = z), position, the two in-plane axes.
+    faces_ = {{2, 0.0, 0, 1}, {2, kHeight, 0, 1}, {1, kHalfWidth, 0, 2},
+              {1, -kHalfWidth, 0, 2}, {0, kXMax, 1, 2}, {0, kXMin, 1, 2}};
+    const double lo[3] = {kXMin, -kHalfWidth, 0.0}, hi[3] = {kXMax, kHalfWidth, kHeight};
+    cv::RNG rng(7);
+    for (Face& f : faces_) {
+      f.origin_a = lo[f.a];
+      f.origin_b = lo[f.b];
+      const int cols = static_cast<int>((hi[f.a] - lo[f.a]) / kTexel) + 2;
+      const int rows = static_cast<int>((hi[f.b] - lo[f.b]) / kTexel) + 2;
+      cv::Mat fine(rows, cols, CV_32F), coarse(rows / 8 + 1, cols / 8 + 1, CV_32F);
+      rng.fill(fine, cv::RNG::UNIFORM, 0.0, 1.0);
+      rng.fill(coarse, cv::RNG::UNIFORM, 0.0, 1.0);
+      cv::GaussianBlur(fine, fine, cv::Size(0, 0), 2.0);
+      cv::resize(coarse, coarse, fine.size(), 0, 0, cv::INTER_CUBIC);
+      f.texture = 0.6 * fine + 0.4 * coarse;
+      cv::normalize(f.texture, f.texture, 20.0, 235.0, cv::NORM_MINMAX);
+    }
+  }
+
+  // Left (cam0) and right (cam1) images of the camera at T_hall_cam0.
+  void Render(const StereoCamera& cam, const Eigen::Isometry3d& T_hall_cam0, cv::Mat* left,
+              cv::Mat* right) const {
+    *left = RenderView(cam, T_hall_cam0);
+    const Eigen::Isometry3d T_cam0_cam1 =
+        MakePose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(cam.baseline_m, 0.0, 0.0));
+    *right = RenderView(cam, T_hall_cam0 * T_cam0_cam1);
+  }
+
+ private:
+  struct Face {
+    int axis;
+    double position;
+    int a, b;
+    double origin_a = 0.0, origin_b = 0.0;
+    cv::Mat texture;  // CV_32F, row = b, column = a
+  };
+
+  double Sample(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const {
+    double best_t = 1e9;
+    const Face* best = nullptr;
+    for (const Face& f : faces_) {
+      if (std::abs(d[f.axis]) < 1e-12) continue;
+      const double t = (f.position - o[f.axis]) / d[f.axis];
+      if (t > 1e-6 && t < best_t) {
+        best_t = t;
+        best = &f;
+      }
+    }
+    if (best == nullptr) return 0.0;
+    const Eigen::Vector3d p = o + best_t * d;
+    const double x = (p[best->a] - best->origin_a) / kTexel;
+    const double y = (p[best->b] - best->origin_b) / kTexel;
+    const int x0 = std::clamp(static_cast<int>(std::floor(x)), 0, best->texture.cols - 2);
+    const int y0 = std::clamp(static_cast<int>(std::floor(y)), 0, best->texture.rows - 2);
+    const double fx = std::clamp(x - x0, 0.0, 1.0), fy = std::clamp(y - y0, 0.0, 1.0);
+    const float* r0 = best->texture.ptr<float>(y0);
+    const float* r1 = best->texture.ptr<float>(y0 + 1);
+    return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) +
+           fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
+  }
+
+  cv::Mat RenderView(const StereoCamera& cam, const Eigen::Isometry3d& T_hall_cam) const {
+    cv::Mat image(cam.height, cam.width, CV_8UC1);
+    const Eigen::Matrix3d R = T_hall_cam.linear();
+    const Eigen::Vector3d o = T_hall_cam.translation();
+    for (int v = 0; v < cam.height; ++v) {
+      for (int u = 0; u < cam.width; ++u) {
+        double sum = 0.0;
+        for (int s = 0; s < 4; ++s) {
+          const double us = u - 0.25 + 0.5 * (s % 2), vs = v - 0.25 + 0.5 * (s / 2);
+          const Eigen::Vector3d d_cam((us - cam.cx_px) / cam.fx_px, (vs - cam.cy_px) / cam.fy_px,
+                                      1.0);
+          sum += Sample(o, R * d_cam);
+        }
+        image.at<uint8_t>(v, u) = cv::saturate_cast<uint8_t>(sum / 4.0);
+      }
+    }
+    return image;
+  }
+
+  std::vector<Face> faces_;
+};
+
+// Camera orientation in the hallway frame for a heading (yaw about z_hall, radians, 0 = along
+// +x) and a small pitch: cv camera axes x right, y down, z forward.
+Eigen::Matrix3d R_hall_cam(double yaw_rad, double pitch_rad = 0.0) {
+  Eigen::Matrix3d R_hall_cam_level;
+  R_hall_cam_level.col(0) = Eigen::Vector3d(0, -1, 0);  // x_cam = right = −y_hall
+  R_hall_cam_level.col(1) = Eigen::Vector3d(0, 0, -1);  // y_cam = down = −z_hall
+  R_hall_cam_level.col(2) = Eigen::Vector3d(1, 0, 0);   // z_cam = forward = +x_hall
+  return Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+         R_hall_cam_level *
+         Eigen::AngleAxisd(pitch_rad, Eigen::Vector3d::UnitX()).toRotationMatrix();
+}
+
+// Frame i of the corridor sequence: 4 cm per frame forward, turning 1° per frame from 5° off
+// the corridor axis, camera 1 m above the floor.
+Eigen::Isometry3d CorridorPose(int i) {
+  const double yaw = (5.0 - 1.0 * i) * kDeg;
+  Eigen::Vector3d t(0.0, 0.2, 1.0);
+  for (int k = 1; k <= i; ++k) {
+    const double yaw_k = (5.0 - 1.0 * k) * kDeg;
+    t += 0.04 * Eigen::Vector3d(std::cos(yaw_k), std::sin(yaw_k), 0.0);
+  }
+  return MakePose(R_hall_cam(yaw, -3.0 * kDeg), t);
+}
+
+struct StereoFrame {
+  cv::Mat left, right;
+};
+
+const std::vector<StereoFrame>& CorridorSequence() {
+  static const std::vector<StereoFrame> frames = [] {
+    const CorridorRenderer renderer;
+    std::vector<StereoFrame> out(12);
+    for (int i = 0; i < 12; ++i) {
+      renderer.Render(HallwayCamera(), CorridorPose(i), &out[i].left, &out[i].right);
+    }
+    return out;
+  }();
+  return frames;
+}
+
+// Ground-truth camera motion from frame 0 to frame i.
+Eigen::Isometry3d TrueMotionFromFirst(int i) { return CorridorPose(0).inverse() * CorridorPose(i); }
+Eigen::Isometry3d EstimatedMotionFromFirst(const std::vector<OdometryResult>& results, int i) {
+  return results[0].T_world_cam0.inverse() * results[i].T_world_cam0;
+}
+
+std::vector<OdometryResult> RunCorridor(const OdometryOptions& options,
+                                        const std::vector<int>& black_frames = {}) {
+  StereoOdometry vo(HallwayCamera(), options);
+  std::vector<OdometryResult> results;
+  const std::vector<StereoFrame>& frames = CorridorSequence();
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const bool black =
+        std::find(black_frames.begin(), black_frames.end(), static_cast<int>(i)) !=
+        black_frames.end();
+    const cv::Mat zeros = cv::Mat::zeros(frames[i].left.size(), CV_8UC1);
+    results.push_back(black ? vo.Process(zeros, zeros, 0.1 * i)
+                            : vo.Process(frames[i].left, frames[i].right, 0.1 * i));
+  }
+  return results;
+}
+
+TEST(OdometryDiag, Print) {
+  for (int variant = 0; variant < 4; ++variant) {
+    OdometryOptions o;
+    if (variant == 1) o.detector.harris.subpixel = true;
+    if (variant == 2) o.use_bundle_adjustment = false;
+    if (variant == 3) { o.detector.harris.subpixel = true; o.use_bundle_adjustment = false; }
+    const std::vector<OdometryResult> rs = RunCorridor(o);
+    std::printf("variant %d\n", variant);
+    for (size_t i = 1; i < rs.size(); ++i) {
+      const Eigen::Isometry3d step = CorridorPose(i - 1).inverse() * CorridorPose(i);
+      const Eigen::Isometry3d cum = TrueMotionFromFirst(i), est = EstimatedMotionFromFirst(rs, i);
+      std::printf("%zu feat %d/%d m %d in %d rms %.2f step %.2f mm %.3f deg cum %.2f mm %.3f deg t %.1f ms (d %.1f f %.1f z %.1f m %.1f r %.1f b %.1f)\n", i,
+        rs[i].num_features, rs[i].num_features_with_depth, rs[i].num_matches, rs[i].num_inliers, rs[i].rms_reprojection_px,
+        1e3 * (rs[i].T_prev_curr.translation() - step.translation()).norm(), RotationAngleRad(rs[i].T_prev_curr.linear(), step.linear()) / kDeg,
+        1e3 * (est.translation() - cum.translation()).norm(), RotationAngleRad(est.linear(), cum.linear()) / kDeg,
+        rs[i].times.total_ms, rs[i].times.disparity_ms, rs[i].times.detect_ms, rs[i].times.depth_ms, rs[i].times.match_ms, rs[i].times.motion_ms, rs[i].times.ba_ms);
+    }
+  }
+}
+
+// ---- (2) Rendered sequence ------------------------------------------------------------------
+
+constexpr double kRenderedTolM = 0.01;           // end of 44 cm travel: < 1 cm
+constexpr double kRenderedTolRad = 0.3 * kDeg;   // after an 11° turn: < 0.3°
+constexpr double kStepTolM = 0.004;              // per frame (4 cm steps): < 4 mm
+constexpr double kStepTolRad = 0.15 * kDeg;      // per frame (1° steps): < 0.15°
+constexpr double kOrientationTolRad = 1.0 * kDeg;  // plane-based initial orientation
+
+TEST(OdometryRenderedTest, ReproducesTheCorridorMotion) {
+  const std::vector<OdometryResult> results = RunCorridor(OdometryOptions());
+  ASSERT_EQ(results.size(), 12u);
+  EXPECT_EQ(results[0].status, TrackingStatus::kInitializing) << results[0].message;
+  EXPECT_TRUE(results[0].initial_orientation_ok) << results[0].message;
+  for (size_t i = 1; i < results.size(); ++i) {
+    const OdometryResult& r = results[i];
+    EXPECT_EQ(r.status, TrackingStatus::kTracking) << "frame " << i << ": " << r.message;
+    EXPECT_GT(r.num_features_with_depth, 100) << "frame " << i;
+    EXPECT_GT(r.num_inliers, 40) << "frame " << i;
+    EXPECT_TRUE(r.ba_ran) << "frame " << i;
+    EXPECT_THAT(r.T_prev_curr,
+                IsNearPose(Eigen::Isometry3d(CorridorPose(i - 1).inverse() * CorridorPose(i)),
+                           kStepTolRad, kStepTolM))
+        << "frame " << i;
+    EXPECT_THAT(EstimatedMotionFromFirst(results, i),
+                IsNearPose(TrueMotionFromFirst(i), kRenderedTolRad, kRenderedTolM))
+        << "frame " << i;
+  }
+}
+
+TEST(OdometryRenderedTest, InitialOrientationIsTheHallwayFrame) {
+  StereoOdometry vo(HallwayCamera(), OdometryOptions());
+  const OdometryResult r =
+      vo.Process(CorridorSequence()[0].left, CorridorSequence()[0].right, 0.0);
+  ASSERT_TRUE(r.initial_orientation_ok) << r.message;
+  EXPECT_LT(RotationAngleRad(vo.R_hall_cam0_initial(), CorridorPose(0).linear()),
+            kOrientationTolRad);
+  // World = hallway frame with its origin at the first camera centre.
+  EXPECT_TRUE(r.T_world_cam0.translation().isZero());
+  EXPECT_TRUE(r.T_world_cam0.linear().isApprox(vo.R_hall_cam0_initial()));
+}
+
+TEST(OdometryRenderedTest, WithoutOrientationTheWorldIsTheFirstCamera) {
+  OdometryOptions options;
+  options.estimate_initial_orientation = false;
+  StereoOdometry vo(HallwayCamera(), options);
+  const OdometryResult r =
+      vo.Process(CorridorSequence()[0].left, CorridorSequence()[0].right, 0.0);
+  EXPECT_FALSE(r.initial_orientation_ok);
+  EXPECT_TRUE(r.T_world_cam0.isApprox(Eigen::Isometry3d::Identity()));
+}
+
+TEST(OdometryRenderedTest, WithoutBundleAdjustmentStillTracks) {
+  OdometryOptions options;
+  options.use_bundle_adjustment = false;
+  const std::vector<OdometryResult> results = RunCorridor(options);
+  for (size_t i = 1; i < results.size(); ++i) {
+    EXPECT_EQ(results[i].status, TrackingStatus::kTracking) << results[i].message;
+    EXPECT_FALSE(results[i].ba_ran);
+  }
+  EXPECT_THAT(EstimatedMotionFromFirst(results, 11),
+              IsNearPose(TrueMotionFromFirst(11), 2 * kRenderedTolRad, 2 * kRenderedTolM));
+}
+
+TEST(OdometryRenderedTest, StageTimesAreFilled) {
+  const std::vector<OdometryResult> results = RunCorridor(OdometryOptions());
+  const StageTimes& t = results[3].times;
+  EXPECT_GT(t.disparity_ms, 0.0);
+  EXPECT_GT(t.detect_ms, 0.0);
+  EXPECT_GT(t.match_ms, 0.0);
+  EXPECT_GT(t.motion_ms, 0.0);
+  EXPECT_GT(t.ba_ms, 0.0);
+  EXPECT_GE(t.total_ms, t.disparity_ms + t.detect_ms + t.depth_ms + t.match_ms + t.motion_ms +
+                            t.ba_ms);
+  EXPECT_GT(results[0].times.orientation_ms, 0.0);
+}
+
+// ---- (3) A black frame in the middle ---------------------------------------------------------
+
+TEST(OdometryLostTest, BlackFrameIsLostThenRecovers) {
+  const std::vector<OdometryResult> results = RunCorridor(OdometryOptions(), {5});
+  for (const OdometryResult& r : results) {
+    EXPECT_TRUE(AllFinite(r.T_world_cam0));
+    EXPECT_TRUE(AllFinite(r.T_prev_curr));
+  }
+  EXPECT_EQ(results[4].status, TrackingStatus::kTracking);
+  EXPECT_EQ(results[5].status, TrackingStatus::kLost);
+  EXPECT_THAT(results[5].message, ::testing::HasSubstr("too few features"));
+  // The lost frame's pose is the constant-velocity prediction: close to the truth here.
+  EXPECT_THAT(EstimatedMotionFromFirst(results, 5),
+              IsNearPose(TrueMotionFromFirst(5), 3 * kRenderedTolRad, 3 * kRenderedTolM));
+  EXPECT_EQ(results[6].status, TrackingStatus::kRecovered) << results[6].message;
+  EXPECT_EQ(results[6].reference_frame_index, 4);  // matched against the last good frame
+  for (size_t i = 7; i < results.size(); ++i) {
+    EXPECT_EQ(results[i].status, TrackingStatus::kTracking) << results[i].message;
+  }
+  EXPECT_THAT(EstimatedMotionFromFirst(results, 11),
+              IsNearPose(TrueMotionFromFirst(11), 2 * kRenderedTolRad, 2 * kRenderedTolM));
+}
+
+TEST(OdometryLostTest, BlackFirstFramesWaitForTheFirstUsableFrame) {
+  const std::vector<OdometryResult> results = RunCorridor(OdometryOptions(), {0, 1});
+  EXPECT_EQ(results[0].status, TrackingStatus::kLost);
+  EXPECT_EQ(results[1].status, TrackingStatus::kLost);
+  EXPECT_EQ(results[2].status, TrackingStatus::kInitializing) << results[2].message;
+  EXPECT_EQ(results[3].status, TrackingStatus::kTracking) << results[3].message;
+  for (const OdometryResult& r : results) EXPECT_TRUE(AllFinite(r.T_world_cam0));
+}
+
+TEST(OdometryLostTest, SeveralBlackFramesRecoverOrReinitialise) {
+  const std::vector<OdometryResult> results = RunCorridor(OdometryOptions(), {4, 5, 6});
+  for (int i : {4, 5, 6}) EXPECT_EQ(results[i].status, TrackingStatus::kLost);
+  EXPECT_EQ(results[7].status, TrackingStatus::kRecovered) << results[7].message;
+  EXPECT_EQ(results[8].status, TrackingStatus::kTracking) << results[8].message;
+  for (const OdometryResult& r : results) EXPECT_TRUE(AllFinite(r.T_world_cam0));
+  // Constant-velocity bridging over 4 frames keeps the end pose within a few centimetres.
+  EXPECT_THAT(EstimatedMotionFromFirst(results, 11),
+              IsNearPose(TrueMotionFromFirst(11), 1.0 * kDeg, 0.03));
+}
+
+// ---- (4) Invalid input -----------------------------------------------------------------------
+
+TEST(OdometryLostTest, InvalidInputIsLostWithAMessage) {
+  StereoOdometry vo(HallwayCamera(), OdometryOptions());
+  const StereoFrame& f = CorridorSequence()[0];
+  ASSERT_EQ(vo.Process(f.left, f.right, 0.0).status, TrackingStatus::kInitializing);
+
+  cv::Mat colour;
+  cv::cvtColor(f.left, colour, cv::COLOR_GRAY2BGR);
+  cv::Mat small;
+  cv::resize(f.right, small, cv::Size(160, 120));
+  cv::Mat wide_left(240, 400, CV_8UC1, cv::Scalar(0)), wide_right = wide_left.clone();
+  cv::Mat left16;
+  f.left.convertTo(left16, CV_16U);
+  const struct {
+    cv::Mat left, right;
+    const char* expected;
+  } cases[] = {
+      {cv::Mat(), f.right, "empty"},
+      {f.left, cv::Mat(), "empty"},
+      {colour, f.right, "CV_8UC1"},
+      {left16, f.right, "CV_8UC1"},
+      {f.left, small, "differ in size"},
+      {wide_left, wide_right, "camera"},
+  };
+  for (const auto& c : cases) {
+    const OdometryResult r = vo.Process(c.left, c.right, 0.1);
+    EXPECT_EQ(r.status, TrackingStatus::kLost);
+    EXPECT_THAT(r.message, ::testing::HasSubstr(c.expected));
+    EXPECT_TRUE(AllFinite(r.T_world_cam0));
+  }
+  // Frame 1 after the bad ones: matched against frame 0 → recovered.
+  const OdometryResult r = vo.Process(CorridorSequence()[1].left, CorridorSequence()[1].right, 0.2);
+  EXPECT_EQ(r.status, TrackingStatus::kRecovered) << r.message;
+  EXPECT_THAT(r.T_prev_curr, ::testing::Not(IsNearPose(Eigen::Isometry3d::Identity(), 0.0, 0.0)));
+}
+
+// ---- (5) Determinism -------------------------------------------------------------------------
+
+TEST(OdometryDeterminismTest, TwoRunsAreBitIdentical) {
+  const std::vector<OdometryResult> a = RunCorridor(OdometryOptions(), {7});
+  const std::vector<OdometryResult> b = RunCorridor(OdometryOptions(), {7});
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].status, b[i].status);
+    EXPECT_EQ(a[i].num_matches, b[i].num_matches);
+    EXPECT_EQ(a[i].num_inliers, b[i].num_inliers);
+    EXPECT_TRUE(a[i].T_world_cam0.matrix() == b[i].T_world_cam0.matrix()) << "frame " << i;
+    EXPECT_EQ(a[i].rms_reprojection_px, b[i].rms_reprojection_px);
+  }
+}
+
+TEST(OdometryDeterminismTest, ResetStartsOver) {
+  StereoOdometry vo(HallwayCamera(), OdometryOptions());
+  std::vector<Eigen::Isometry3d> first, second;
+  for (int run = 0; run < 2; ++run) {
+    for (int i = 0; i < 4; ++i) {
+      const OdometryResult r =
+          vo.Process(CorridorSequence()[i].left, CorridorSequence()[i].right, 0.1 * i);
+      EXPECT_EQ(r.frame_index, i);
+      (run == 0 ? first : second).push_back(r.T_world_cam0);
+    }
+    vo.Reset();
+  }
+  for (int i = 0; i < 4; ++i) EXPECT_TRUE(first[i].matrix() == second[i].matrix());
+}
+
+// ---- (6) Options -----------------------------------------------------------------------------
+
+TEST(OdometryOptionsTest, DefaultsAreValid) {
+  std::string error;
+  EXPECT_TRUE(OdometryOptions().IsValid(&error)) << error;
+}
+
+TEST(OdometryOptionsTest, RejectsBadValues) {
+  const auto rejects = [](const std::function<void(OdometryOptions*)>& change,
+                          const std::string& expected) {
+    OdometryOptions options;
+    change(&options);
+    std::string error;
+    EXPECT_FALSE(options.IsValid(&error)) << expected;
+    EXPECT_THAT(error, ::testing::HasSubstr(expected));
+    EXPECT_EQ(StereoOdometry::Create(HallwayCamera(), options), nullptr);
+  };
+  rejects([](OdometryOptions* o) { o->ba_window_frames = 2; }, "ba_window_frames");
+  rejects([](OdometryOptions* o) { o->ba_window_frames = 11; }, "ba_window_frames");
+  rejects([](OdometryOptions* o) { o->prior_weight = -0.1; }, "prior_weight");
+  rejects([](OdometryOptions* o) { o->prior_weight = 1.5; }, "prior_weight");
+  rejects([](OdometryOptions* o) { o->min_inliers = 2; }, "min_inliers");
+  rejects([](OdometryOptions* o) { o->min_features = 0; }, "min_features");
+  rejects([](OdometryOptions* o) { o->disparity_min_depth_m = 0.0; }, "disparity_min_depth_m");
+  rejects([](OdometryOptions* o) { o->max_num_disparities = 40; }, "max_num_disparities");
+  rejects([](OdometryOptions* o) { o->reinit_after_lost_frames = 0; }, "reinit_after_lost");
+  rejects([](OdometryOptions* o) { o->orientation_sample_step_px = 0; }, "orientation_sample");
+  rejects([](OdometryOptions* o) { o->matcher.type = MatcherType::kSiftRatio; }, "kSift");
+  rejects([](OdometryOptions* o) { o->detector.max_features = -1; }, "detector");
+  rejects([](OdometryOptions* o) { o->ransac.confidence = 1.0; }, "ransac");
+  rejects([](OdometryOptions* o) { o->ba.num_fixed_poses = 0; }, "ba");
+  rejects([](OdometryOptions* o) { o->ba.num_fixed_poses = 5; }, "num_fixed_poses");
+  rejects(
+      [](OdometryOptions* o) {
+        o->derive_num_disparities = false;
+        o->disparity.num_disparities = 20;
+      },
+      "disparity");
+}
+
+TEST(OdometryOptionsTest, InvalidCameraIsRejectedByCreate) {
+  StereoCamera cam = HallwayCamera();
+  cam.baseline_m = 0.0;
+  std::string error;
+  EXPECT_EQ(StereoOdometry::Create(cam, OdometryOptions(), &error), nullptr);
+  EXPECT_THAT(error, ::testing::HasSubstr("camera"));
+}
+
+TEST(OdometryOptionsTest, DisparityRangeIsDerivedFromTheCamera) {
+  // Hallway rig: 230 · 0.09 / 0.4 = 51.75 px → 64.
+  StereoOdometry hallway(HallwayCamera(), OdometryOptions());
+  EXPECT_EQ(hallway.options().disparity.num_disparities, 64);
+  // KITTI: 718 · 0.54 / 0.4 = 969 px → clamped to 256.
+  StereoCamera kitti;
+  kitti.width = 1241;
+  kitti.height = 376;
+  kitti.fx_px = kitti.fy_px = 718.856;
+  kitti.cx_px = 607.19;
+  kitti.cy_px = 185.22;
+  kitti.baseline_m = 0.54;
+  StereoOdometry kitti_vo(kitti, OdometryOptions());
+  EXPECT_EQ(kitti_vo.options().disparity.num_disparities, 256);
+  // Explicit value kept when not derived; RANSAC's min_inliers raised to the pipeline's.
+  OdometryOptions options;
+  options.derive_num_disparities = false;
+  options.disparity.num_disparities = 32;
+  StereoOdometry fixed(HallwayCamera(), options);
+  EXPECT_EQ(fixed.options().disparity.num_disparities, 32);
+  EXPECT_EQ(fixed.options().ransac.min_inliers, options.min_inliers);
+}
+
+TEST(OdometryOptionsTest, StatusNames) {
+  EXPECT_STREQ(ToString(TrackingStatus::kInitializing), "initializing");
+  EXPECT_STREQ(ToString(TrackingStatus::kTracking), "tracking");
+  EXPECT_STREQ(ToString(TrackingStatus::kLost), "lost");
+  EXPECT_STREQ(ToString(TrackingStatus::kRecovered), "recovered");
+}
+
+}  // namespace
+}  // namespace vo

@@ -1,0 +1,605 @@
+#include "vo/odometry.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <utility>
+
+namespace vo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Prefixes the failing part's message with its name.
+bool FailPart(const char* part, const std::string& part_error, std::string* error) {
+  if (error) *error = std::string(part) + ": " + part_error;
+  return false;
+}
+
+bool Fail(const std::ostringstream& msg, std::string* error) {
+  if (error) *error = msg.str();
+  return false;
+}
+
+bool IsFinite(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
+
+// Rotation and translation blend: slerp(q_a, q_b, w), (1 − w) t_a + w t_b.
+Eigen::Isometry3d Blend(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b, double w) {
+  if (w <= 0.0) return T_a;
+  const Eigen::Quaterniond q_a(T_a.linear());
+  const Eigen::Quaterniond q_b(T_b.linear());
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q_a.slerp(w, q_b).normalized().toRotationMatrix();
+  T.translation() = (1.0 - w) * T_a.translation() + w * T_b.translation();
+  return T;
+}
+
+// T repeated n >= 1 times (the constant-velocity motion over n frames).
+Eigen::Isometry3d Power(const Eigen::Isometry3d& T, int64_t n) {
+  Eigen::Isometry3d P = T;
+  for (int64_t i = 1; i < n; ++i) P = P * T;
+  return P;
+}
+
+// The per-frame motion of a motion spanning n >= 1 frames: the rotation's n-th root (slerp from
+// identity), the translation divided by n (exact for pure translations and pure rotations).
+Eigen::Isometry3d Root(const Eigen::Isometry3d& T, int64_t n) {
+  if (n <= 1) return T;
+  const double f = 1.0 / static_cast<double>(n);
+  Eigen::Isometry3d R = Eigen::Isometry3d::Identity();
+  R.linear() = Eigen::Quaterniond::Identity()
+                   .slerp(f, Eigen::Quaterniond(T.linear()))
+                   .normalized()
+                   .toRotationMatrix();
+  R.translation() = f * T.translation();
+  return R;
+}
+
+// Smallest multiple of 16 >= fx · b / min_depth, clamped (see OdometryOptions).
+int DerivedNumDisparities(const StereoCamera& camera, const OdometryOptions& options) {
+  const double needed = camera.fx_px * camera.baseline_m / options.disparity_min_depth_m;
+  int n = static_cast<int>(std::ceil(needed / 16.0)) * 16;
+  const int width_cap = std::max(16, (camera.width - 1) / 16 * 16);
+  n = std::min({n, options.max_num_disparities, width_cap});
+  return std::max(16, n);
+}
+
+// Options as the pipeline uses them: derived disparity range, RANSAC min_inliers raised.
+OdometryOptions EffectiveOptions(const StereoCamera& camera, const OdometryOptions& options) {
+  OdometryOptions effective = options;
+  if (options.derive_num_disparities) {
+    effective.disparity.num_disparities = DerivedNumDisparities(camera, options);
+  }
+  effective.ransac.min_inliers = std::max(options.ransac.min_inliers, options.min_inliers);
+  return effective;
+}
+
+}  // namespace
+
+BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions() {
+  BundleAdjustmentOptions options;
+  options.min_frames_per_point = 2;
+  options.max_num_iterations = 10;
+  return options;
+}
+
+DetectorOptions DefaultOdometryDetectorOptions() {
+  DetectorOptions options;
+  options.type = DetectorType::kHarris;
+  options.max_features = 300;
+  options.bucket_cols = 8;
+  options.bucket_rows = 6;
+  options.max_per_bucket = 10;
+  return options;
+}
+
+bool OdometryOptions::IsValid(std::string* error) const {
+  std::string part_error;
+  if (!detector.IsValid(&part_error)) return FailPart("detector", part_error, error);
+  DisparityOptions disparity_checked = disparity;
+  if (derive_num_disparities) disparity_checked.num_disparities = 16;  // replaced later
+  if (!disparity_checked.IsValid(&part_error)) return FailPart("disparity", part_error, error);
+  if (!depth.IsValid(&part_error)) return FailPart("depth", part_error, error);
+  if (!matcher.IsValid(&part_error)) return FailPart("matcher", part_error, error);
+  if (!ransac.IsValid(&part_error)) return FailPart("ransac", part_error, error);
+  if (!ba.IsValid(&part_error)) return FailPart("ba", part_error, error);
+  if (estimate_initial_orientation && !orientation.IsValid(&part_error)) {
+    return FailPart("orientation", part_error, error);
+  }
+  std::ostringstream msg;
+  if (matcher.type == MatcherType::kSiftRatio && detector.type != DetectorType::kSift) {
+    msg << "matcher sift_ratio needs descriptors: detector.type must be kSift";
+  } else if (!(disparity_min_depth_m > 0.0) || !std::isfinite(disparity_min_depth_m)) {
+    msg << "disparity_min_depth_m must be finite and > 0, got " << disparity_min_depth_m;
+  } else if (max_num_disparities < 16 || max_num_disparities % 16 != 0) {
+    msg << "max_num_disparities must be a multiple of 16 and >= 16, got " << max_num_disparities;
+  } else if (ba_window_frames < 3 || ba_window_frames > 10) {
+    msg << "ba_window_frames must be in [3, 10], got " << ba_window_frames;
+  } else if (ba.num_fixed_poses >= ba_window_frames) {
+    msg << "ba.num_fixed_poses (" << ba.num_fixed_poses << ") must be < ba_window_frames ("
+        << ba_window_frames << ")";
+  } else if (!(prior_weight >= 0.0 && prior_weight <= 1.0)) {
+    msg << "prior_weight must be in [0, 1], got " << prior_weight;
+  } else if (orientation_sample_step_px < 1) {
+    msg << "orientation_sample_step_px must be >= 1, got " << orientation_sample_step_px;
+  } else if (min_features < 3) {
+    msg << "min_features must be >= 3, got " << min_features;
+  } else if (min_inliers < 3) {
+    msg << "min_inliers must be >= 3, got " << min_inliers;
+  } else if (reinit_after_lost_frames < 1) {
+    msg << "reinit_after_lost_frames must be >= 1, got " << reinit_after_lost_frames;
+  }
+  if (msg.tellp() != 0) return Fail(msg, error);
+  return true;
+}
+
+const char* ToString(TrackingStatus status) {
+  switch (status) {
+    case TrackingStatus::kInitializing:
+      return "initializing";
+    case TrackingStatus::kTracking:
+      return "tracking";
+    case TrackingStatus::kLost:
+      return "lost";
+    case TrackingStatus::kRecovered:
+      return "recovered";
+  }
+  return "unknown";
+}
+
+std::unique_ptr<StereoOdometry> StereoOdometry::Create(const StereoCamera& camera,
+                                                       const OdometryOptions& options,
+                                                       std::string* error) {
+  std::string why;
+  if (!camera.IsValid(&why)) {
+    if (error) *error = "camera: " + why;
+    return nullptr;
+  }
+  if (!options.IsValid(&why)) {
+    if (error) *error = why;
+    return nullptr;
+  }
+  return std::make_unique<StereoOdometry>(camera, options);
+}
+
+StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions& options)
+    : camera_(camera),
+      options_(EffectiveOptions(camera, options)),
+      tracks_(TrackManagerOptions{options.ba_window_frames}) {
+  std::string why;
+  if (!camera_.IsValid(&why)) {
+    std::fprintf(stderr, "vo::StereoOdometry: invalid camera: %s\n", why.c_str());
+    std::abort();
+  }
+  if (!options_.IsValid(&why)) {
+    std::fprintf(stderr, "vo::StereoOdometry: invalid options: %s\n", why.c_str());
+    std::abort();
+  }
+  disparity_ = std::make_unique<DisparityEstimator>(options_.disparity);
+  detector_ = CreateFeatureDetector(options_.detector, &why);
+  matcher_ = CreateFrameMatcher(options_.matcher, &why);
+  if (!detector_ || !matcher_) {
+    std::fprintf(stderr, "vo::StereoOdometry: %s\n", why.c_str());
+    std::abort();
+  }
+}
+
+StereoOdometry::~StereoOdometry() = default;
+
+void StereoOdometry::Reset() {
+  tracks_.Reset();
+  matcher_->Reset();
+  frame_index_ = 0;
+  initialised_ = false;
+  consecutive_lost_ = 0;
+  reference_ = Reference();
+  T_world_cam0_by_frame_.clear();
+  T_world_prev_ = Eigen::Isometry3d::Identity();
+  velocity_ = Eigen::Isometry3d::Identity();
+  has_velocity_ = false;
+  R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
+  orientation_result_ = PlaneOrientationResult();
+  last_features_.clear();
+  last_matches_.clear();
+  last_inlier_mask_.clear();
+  last_reference_features_.clear();
+  prev_call_index_map_.clear();
+}
+
+OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
+                                      TimePoint start) {
+  // Never hand out a non-finite pose: fall back to the previous output.
+  const Eigen::Isometry3d T = IsFinite(T_world_cam0) ? T_world_cam0 : T_world_prev_;
+  result.T_world_cam0 = T;
+  result.T_prev_curr = result.frame_index == 0 ? Eigen::Isometry3d::Identity()
+                                               : Eigen::Isometry3d(T_world_prev_.inverse() * T);
+  T_world_prev_ = T;
+  result.times.total_ms = MsSince(start);
+  return result;
+}
+
+OdometryResult StereoOdometry::Lost(OdometryResult result, const std::string& message,
+                                    TimePoint start) {
+  result.status = TrackingStatus::kLost;
+  result.message = message;
+  ++consecutive_lost_;
+  // Frames are skipped from the matcher's point of view (the Kalman tracker keeps state).
+  matcher_->Reset();
+  const Eigen::Isometry3d predicted =
+      has_velocity_ ? Eigen::Isometry3d(T_world_prev_ * velocity_) : T_world_prev_;
+  return Finish(std::move(result), predicted, start);
+}
+
+bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0) {
+  orientation_result_ = EstimateHallwayOrientation(points_cam0, options_.orientation);
+  const bool ok =
+      orientation_result_.ok() ||
+      (orientation_result_.status == PlaneOrientationResult::Status::kNoWall &&
+       !options_.orientation_requires_wall);
+  R_hall_cam0_initial_ = ok ? orientation_result_.R_hall_cam0 : Eigen::Matrix3d::Identity();
+  return ok;
+}
+
+OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame frame,
+                                          const std::string& reason, TimePoint start) {
+  Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
+  if (!initialised_) {
+    // World = hallway frame with its origin at the first camera centre, or the first camera.
+    T_world_cam0.linear() = R_hall_cam0_initial_;
+    result.status = TrackingStatus::kInitializing;
+    result.message = reason;
+  } else {
+    // Re-initialisation after a loss: keep the predicted pose and the constant velocity.
+    T_world_cam0 = has_velocity_ ? Eigen::Isometry3d(T_world_prev_ * velocity_) : T_world_prev_;
+    if (!IsFinite(T_world_cam0)) T_world_cam0 = T_world_prev_;
+    result.status = TrackingStatus::kRecovered;
+    result.message = reason.empty() ? "re-initialised at the predicted pose" : reason;
+  }
+  tracks_.Reset();
+  matcher_->Reset();
+  const TrackUpdateResult update = tracks_.AddFrame(result.frame_index, &frame.features, {});
+  if (!update.ok()) {  // cannot happen after Reset(); keep going without tracks
+    result.message += (result.message.empty() ? "" : "; ") + std::string("tracks: ") + update.message;
+  }
+  T_world_cam0_by_frame_.clear();
+  T_world_cam0_by_frame_[result.frame_index] = T_world_cam0;
+  initialised_ = true;
+  consecutive_lost_ = 0;
+  last_features_ = frame.features;
+  reference_.valid = true;
+  reference_.frame_index = result.frame_index;
+  reference_.frame = std::move(frame);
+  return Finish(std::move(result), T_world_cam0, start);
+}
+
+OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
+                                     const std::vector<Match>& matches, TimePoint start) {
+  const Clock::time_point motion_start = Clock::now();
+  const std::vector<Feature>& ref_features = reference_.frame.features;
+  result.reference_frame_index = static_cast<int>(reference_.frame_index);
+  result.num_matches = static_cast<int>(matches.size());
+
+  // RANSAC + Horn on the matches whose both features have depth; seeded by track ages.
+  std::vector<int> match_index;
+  const std::vector<StereoCorrespondence> correspondences =
+      MakeStereoCorrespondences(ref_features, frame.features, matches, &match_index);
+  const RansacResult ransac = EstimateMotionRansac(camera_, correspondences, options_.ransac);
+
+  last_matches_ = matches;
+  last_inlier_mask_.assign(matches.size(), false);
+  std::vector<Match> inlier_matches;
+  for (size_t k = 0; k < correspondences.size() && k < ransac.inlier_mask.size(); ++k) {
+    if (ransac.inlier_mask[k]) last_inlier_mask_[match_index[k]] = true;
+  }
+  for (size_t m = 0; m < matches.size(); ++m) {
+    if (last_inlier_mask_[m]) inlier_matches.push_back(matches[m]);
+  }
+  last_reference_features_ = ref_features;
+  last_features_ = frame.features;
+  result.num_inliers = ransac.ok() ? ransac.num_inliers : 0;
+
+  if (!ransac.ok() || ransac.num_inliers < options_.min_inliers ||
+      !IsFinite(ransac.T_prev_curr)) {
+    std::ostringstream why;
+    why << "motion failed: " << (ransac.ok() ? "too few inliers" : ToString(ransac.status)) << " ("
+        << ransac.num_inliers << " inliers of " << correspondences.size()
+        << " correspondences, " << matches.size() << " matches; need " << options_.min_inliers
+        << ")";
+    if (!ransac.message.empty()) why << ": " << ransac.message;
+    result.times.motion_ms = MsSince(motion_start);
+    if (consecutive_lost_ >= options_.reinit_after_lost_frames) {
+      // The reference is stale: start again from this frame at its predicted pose.
+      return Initialise(std::move(result), std::move(frame),
+                        why.str() + "; re-initialised at the predicted pose", start);
+    }
+    return Lost(std::move(result), why.str(), start);
+  }
+
+  // Initial pose: blend of the RANSAC/Horn motion and the constant-velocity prediction.
+  const int64_t gap = result.frame_index - reference_.frame_index;
+  const double inlier_ratio =
+      static_cast<double>(ransac.num_inliers) / std::max<size_t>(1, matches.size());
+  const double w = has_velocity_ ? options_.prior_weight * (1.0 - std::min(1.0, inlier_ratio)) : 0.0;
+  const Eigen::Isometry3d T_ref_curr_initial =
+      Blend(ransac.T_prev_curr, Power(velocity_, gap), w);
+
+  // Tracks from the inlier matches (track ids and ages written into the features).
+  const TrackUpdateResult update =
+      tracks_.AddFrame(result.frame_index, &frame.features, inlier_matches);
+  if (!update.ok()) {
+    result.times.motion_ms = MsSince(motion_start);
+    return Lost(std::move(result), "tracks: " + update.message, start);
+  }
+  const Eigen::Isometry3d T_world_ref = T_world_cam0_by_frame_.at(reference_.frame_index);
+  Eigen::Isometry3d T_world_curr = T_world_ref * T_ref_curr_initial;
+  T_world_cam0_by_frame_[result.frame_index] = T_world_curr;
+  // Keep the poses of the window's frames only.
+  for (auto it = T_world_cam0_by_frame_.begin(); it != T_world_cam0_by_frame_.end();) {
+    const auto& window = tracks_.window_frame_ids();
+    if (std::find(window.begin(), window.end(), it->first) == window.end()) {
+      it = T_world_cam0_by_frame_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  result.times.motion_ms = MsSince(motion_start);
+  result.rms_reprojection_px = ransac.rms_reprojection_px;
+
+  // Windowed bundle adjustment, the oldest pose(s) fixed.
+  if (options_.use_bundle_adjustment && T_world_cam0_by_frame_.size() >= 2) {
+    const Clock::time_point ba_start = Clock::now();
+    std::vector<int64_t> frame_ids;
+    const BundleAdjustmentProblem problem =
+        MakeWindowProblem(tracks_, T_world_cam0_by_frame_, &frame_ids);
+    if (static_cast<int>(problem.T_world_cam0.size()) > options_.ba.num_fixed_poses) {
+      const BundleAdjustmentSummary ba = RunBundleAdjustment(camera_, problem, options_.ba);
+      bool usable = ba.ok() && ba.T_world_cam0.size() == frame_ids.size();
+      for (size_t i = 0; usable && i < ba.T_world_cam0.size(); ++i) {
+        usable = IsFinite(ba.T_world_cam0[i]);
+      }
+      if (usable) {
+        for (size_t i = 0; i < frame_ids.size(); ++i) {
+          T_world_cam0_by_frame_[frame_ids[i]] = ba.T_world_cam0[i];
+        }
+        T_world_curr = T_world_cam0_by_frame_.at(result.frame_index);
+        result.ba_ran = true;
+        result.ba_num_frames = static_cast<int>(frame_ids.size());
+        result.ba_num_points = ba.num_points_optimized;
+        result.rms_reprojection_px = ba.rms_inlier_reprojection_after_px;
+      }
+    }
+    result.times.ba_ms = MsSince(ba_start);
+  }
+
+  // Constant-velocity model: the (refined) motion from the reference, per frame.
+  const Eigen::Isometry3d T_ref_curr =
+      T_world_cam0_by_frame_.count(reference_.frame_index)
+          ? Eigen::Isometry3d(T_world_cam0_by_frame_.at(reference_.frame_index).inverse() *
+                              T_world_curr)
+          : T_ref_curr_initial;
+  const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
+  if (IsFinite(per_frame)) {
+    velocity_ = per_frame;
+    has_velocity_ = true;
+  }
+
+  result.status = consecutive_lost_ > 0 ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
+  if (consecutive_lost_ > 0) {
+    std::ostringstream msg;
+    msg << "recovered against frame " << reference_.frame_index << " after " << consecutive_lost_
+        << " lost frame(s)";
+    result.message = msg.str();
+  }
+  consecutive_lost_ = 0;
+  last_features_ = frame.features;
+  reference_.frame_index = result.frame_index;
+  reference_.frame = std::move(frame);
+  reference_.valid = true;
+  return Finish(std::move(result), T_world_curr, start);
+}
+
+OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right, double time_s) {
+  const Clock::time_point start = Clock::now();
+  OdometryResult result;
+  result.frame_index = frame_index_++;
+  result.time_s = time_s;
+  last_features_.clear();
+  last_matches_.clear();
+  last_inlier_mask_.clear();
+  last_reference_features_.clear();
+  prev_call_index_map_.clear();
+
+  // Input checks: expected failures come back as kLost.
+  const cv::Size camera_size(camera_.width, camera_.height);
+  if (left.empty() || right.empty()) return Lost(std::move(result), "empty image", start);
+  if (left.type() != CV_8UC1 || right.type() != CV_8UC1) {
+    return Lost(std::move(result), "images must be 8-bit grayscale (CV_8UC1)", start);
+  }
+  if (left.size() != right.size()) {
+    return Lost(std::move(result), "left and right images differ in size", start);
+  }
+  if (left.size() != camera_size) {
+    std::ostringstream msg;
+    msg << "image size " << left.cols << "x" << left.rows << " differs from the camera's "
+        << camera_.width << "x" << camera_.height;
+    return Lost(std::move(result), msg.str(), start);
+  }
+
+  // Dense disparity.
+  Clock::time_point t = Clock::now();
+  const DisparityResult disparity = disparity_->Compute(left, right);
+  result.times.disparity_ms = MsSince(t);
+  if (!disparity.ok) return Lost(std::move(result), "disparity: " + disparity.message, start);
+
+  // Features in the left image.
+  t = Clock::now();
+  FeatureSet set = detector_->DetectWithDescriptors(left);
+  result.times.detect_ms = MsSince(t);
+  result.num_features = static_cast<int>(set.features.size());
+
+  // Depth from the disparity map; features without depth are dropped (with their descriptors).
+  t = Clock::now();
+  AttachDepth(disparity.disparity_px, camera_, &set.features, options_.depth);
+  MatchFrame frame;
+  frame.frame_id = result.frame_index;
+  std::vector<int> kept;
+  for (size_t i = 0; i < set.features.size(); ++i) {
+    if (set.features[i].has_depth() && set.features[i].p_cam0.allFinite()) {
+      kept.push_back(static_cast<int>(i));
+    }
+  }
+  frame.features.reserve(kept.size());
+  for (int i : kept) frame.features.push_back(set.features[i]);
+  if (!set.descriptors.empty()) {
+    frame.descriptors.create(static_cast<int>(kept.size()), set.descriptors.cols,
+                             set.descriptors.type());
+    for (size_t k = 0; k < kept.size(); ++k) {
+      set.descriptors.row(kept[k]).copyTo(frame.descriptors.row(static_cast<int>(k)));
+    }
+  }
+  result.times.depth_ms = MsSince(t);
+  result.num_features_with_depth = static_cast<int>(frame.features.size());
+  last_features_ = frame.features;
+  if (result.num_features_with_depth < options_.min_features) {
+    std::ostringstream msg;
+    msg << "too few features with depth (" << result.num_features_with_depth << " of "
+        << result.num_features << " features; need " << options_.min_features
+        << "): black, textureless or unmatched frame";
+    return Lost(std::move(result), msg.str(), start);
+  }
+  frame.image = left.clone();  // the caller may reuse its buffer
+
+  if (!reference_.valid) {
+    std::string reason;
+    if (!initialised_ && options_.estimate_initial_orientation) {
+      // Initial orientation from the floor/wall planes of the dense disparity map.
+      t = Clock::now();
+      std::vector<Eigen::Vector3d> points;
+      const int step = options_.orientation_sample_step_px;
+      const cv::Mat& d = disparity.disparity_px;
+      for (int v = 0; v < d.rows; v += step) {
+        const float* row = d.ptr<float>(v);
+        for (int u = 0; u < d.cols; u += step) {
+          if (!(row[u] > 0.0f)) continue;
+          const Eigen::Vector3d p = camera_.Backproject(u, v, row[u]);
+          if (p.z() >= options_.depth.min_depth_m && p.z() <= options_.depth.max_depth_m) {
+            points.push_back(p);
+          }
+        }
+      }
+      result.initial_orientation_ok = EstimateInitialOrientation(points);
+      if (!result.initial_orientation_ok) {
+        reason = std::string("initial orientation failed (") +
+                 ToString(orientation_result_.status) + "): world = first camera frame";
+      }
+      result.times.orientation_ms = MsSince(t);
+    }
+    return Initialise(std::move(result), std::move(frame), reason, start);
+  }
+
+  // Match against the reference frame (its cues are cached in reference_.frame).
+  t = Clock::now();
+  MatcherSummary summary;
+  const std::vector<Match> matches = matcher_->MatchFrames(reference_.frame, frame, &summary);
+  result.times.match_ms = MsSince(t);
+  if (!summary.ok) {
+    last_reference_features_ = reference_.frame.features;
+    result.reference_frame_index = static_cast<int>(reference_.frame_index);
+    return Lost(std::move(result), "matcher: " + summary.message, start);
+  }
+  return Track(std::move(result), std::move(frame), matches, start);
+}
+
+OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
+                                               const std::vector<Match>& matches_to_prev,
+                                               double time_s) {
+  const Clock::time_point start = Clock::now();
+  OdometryResult result;
+  result.frame_index = frame_index_++;
+  result.time_s = time_s;
+  result.num_features = static_cast<int>(features.size());
+  last_features_.clear();
+  last_matches_.clear();
+  last_inlier_mask_.clear();
+  last_reference_features_.clear();
+
+  // Keep the features with depth; p_cam0 from the camera, track fields reset.
+  const Clock::time_point t = Clock::now();
+  std::vector<int> index_map(features.size(), -1);  // given index → kept index
+  MatchFrame frame;
+  frame.frame_id = result.frame_index;
+  for (size_t i = 0; i < features.size(); ++i) {
+    Feature f = features[i];
+    if (!f.uv_px.allFinite() || !std::isfinite(f.disparity_px) || !f.has_depth()) continue;
+    f.p_cam0 = camera_.Backproject(f.uv_px.x(), f.uv_px.y(), f.disparity_px);
+    if (!f.p_cam0.allFinite()) continue;
+    f.track_id = -1;
+    f.track_age = 0;
+    index_map[i] = static_cast<int>(frame.features.size());
+    frame.features.push_back(f);
+  }
+  result.times.depth_ms = MsSince(t);
+  result.num_features_with_depth = static_cast<int>(frame.features.size());
+  last_features_ = frame.features;
+
+  // The matches refer to the previous call's features; usable only when that call became the
+  // reference. Re-index, skipping dropped or out-of-range features and repeated indices.
+  const bool prev_is_reference = reference_.valid &&
+                                 reference_.frame_index == result.frame_index - 1 &&
+                                 !prev_call_index_map_.empty();
+  std::vector<Match> matches;
+  if (prev_is_reference) {
+    std::vector<bool> prev_used(reference_.frame.features.size(), false);
+    std::vector<bool> curr_used(frame.features.size(), false);
+    for (const Match& m : matches_to_prev) {
+      if (m.prev < 0 || m.prev >= static_cast<int>(prev_call_index_map_.size()) || m.curr < 0 ||
+          m.curr >= static_cast<int>(index_map.size())) {
+        continue;
+      }
+      const int p = prev_call_index_map_[m.prev];
+      const int c = index_map[m.curr];
+      if (p < 0 || c < 0 || prev_used[p] || curr_used[c]) continue;
+      prev_used[p] = curr_used[c] = true;
+      matches.push_back(Match{p, c, m.score});
+    }
+    std::sort(matches.begin(), matches.end(),
+              [](const Match& a, const Match& b) { return a.prev < b.prev; });
+  }
+  prev_call_index_map_.clear();
+
+  if (result.num_features_with_depth < options_.min_features) {
+    std::ostringstream msg;
+    msg << "too few features with depth (" << result.num_features_with_depth << " of "
+        << result.num_features << "; need " << options_.min_features << ")";
+    return Lost(std::move(result), msg.str(), start);
+  }
+  prev_call_index_map_ = index_map;
+  if (!prev_is_reference) {
+    std::string reason;
+    if (!initialised_ && options_.estimate_initial_orientation) {
+      const Clock::time_point to = Clock::now();
+      std::vector<Eigen::Vector3d> points;
+      for (const Feature& f : frame.features) points.push_back(f.p_cam0);
+      result.initial_orientation_ok = EstimateInitialOrientation(points);
+      if (!result.initial_orientation_ok) {
+        reason = std::string("initial orientation failed (") +
+                 ToString(orientation_result_.status) + "): world = first camera frame";
+      }
+      result.times.orientation_ms = MsSince(to);
+    } else if (initialised_) {
+      reason = "the previous frame was lost, its matches cannot be used: re-initialised at the "
+               "predicted pose";
+    }
+    return Initialise(std::move(result), std::move(frame), reason, start);
+  }
+  return Track(std::move(result), std::move(frame), matches, start);
+}
+
+}  // namespace vo

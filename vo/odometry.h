@@ -1,0 +1,274 @@
+// The stereo visual-odometry pipeline: one call per stereo pair, the camera's pose back.
+// Kwolek, PAPER.md (the whole table), sections IV–V of the paper:
+//
+//   frame 0      disparity → features (left image) → depth → [plane-based initial orientation]
+//   frame k > 0  disparity (area-based, texture filter, left-right check)       disparity.h
+//                → features (Harris | SIFT, bucketed)                           features.h
+//                → AttachDepth, features without depth dropped                 disparity.h
+//                → match to the reference frame (SVD · NCC · Gabor by default)  matcher.h
+//                → RANSAC + Horn (T_ref_curr), seeded by track ages             ransac.h
+//                → tracks (inlier matches only)                                 tracks.h
+//                → initial pose = blend of the RANSAC estimate and the constant-velocity
+//                  prediction (slerp on the rotation, linear on the translation)
+//                → windowed bundle adjustment, oldest pose fixed                bundle_adjustment.h
+//                → T_world_cam0
+//
+// The reference frame is the last frame that was tracked (or initialised): normally the
+// previous frame; after lost frames, the last good one.
+//
+// World frame. With estimate_initial_orientation (default) and a floor (or ceiling) found in
+// the first frame: the hallway frame of plane_orientation.h (x along the corridor, y left,
+// z up), with its origin at the first camera centre, i.e. T_world_cam0(frame 0) =
+// [R_hall_cam0 | 0]. Otherwise the world is the first camera frame (T_world_cam0 = identity).
+//
+// Initial pose of the newest frame (paper, section V: "a linear combination of the pose
+// estimated by the Horn method and the pose from the previous SBA"): with the RANSAC/Horn
+// motion T_R and the constant-velocity prediction T_V (the last bundle-adjusted frame-to-
+// frame motion, repeated once per frame since the reference), the initial T_ref_curr has
+//   rotation    = slerp(q_R, q_V, w),   translation = (1 − w) t_R + w t_V,
+//   w           = prior_weight · (1 − inlier_ratio),   inlier_ratio = inliers / matches
+// So a motion supported by every match is taken as it is, and the prediction gains weight as
+// the consensus weakens (w <= prior_weight). Without bundle adjustment this blend is the
+// output; with it, the blend is where the solver starts.
+//
+// Lost tracking and recovery. A frame is "lost" (TrackingStatus::kLost, with a message) when
+// its input is invalid (empty, not CV_8UC1, sizes differ from each other or from the camera),
+// its disparity fails, it has fewer than min_features features with depth (black or
+// textureless frame), or the motion fails (RANSAC without consensus, fewer than min_inliers
+// inliers). Its pose is the constant-velocity prediction from the previous output, never NaN;
+// the reference frame, the tracks and the window are kept. The next frame is matched against
+// that reference (the last good frame), the motion being allowed to span the gap; success
+// gives kRecovered. When the motion fails again while already lost (the reference is stale),
+// the pipeline re-initialises on the current frame at its predicted pose (kRecovered, message
+// "re-initialised"): tracks and window restart, the constant velocity is kept. The frame after
+// a kRecovered frame is kTracking again.
+//
+// Determinism: every random choice is seeded (RANSAC, plane extraction), the bundle
+// adjustment is single-threaded; the same inputs give bit-identical outputs. Global OpenCV
+// state (cv::setNumThreads) is left alone.
+//
+// Not thread-safe: one StereoOdometry per sequence and thread.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "vo/bundle_adjustment.h"
+#include "vo/camera.h"
+#include "vo/disparity.h"
+#include "vo/features.h"
+#include "vo/matcher.h"
+#include "vo/plane_orientation.h"
+#include "vo/ransac.h"
+#include "vo/tracks.h"
+#include "vo/types.h"
+
+namespace vo {
+
+// Bundle-adjustment defaults for the pipeline: points seen in a single frame of the window
+// carry no pose information, so they are left out (min_frames_per_point = 2); 10 LM
+// iterations suffice from the blended initial pose.
+BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions();
+// Detector defaults for the pipeline: Harris, at most 300 features, bucketed on an 8 × 6 grid
+// (at most 10 per cell) so they spread over the image.
+DetectorOptions DefaultOdometryDetectorOptions();
+
+struct OdometryOptions {
+  DetectorOptions detector = DefaultOdometryDetectorOptions();  // feature detection (left)
+  DisparityOptions disparity;      // dense disparity; num_disparities is replaced by the value
+                                   // derived from the camera when derive_num_disparities
+  bool derive_num_disparities = true;  // search range from the camera: the smallest multiple
+                                       // of 16 >= fx · baseline / disparity_min_depth_m, clamped
+                                       // to [16, max_num_disparities] (and < image width)
+  double disparity_min_depth_m = 0.4;  // nearest depth the derived search range covers (metres),
+                                       // > 0. Hallway rig (fx 230 px, 0.09 m): 52 px → 64;
+                                       // KITTI (718 px, 0.54 m): clamped to 256 (≈ 1.5 m)
+  int max_num_disparities = 256;       // upper clamp of the derived range (pixels), multiple
+                                       // of 16, >= 16
+  DepthSamplingOptions depth;          // how features read the disparity map
+  MatcherOptions matcher;              // inter-frame matcher (default: SVD · NCC · Gabor)
+  RansacOptions ransac;                // robust frame-to-frame motion
+  BundleAdjustmentOptions ba = DefaultOdometryBundleAdjustmentOptions();  // windowed BA
+
+  bool use_bundle_adjustment = true;  // refine with the windowed BA; false = the blended
+                                      // RANSAC/Horn estimate is the output
+  int ba_window_frames = 5;           // frames in the BA window (and kept by the track
+                                      // manager), 3..10 (paper: 3–5, 10 wished for)
+  double prior_weight = 0.5;  // weight of the constant-velocity prediction in the initial pose
+                              // is prior_weight · (1 − inlier_ratio), in [0, 1]; 0 = the
+                              // RANSAC/Horn estimate alone (see the header comment)
+  bool estimate_initial_orientation = true;  // hallway frame from the first frame's planes
+                                             // (floor/walls); false = world is the first camera
+  PlaneOrientationOptions orientation;  // plane extraction for the initial orientation
+  int orientation_sample_step_px = 4;   // the first frame's dense disparity map is sampled every
+                                        // this many pixels (both axes) for the plane extraction
+                                        // (pixels), >= 1. ProcessFeatures uses the features' 3D
+  bool orientation_requires_wall = false;  // true: kNoWall (up known, yaw not) also counts as a
+                                           // failure (world = first camera); false: the yaw is
+                                           // then the camera's heading (zero)
+  int min_features = 15;  // fewer features with depth than this → lost (black, textureless or
+                          // overexposed frame), >= 3
+  int min_inliers = 12;   // fewer RANSAC inliers than this → lost, >= 3 (RANSAC's own
+                          // min_inliers is raised to this when lower)
+  int reinit_after_lost_frames = 1;  // while this many consecutive frames (or more) have been
+                                     // lost, a frame whose motion fails against the reference
+                                     // re-initialises the pipeline on itself, >= 1
+
+  bool IsValid(std::string* error) const;
+};
+
+enum class TrackingStatus {
+  kInitializing,  // first frame (or a frame before the first usable one): pose = initial
+  kTracking,      // motion estimated against the previous frame
+  kLost,          // no motion estimate; pose = constant-velocity prediction; see `message`
+  kRecovered,     // first frame estimated (or re-initialised) after one or more lost frames
+};
+
+// "initializing", "tracking", "lost", "recovered".
+const char* ToString(TrackingStatus status);
+
+// Wall-clock time of each stage of one frame (milliseconds, std::chrono::steady_clock);
+// 0 for stages that did not run.
+struct StageTimes {
+  double disparity_ms = 0.0;  // dense disparity
+  double detect_ms = 0.0;     // feature detection
+  double depth_ms = 0.0;      // AttachDepth + dropping features without depth
+  double match_ms = 0.0;      // inter-frame matching (cue computation included)
+  double motion_ms = 0.0;     // correspondences + RANSAC + tracks + initial-pose blend
+  double ba_ms = 0.0;         // window problem + bundle adjustment
+  double orientation_ms = 0.0;  // first frame only: plane-based initial orientation
+  double total_ms = 0.0;      // the whole Process / ProcessFeatures call
+};
+
+struct OdometryResult {
+  TrackingStatus status = TrackingStatus::kLost;
+  std::string message;  // empty when tracking normally; says why when lost or re-initialised
+  int64_t frame_index = -1;  // 0-based count of Process/ProcessFeatures calls since Reset
+  double time_s = 0.0;       // the time stamp given (seconds)
+  Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();  // p_world = T * p_cam0;
+                                                                   // always finite
+  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();   // motion since the previous
+      // call's output pose: p_prev = T_prev_curr * p_curr, i.e. T_world_cam0(prev)⁻¹ ·
+      // T_world_cam0(curr); identity for the first frame
+  int num_features = 0;             // features detected (or given) in the left image
+  int num_features_with_depth = 0;  // of those, with a valid disparity (kept)
+  int num_matches = 0;              // matches to the reference frame
+  int num_inliers = 0;              // RANSAC inliers among them
+  double rms_reprojection_px = 0.0;  // BA inlier rms when BA ran, else RANSAC's rms (pixels)
+  bool ba_ran = false;               // the bundle adjustment ran and its result was used
+  int ba_num_frames = 0;             // poses in the BA window (when ba_ran)
+  int ba_num_points = 0;             // points optimised (when ba_ran)
+  int reference_frame_index = -1;    // frame_index of the frame matched against; -1 = none
+  StageTimes times;
+  bool initial_orientation_ok = false;  // first frame only: the hallway orientation was found
+                                        // and defines the world frame
+};
+
+class StereoOdometry {
+ public:
+  // Aborts with a message when the camera or the options are invalid (a programmer error);
+  // use Create() to get the error instead.
+  StereoOdometry(const StereoCamera& camera, const OdometryOptions& options);
+  ~StereoOdometry();
+  StereoOdometry(const StereoOdometry&) = delete;
+  StereoOdometry& operator=(const StereoOdometry&) = delete;
+
+  // nullptr (and *error filled, when given) for an invalid camera or options.
+  static std::unique_ptr<StereoOdometry> Create(const StereoCamera& camera,
+                                                const OdometryOptions& options,
+                                                std::string* error = nullptr);
+
+  // One rectified stereo pair: left/right CV_8UC1 of the camera's size. time_s: the frame's
+  // time stamp (seconds), recorded only. Never throws; bad input gives kLost.
+  OdometryResult Process(const cv::Mat& left, const cv::Mat& right, double time_s);
+
+  // The seam (libviso2's process(matches)): runs the back end (RANSAC, tracks, blend, BA) on
+  // externally supplied left-image features and matches, skipping disparity, detection and
+  // matching. features: uv_px and disparity_px (> 0 for depth; p_cam0 is recomputed from
+  // them with the camera); features without depth are dropped (matches re-indexed).
+  // matches_to_prev: indices into the features of the PREVIOUS ProcessFeatures call (prev) and
+  // into `features` (curr), one-to-one; ignored for the first frame. When the previous call
+  // was lost, the matches cannot be used and the frame re-initialises (kRecovered).
+  OdometryResult ProcessFeatures(std::vector<Feature> features,
+                                 const std::vector<Match>& matches_to_prev, double time_s);
+
+  // The last call's features (with depth, track ids set when tracked), its matches to the
+  // reference frame (prev = index into last_reference_features()), and per match whether it
+  // is a RANSAC inlier. For matcher evaluation by the harness.
+  const std::vector<Feature>& last_features() const { return last_features_; }
+  const std::vector<Match>& last_matches() const { return last_matches_; }
+  const std::vector<bool>& last_inlier_mask() const { return last_inlier_mask_; }
+  const std::vector<Feature>& last_reference_features() const { return last_reference_features_; }
+
+  // R_hall_cam0 of the first frame from the plane orientation (identity when not estimated or
+  // failed; see OdometryResult::initial_orientation_ok).
+  const Eigen::Matrix3d& R_hall_cam0_initial() const { return R_hall_cam0_initial_; }
+  // The whole plane-orientation result of the first frame (status kInvalidInput until then).
+  const PlaneOrientationResult& initial_orientation() const { return orientation_result_; }
+
+  const StereoCamera& camera() const { return camera_; }
+  // The effective options (num_disparities as derived, RANSAC min_inliers raised).
+  const OdometryOptions& options() const { return options_; }
+
+  // Forgets the sequence: the next frame initialises again.
+  void Reset();
+
+ private:
+  // The frame motion is estimated against.
+  struct Reference {
+    bool valid = false;
+    int64_t frame_index = -1;
+    MatchFrame frame;  // left image (Process only), features (with track ids), cue cache
+  };
+
+  using TimePoint = std::chrono::steady_clock::time_point;
+
+  // A lost frame: pose = constant-velocity prediction, reference and tracks kept.
+  OdometryResult Lost(OdometryResult result, const std::string& message, TimePoint start);
+  // (Re-)initialises on `frame`: first time at the initial orientation, later at the predicted
+  // pose (kRecovered). `reason` goes into the message.
+  OdometryResult Initialise(OdometryResult result, MatchFrame frame, const std::string& reason,
+                            TimePoint start);
+  // Everything after matching: RANSAC, tracks, blend, BA. `result` carries the counts so far.
+  OdometryResult Track(OdometryResult result, MatchFrame frame, const std::vector<Match>& matches,
+                       TimePoint start);
+  // Sets the output pose (finite), T_prev_curr and the total time.
+  OdometryResult Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
+                        TimePoint start);
+  // Plane-based orientation of the first frame; true when it defines the world frame.
+  bool EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0);
+
+  StereoCamera camera_;
+  OdometryOptions options_;
+  std::unique_ptr<DisparityEstimator> disparity_;
+  std::unique_ptr<FeatureDetector> detector_;
+  std::unique_ptr<FrameMatcher> matcher_;
+  TrackManager tracks_;
+
+  int64_t frame_index_ = 0;          // index of the next call
+  bool initialised_ = false;         // a reference was set at least once since Reset
+  int consecutive_lost_ = 0;         // lost frames since the last good one
+  Reference reference_;
+  std::map<int64_t, Eigen::Isometry3d> T_world_cam0_by_frame_;  // window poses (frame index)
+  Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();  // previous call's output
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // constant-velocity model: last
+                                                                // estimated per-frame T_prev_curr
+  bool has_velocity_ = false;
+
+  Eigen::Matrix3d R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
+  PlaneOrientationResult orientation_result_;
+  std::vector<Feature> last_features_;
+  std::vector<Match> last_matches_;
+  std::vector<bool> last_inlier_mask_;
+  std::vector<Feature> last_reference_features_;
+  std::vector<int> prev_call_index_map_;  // ProcessFeatures: given index → kept index of the
+                                          // previous call's features (empty when unusable)
+};
+
+}  // namespace vo
