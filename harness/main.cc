@@ -13,6 +13,8 @@
 #include "harness/plots.h"
 #include "harness/progress.h"
 #include "harness/render.h"
+#include "harness/run.h"
+#include "harness/vo_config.h"
 #include "harness/trajectory_io.h"
 
 namespace {
@@ -147,6 +149,61 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
   return 0;
 }
 
+void PrintRunTable(const harness::RunSummary& s, const std::string& out) {
+  const harness::TrajectoryMetrics& m = s.metrics;
+  std::printf("run             %s -> %s\n", s.name.c_str(), out.c_str());
+  std::printf("frames          %d (lost %d)\n", m.frames, s.lost_frames);
+  if (s.has_ground_truth) {
+    std::printf("path length     %.3f m\n", m.path_length_m);
+    std::printf("end-pose error  %.4f m (%.2f %% of the path), rotation %.3f deg\n", m.end_pose_error_m,
+                m.end_pose_error_pct, m.end_rotation_error_deg);
+    std::printf("ATE RMSE        %.4f m (SE(3)-aligned), %.4f m (from the start)\n", m.ate_rmse_m, m.ate_rmse_unaligned_m);
+    std::printf("drift           %.3f %%, %.4f deg/m\n", m.drift_pct, m.drift_deg_per_m);
+    if (s.initial_orientation_error_deg >= 0)
+      std::printf("initial orient. %.2f deg from ground truth (plane-based)\n", s.initial_orientation_error_deg);
+  }
+  std::printf("VO time/frame   median %.2f ms, p95 %.2f ms |", s.vo_ms_median, s.vo_ms_p95);
+  for (const auto& [k, v] : s.stage_ms_median) std::printf(" %s %.2f", k.c_str(), v);
+  std::printf("\n");
+}
+
+int RunRun(const std::string& scenario_arg, const std::string& config, const std::string& dataset,
+           std::string out, int max_frames, bool no_plots, bool quiet) {
+  std::string error;
+  vo::OdometryOptions vo_options;
+  if (!config.empty() && !harness::LoadVoConfig(config, &vo_options, &error)) {
+    std::fprintf(stderr, "vobench run: %s\n", error.c_str());
+    return 2;
+  }
+  harness::RunOptions options;
+  options.progress = !quiet;
+  options.plots = !no_plots;
+  options.max_frames = max_frames;
+  harness::RunSummary summary;
+  bool ok;
+  if (!dataset.empty()) {
+    if (out.empty()) out = "out/run/" + std::filesystem::path(dataset).filename().string();
+    options.out_dir = out;
+    ok = harness::RunKittiDataset(dataset, vo_options, options, &summary, &error);
+  } else {
+    sim::Scenario scenario;
+    if (!harness::ResolveScenario(scenario_arg, &scenario, &error)) {
+      std::fprintf(stderr, "vobench run: %s\n", error.c_str());
+      return 2;
+    }
+    if (out.empty()) out = "out/run/" + scenario.name;
+    options.out_dir = out;
+    ok = harness::RunScenario(scenario, vo_options, options, &summary, &error);
+  }
+  if (!ok) {
+    std::fprintf(stderr, "vobench run: %s\n", error.c_str());
+    return 1;
+  }
+  PrintRunTable(summary, out);
+  std::printf("report          %s/report.md\n", out.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -174,10 +231,23 @@ int main(int argc, char** argv) {
   match_eval->add_option("--max-frames", me_max_frames, "Use only the first N frames (0 = all)");
   match_eval->add_flag("-q,--quiet", quiet, "No progress display");
 
+  std::string run_scenario = "l_hallway", run_config, run_dataset, run_out;
+  int run_max_frames = 0;
+  bool run_no_plots = false;
+  CLI::App* run = app.add_subcommand("run", "Run the VO on a simulated scenario (or a KITTI-layout dataset) and compare with ground truth");
+  run->add_option("scenario", run_scenario, "Scenario YAML file or built-in name")->capture_default_str();
+  run->add_option("--config", run_config, "VO options (YAML; see a run folder's vo_options.yaml)");
+  run->add_option("--dataset", run_dataset, "Read a dataset folder in the KITTI layout instead of simulating");
+  run->add_option("--out,-o", run_out, "Run folder (default out/run/<name>); an earlier run there is replaced");
+  run->add_option("--max-frames", run_max_frames, "Stop after N frames (0 = all)");
+  run->add_flag("--no-plots", run_no_plots, "Skip the PNG plots");
+  run->add_flag("-q,--quiet", quiet, "No progress display");
+
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   spdlog::set_pattern("[%l] %v");
   if (*render) return RunRender(scenario, out, format, overwrite, quiet);
+  if (*run) return RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_no_plots, quiet);
   if (*match_eval) return RunMatchEval(me_scenario, me_strides, me_matchers, me_out, me_max_frames, quiet);
   return 0;
 }

@@ -78,7 +78,45 @@ OdometryOptions EffectiveOptions(const StereoCamera& camera, const OdometryOptio
     effective.disparity.num_disparities = DerivedNumDisparities(camera, options);
   }
   effective.ransac.min_inliers = std::max(options.ransac.min_inliers, options.min_inliers);
+  if (options.use_bundle_adjustment && !options.ransac_refine_with_ba) {
+    effective.ransac.refine_nonlinear = false;
+  }
   return effective;
+}
+
+// Keeps at most max_points points of the window problem (0 = all): those seen in the most
+// frames (at least min_frames), ties by index (= ascending track id, the older tracks first).
+// Points left out are dropped with their observations; the others are re-indexed.
+BundleAdjustmentProblem SelectBaPoints(BundleAdjustmentProblem problem, int max_points,
+                                       int min_frames) {
+  const int num_points = static_cast<int>(problem.points_world.size());
+  std::vector<int> frames_seen(num_points, 0);
+  for (const BaObservation& o : problem.observations) ++frames_seen[o.point_index];
+  std::vector<int> order;
+  for (int j = 0; j < num_points; ++j) {
+    if (frames_seen[j] >= min_frames) order.push_back(j);
+  }
+  if (max_points <= 0 || static_cast<int>(order.size()) <= max_points) {
+    if (static_cast<int>(order.size()) == num_points) return problem;
+  } else {
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return frames_seen[a] > frames_seen[b]; });
+    order.resize(max_points);
+    std::sort(order.begin(), order.end());
+  }
+  std::vector<int> new_index(num_points, -1);
+  BundleAdjustmentProblem selected;
+  selected.T_world_cam0 = std::move(problem.T_world_cam0);
+  for (int j : order) {
+    new_index[j] = static_cast<int>(selected.points_world.size());
+    selected.points_world.push_back(problem.points_world[j]);
+  }
+  for (BaObservation o : problem.observations) {
+    if (new_index[o.point_index] < 0) continue;
+    o.point_index = new_index[o.point_index];
+    selected.observations.push_back(o);
+  }
+  return selected;
 }
 
 }  // namespace
@@ -87,6 +125,7 @@ BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions() {
   BundleAdjustmentOptions options;
   options.min_frames_per_point = 2;
   options.max_num_iterations = 10;
+  options.linear_solver = BaLinearSolver::kDenseSchur;
   return options;
 }
 
@@ -127,6 +166,11 @@ bool OdometryOptions::IsValid(std::string* error) const {
         << ba_window_frames << ")";
   } else if (!(prior_weight >= 0.0 && prior_weight <= 1.0)) {
     msg << "prior_weight must be in [0, 1], got " << prior_weight;
+  } else if (!(ba_max_correction_m > 0.0) || !(ba_max_correction_deg > 0.0)) {
+    msg << "ba_max_correction_m and ba_max_correction_deg must be > 0, got " << ba_max_correction_m
+        << " and " << ba_max_correction_deg;
+  } else if (ba_max_points < 0) {
+    msg << "ba_max_points must be >= 0 (0 = no limit), got " << ba_max_points;
   } else if (orientation_sample_step_px < 1) {
     msg << "orientation_sample_step_px must be >= 1, got " << orientation_sample_step_px;
   } else if (min_features < 3) {
@@ -239,10 +283,9 @@ OdometryResult StereoOdometry::Lost(OdometryResult result, const std::string& me
 
 bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0) {
   orientation_result_ = EstimateHallwayOrientation(points_cam0, options_.orientation);
-  const bool ok =
-      orientation_result_.ok() ||
-      (orientation_result_.status == PlaneOrientationResult::Status::kNoWall &&
-       !options_.orientation_requires_wall);
+  const bool ok = orientation_result_.ok() ||
+                  (orientation_result_.status == PlaneOrientationResult::Status::kNoWall &&
+                   !options_.orientation_requires_wall);
   R_hall_cam0_initial_ = ok ? orientation_result_.R_hall_cam0 : Eigen::Matrix3d::Identity();
   return ok;
 }
@@ -266,7 +309,8 @@ OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame fram
   matcher_->Reset();
   const TrackUpdateResult update = tracks_.AddFrame(result.frame_index, &frame.features, {});
   if (!update.ok()) {  // cannot happen after Reset(); keep going without tracks
-    result.message += (result.message.empty() ? "" : "; ") + std::string("tracks: ") + update.message;
+    result.message +=
+        (result.message.empty() ? "" : "; ") + std::string("tracks: ") + update.message;
   }
   T_world_cam0_by_frame_.clear();
   T_world_cam0_by_frame_[result.frame_index] = T_world_cam0;
@@ -305,13 +349,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
   last_features_ = frame.features;
   result.num_inliers = ransac.ok() ? ransac.num_inliers : 0;
 
-  if (!ransac.ok() || ransac.num_inliers < options_.min_inliers ||
-      !IsFinite(ransac.T_prev_curr)) {
+  if (!ransac.ok() || ransac.num_inliers < options_.min_inliers || !IsFinite(ransac.T_prev_curr)) {
     std::ostringstream why;
     why << "motion failed: " << (ransac.ok() ? "too few inliers" : ToString(ransac.status)) << " ("
-        << ransac.num_inliers << " inliers of " << correspondences.size()
-        << " correspondences, " << matches.size() << " matches; need " << options_.min_inliers
-        << ")";
+        << ransac.num_inliers << " inliers of " << correspondences.size() << " correspondences, "
+        << matches.size() << " matches; need " << options_.min_inliers << ")";
     if (!ransac.message.empty()) why << ": " << ransac.message;
     result.times.motion_ms = MsSince(motion_start);
     if (consecutive_lost_ >= options_.reinit_after_lost_frames) {
@@ -326,9 +368,9 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
   const int64_t gap = result.frame_index - reference_.frame_index;
   const double inlier_ratio =
       static_cast<double>(ransac.num_inliers) / std::max<size_t>(1, matches.size());
-  const double w = has_velocity_ ? options_.prior_weight * (1.0 - std::min(1.0, inlier_ratio)) : 0.0;
-  const Eigen::Isometry3d T_ref_curr_initial =
-      Blend(ransac.T_prev_curr, Power(velocity_, gap), w);
+  const double w =
+      has_velocity_ ? options_.prior_weight * (1.0 - std::min(1.0, inlier_ratio)) : 0.0;
+  const Eigen::Isometry3d T_ref_curr_initial = Blend(ransac.T_prev_curr, Power(velocity_, gap), w);
 
   // Tracks from the inlier matches (track ids and ages written into the features).
   const TrackUpdateResult update =
@@ -357,12 +399,31 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
     const Clock::time_point ba_start = Clock::now();
     std::vector<int64_t> frame_ids;
     const BundleAdjustmentProblem problem =
-        MakeWindowProblem(tracks_, T_world_cam0_by_frame_, &frame_ids);
+        SelectBaPoints(MakeWindowProblem(tracks_, T_world_cam0_by_frame_, &frame_ids),
+                       options_.ba_max_points, options_.ba.min_frames_per_point);
     if (static_cast<int>(problem.T_world_cam0.size()) > options_.ba.num_fixed_poses) {
       const BundleAdjustmentSummary ba = RunBundleAdjustment(camera_, problem, options_.ba);
       bool usable = ba.ok() && ba.T_world_cam0.size() == frame_ids.size();
       for (size_t i = 0; usable && i < ba.T_world_cam0.size(); ++i) {
         usable = IsFinite(ba.T_world_cam0[i]);
+      }
+      // Divergence guard: the newest pose may move only so far from its initial value.
+      const size_t newest = static_cast<size_t>(
+          std::find(frame_ids.begin(), frame_ids.end(), result.frame_index) - frame_ids.begin());
+      usable = usable && newest < frame_ids.size();
+      if (usable) {
+        const Eigen::Isometry3d& T_new = ba.T_world_cam0[newest];
+        const double moved_m = (T_new.translation() - T_world_curr.translation()).norm();
+        const double turned_deg =
+            Eigen::AngleAxisd(T_new.linear().transpose() * T_world_curr.linear()).angle() * 180.0 /
+            M_PI;
+        if (moved_m > options_.ba_max_correction_m || turned_deg > options_.ba_max_correction_deg) {
+          std::ostringstream msg;
+          msg << "bundle adjustment rejected: it moved the pose by " << moved_m << " m and "
+              << turned_deg << " deg";
+          result.message = msg.str();
+          usable = false;
+        }
       }
       if (usable) {
         for (size_t i = 0; i < frame_ids.size(); ++i) {
@@ -594,8 +655,9 @@ OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
       }
       result.times.orientation_ms = MsSince(to);
     } else if (initialised_) {
-      reason = "the previous frame was lost, its matches cannot be used: re-initialised at the "
-               "predicted pose";
+      reason =
+          "the previous frame was lost, its matches cannot be used: re-initialised at the "
+          "predicted pose";
     }
     return Initialise(std::move(result), std::move(frame), reason, start);
   }

@@ -73,7 +73,8 @@ namespace vo {
 
 // Bundle-adjustment defaults for the pipeline: points seen in a single frame of the window
 // carry no pose information, so they are left out (min_frames_per_point = 2); 10 LM
-// iterations suffice from the blended initial pose.
+// iterations suffice from the blended initial pose; a window of 3–10 poses makes the reduced
+// camera system tiny, so DENSE_SCHUR beats the sparse factorisation.
 BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions();
 // Detector defaults for the pipeline: Harris, at most 300 features, bucketed on an 8 × 6 grid
 // (at most 10 per cell) so they spread over the image.
@@ -81,13 +82,13 @@ DetectorOptions DefaultOdometryDetectorOptions();
 
 struct OdometryOptions {
   DetectorOptions detector = DefaultOdometryDetectorOptions();  // feature detection (left)
-  DisparityOptions disparity;      // dense disparity; num_disparities is replaced by the value
-                                   // derived from the camera when derive_num_disparities
+  DisparityOptions disparity;          // dense disparity; num_disparities is replaced by the value
+                                       // derived from the camera when derive_num_disparities
   bool derive_num_disparities = true;  // search range from the camera: the smallest multiple
                                        // of 16 >= fx · baseline / disparity_min_depth_m, clamped
                                        // to [16, max_num_disparities] (and < image width)
-  double disparity_min_depth_m = 0.4;  // nearest depth the derived search range covers (metres),
-                                       // > 0. Hallway rig (fx 230 px, 0.09 m): 52 px → 64;
+  double disparity_min_depth_m = 0.5;  // nearest depth the derived search range covers (metres),
+                                       // > 0. Hallway rig (fx 230 px, 0.09 m): 41.4 px → 48;
                                        // KITTI (718 px, 0.54 m): clamped to 256 (≈ 1.5 m)
   int max_num_disparities = 256;       // upper clamp of the derived range (pixels), multiple
                                        // of 16, >= 16
@@ -98,17 +99,30 @@ struct OdometryOptions {
 
   bool use_bundle_adjustment = true;  // refine with the windowed BA; false = the blended
                                       // RANSAC/Horn estimate is the output
-  int ba_window_frames = 5;           // frames in the BA window (and kept by the track
-                                      // manager), 3..10 (paper: 3–5, 10 wished for)
+  int ba_max_points = 100;  // at most this many points in the BA (those seen in the most frames
+                            // of the window, then the oldest tracks), >= 0; 0 = every point
+                            // seen in at least ba.min_frames_per_point frames. 100 costs
+                            // ~3 ms at 5 frames and loses no accuracy on the synthetic corridor
+  double ba_max_correction_m = 0.25;   // a BA result that moves the newest pose farther than
+                                       // this from its initial value (metres) is rejected
+                                       // (divergence guard; the blend is kept), > 0
+  double ba_max_correction_deg = 5.0;  // the same for the rotation (degrees), > 0
+  bool ransac_refine_with_ba = false;  // keep RANSAC's nonlinear refinement
+                                       // (ransac.refine_nonlinear) when the BA runs after it;
+                                       // false = skip it then (the BA refines anyway; saves
+                                       // ~3 ms at 300 features). Without BA it always runs
+                                       // as ransac.refine_nonlinear says
+  int ba_window_frames = 5;            // frames in the BA window (and kept by the track
+                                       // manager), 3..10 (paper: 3–5, 10 wished for)
   double prior_weight = 0.5;  // weight of the constant-velocity prediction in the initial pose
                               // is prior_weight · (1 − inlier_ratio), in [0, 1]; 0 = the
                               // RANSAC/Horn estimate alone (see the header comment)
   bool estimate_initial_orientation = true;  // hallway frame from the first frame's planes
                                              // (floor/walls); false = world is the first camera
-  PlaneOrientationOptions orientation;  // plane extraction for the initial orientation
-  int orientation_sample_step_px = 4;   // the first frame's dense disparity map is sampled every
-                                        // this many pixels (both axes) for the plane extraction
-                                        // (pixels), >= 1. ProcessFeatures uses the features' 3D
+  PlaneOrientationOptions orientation;       // plane extraction for the initial orientation
+  int orientation_sample_step_px = 4;      // the first frame's dense disparity map is sampled every
+                                           // this many pixels (both axes) for the plane extraction
+                                           // (pixels), >= 1. ProcessFeatures uses the features' 3D
   bool orientation_requires_wall = false;  // true: kNoWall (up known, yaw not) also counts as a
                                            // failure (world = first camera); false: the yaw is
                                            // then the camera's heading (zero)
@@ -136,30 +150,32 @@ const char* ToString(TrackingStatus status);
 // Wall-clock time of each stage of one frame (milliseconds, std::chrono::steady_clock);
 // 0 for stages that did not run.
 struct StageTimes {
-  double disparity_ms = 0.0;  // dense disparity
-  double detect_ms = 0.0;     // feature detection
-  double depth_ms = 0.0;      // AttachDepth + dropping features without depth
-  double match_ms = 0.0;      // inter-frame matching (cue computation included)
-  double motion_ms = 0.0;     // correspondences + RANSAC + tracks + initial-pose blend
-  double ba_ms = 0.0;         // window problem + bundle adjustment
+  double disparity_ms = 0.0;    // dense disparity
+  double detect_ms = 0.0;       // feature detection
+  double depth_ms = 0.0;        // AttachDepth + dropping features without depth
+  double match_ms = 0.0;        // inter-frame matching (cue computation included)
+  double motion_ms = 0.0;       // correspondences + RANSAC + tracks + initial-pose blend
+  double ba_ms = 0.0;           // window problem + bundle adjustment
   double orientation_ms = 0.0;  // first frame only: plane-based initial orientation
-  double total_ms = 0.0;      // the whole Process / ProcessFeatures call
+  double total_ms = 0.0;        // the whole Process / ProcessFeatures call
 };
 
 struct OdometryResult {
   TrackingStatus status = TrackingStatus::kLost;
-  std::string message;  // empty when tracking normally; says why when lost or re-initialised
+  std::string message;       // empty when tracking normally; says why when lost or re-initialised
   int64_t frame_index = -1;  // 0-based count of Process/ProcessFeatures calls since Reset
   double time_s = 0.0;       // the time stamp given (seconds)
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();  // p_world = T * p_cam0;
                                                                    // always finite
-  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();   // motion since the previous
-      // call's output pose: p_prev = T_prev_curr * p_curr, i.e. T_world_cam0(prev)⁻¹ ·
-      // T_world_cam0(curr); identity for the first frame
-  int num_features = 0;             // features detected (or given) in the left image
-  int num_features_with_depth = 0;  // of those, with a valid disparity (kept)
-  int num_matches = 0;              // matches to the reference frame
-  int num_inliers = 0;              // RANSAC inliers among them
+  Eigen::Isometry3d T_prev_curr =
+      Eigen::Isometry3d::Identity();  // motion since the previous
+                                      // call's output pose: p_prev = T_prev_curr * p_curr, i.e.
+                                      // T_world_cam0(prev)⁻¹ · T_world_cam0(curr); identity for the
+                                      // first frame
+  int num_features = 0;              // features detected (or given) in the left image
+  int num_features_with_depth = 0;   // of those, with a valid disparity (kept)
+  int num_matches = 0;               // matches to the reference frame
+  int num_inliers = 0;               // RANSAC inliers among them
   double rms_reprojection_px = 0.0;  // BA inlier rms when BA ran, else RANSAC's rms (pixels)
   bool ba_ran = false;               // the bundle adjustment ran and its result was used
   int ba_num_frames = 0;             // poses in the BA window (when ba_ran)
@@ -251,13 +267,13 @@ class StereoOdometry {
   std::unique_ptr<FrameMatcher> matcher_;
   TrackManager tracks_;
 
-  int64_t frame_index_ = 0;          // index of the next call
-  bool initialised_ = false;         // a reference was set at least once since Reset
-  int consecutive_lost_ = 0;         // lost frames since the last good one
+  int64_t frame_index_ = 0;   // index of the next call
+  bool initialised_ = false;  // a reference was set at least once since Reset
+  int consecutive_lost_ = 0;  // lost frames since the last good one
   Reference reference_;
-  std::map<int64_t, Eigen::Isometry3d> T_world_cam0_by_frame_;  // window poses (frame index)
+  std::map<int64_t, Eigen::Isometry3d> T_world_cam0_by_frame_;      // window poses (frame index)
   Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();  // previous call's output
-  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // constant-velocity model: last
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();      // constant-velocity model: last
                                                                 // estimated per-frame T_prev_curr
   bool has_velocity_ = false;
 

@@ -57,10 +57,10 @@ Eigen::Isometry3d SeamPose(int i) {
     const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix();
     t += R * Eigen::Vector3d(0.0, 0.003 * std::cos(1.3 * k), speed);
   }
-  return MakePose(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix() *
-                      Eigen::AngleAxisd(0.01 * std::sin(0.5 * i), Eigen::Vector3d::UnitX())
-                          .toRotationMatrix(),
-                  t);
+  return MakePose(
+      Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix() *
+          Eigen::AngleAxisd(0.01 * std::sin(0.5 * i), Eigen::Vector3d::UnitX()).toRotationMatrix(),
+      t);
 }
 
 // Points 1–10 m around the path (a ring, so the turning camera always sees some).
@@ -164,8 +164,11 @@ TEST_P(OdometrySeamTest, ExactMatchesReproduceTheTrajectory) {
       EXPECT_EQ(r.ba_ran, GetParam().use_ba);
       EXPECT_EQ(r.num_matches, static_cast<int>(matches.size()));
       EXPECT_EQ(vo->last_inlier_mask().size(), matches.size());
-      if (GetParam().outlier_every == 0) EXPECT_EQ(r.num_inliers, r.num_matches);
-      if (GetParam().outlier_every > 0) EXPECT_LT(r.num_inliers, r.num_matches);
+      if (GetParam().outlier_every == 0) {
+        EXPECT_EQ(r.num_inliers, r.num_matches);
+      } else {
+        EXPECT_LT(r.num_inliers, r.num_matches);
+      }
     }
     prev = std::move(curr);
   }
@@ -173,10 +176,10 @@ TEST_P(OdometrySeamTest, ExactMatchesReproduceTheTrajectory) {
 
 INSTANTIATE_TEST_SUITE_P(
     Variants, OdometrySeamTest,
-    ::testing::Values(SeamCase{false, 0, 0.5},  // RANSAC/Horn alone
-                      SeamCase{true, 0, 0.5},   // + windowed BA
-                      SeamCase{true, 0, 1.0},   // full inlier ratio: the prior gets no weight
-                      SeamCase{true, 5, 0.5},   // 20 % wrong matches: BA starts off the truth
+    ::testing::Values(SeamCase{false, 0, 0.5},   // RANSAC/Horn alone
+                      SeamCase{true, 0, 0.5},    // + windowed BA
+                      SeamCase{true, 0, 1.0},    // full inlier ratio: the prior gets no weight
+                      SeamCase{true, 5, 0.5},    // 20 % wrong matches: BA starts off the truth
                       SeamCase{false, 5, 0.0}),  // ... without BA the prior must be off
     [](const ::testing::TestParamInfo<SeamCase>& info) {
       return std::string(info.param.use_ba ? "Ba" : "NoBa") + "Outliers" +
@@ -231,8 +234,8 @@ TEST(OdometrySeamTest, TooFewMatchesIsLostThenReinitialises) {
   const OdometryResult r3 =
       vo.ProcessFeatures(frames[3].features, SeamMatches(frames[2], frames[3], 0), 0.3);
   EXPECT_EQ(r3.status, TrackingStatus::kRecovered) << r3.message;
-  EXPECT_THAT(r3.T_world_cam0, IsNearPose(Eigen::Isometry3d(r2.T_world_cam0 * velocity), 1e-6,
-                                          1e-6));
+  EXPECT_THAT(r3.T_world_cam0,
+              IsNearPose(Eigen::Isometry3d(r2.T_world_cam0 * velocity), 1e-6, 1e-6));
   // Frame 4: tracking again, with the exact relative motion.
   const OdometryResult r4 =
       vo.ProcessFeatures(frames[4].features, SeamMatches(frames[3], frames[4], 0), 0.4);
@@ -255,8 +258,15 @@ class CorridorRenderer {
 
   CorridorRenderer() {
     // Face k: axis (0 = x, 1 = y, 2 = z), position, the two in-plane axes.
-    faces_ = {{2, 0.0, 0, 1}, {2, kHeight, 0, 1}, {1, kHalfWidth, 0, 2},
-              {1, -kHalfWidth, 0, 2}, {0, kXMax, 1, 2}, {0, kXMin, 1, 2}};
+    const double spec[6][4] = {{2, 0.0, 0, 1},         {2, kHeight, 0, 1}, {1, kHalfWidth, 0, 2},
+                               {1, -kHalfWidth, 0, 2}, {0, kXMax, 1, 2},   {0, kXMin, 1, 2}};
+    faces_.resize(6);
+    for (int k = 0; k < 6; ++k) {
+      faces_[k].axis = static_cast<int>(spec[k][0]);
+      faces_[k].position = spec[k][1];
+      faces_[k].a = static_cast<int>(spec[k][2]);
+      faces_[k].b = static_cast<int>(spec[k][3]);
+    }
     const double lo[3] = {kXMin, -kHalfWidth, 0.0}, hi[3] = {kXMax, kHalfWidth, kHeight};
     cv::RNG rng(7);
     for (Face& f : faces_) {
@@ -283,11 +293,26 @@ class CorridorRenderer {
     *right = RenderView(cam, T_hall_cam0 * T_cam0_cam1);
   }
 
+  // Depth (z in cam0, metres) of the surface seen at pixel (u, v).
+  double DepthAt(const StereoCamera& cam, const Eigen::Isometry3d& T_hall_cam, double u,
+                 double v) const {
+    const Eigen::Vector3d d_cam((u - cam.cx_px) / cam.fx_px, (v - cam.cy_px) / cam.fy_px, 1.0);
+    const Eigen::Vector3d d = T_hall_cam.linear() * d_cam;
+    const Eigen::Vector3d o = T_hall_cam.translation();
+    double best_t = 1e9;
+    for (const Face& f : faces_) {
+      if (std::abs(d[f.axis]) < 1e-12) continue;
+      const double t = (f.position - o[f.axis]) / d[f.axis];
+      if (t > 1e-6 && t < best_t) best_t = t;
+    }
+    return best_t;  // d_cam has z = 1
+  }
+
  private:
   struct Face {
-    int axis;
-    double position;
-    int a, b;
+    int axis = 0;
+    double position = 0.0;
+    int a = 0, b = 0;
     double origin_a = 0.0, origin_b = 0.0;
     cv::Mat texture;  // CV_32F, row = b, column = a
   };
@@ -390,9 +415,8 @@ std::vector<OdometryResult> RunCorridor(const OdometryOptions& options,
   std::vector<OdometryResult> results;
   const std::vector<StereoFrame>& frames = CorridorSequence();
   for (size_t i = 0; i < frames.size(); ++i) {
-    const bool black =
-        std::find(black_frames.begin(), black_frames.end(), static_cast<int>(i)) !=
-        black_frames.end();
+    const bool black = std::find(black_frames.begin(), black_frames.end(), static_cast<int>(i)) !=
+                       black_frames.end();
     const cv::Mat zeros = cv::Mat::zeros(frames[i].left.size(), CV_8UC1);
     results.push_back(black ? vo.Process(zeros, zeros, 0.1 * i)
                             : vo.Process(frames[i].left, frames[i].right, 0.1 * i));
@@ -400,32 +424,15 @@ std::vector<OdometryResult> RunCorridor(const OdometryOptions& options,
   return results;
 }
 
-TEST(OdometryDiag, Print) {
-  for (int variant = 0; variant < 4; ++variant) {
-    OdometryOptions o;
-    if (variant == 1) o.detector.harris.subpixel = true;
-    if (variant == 2) o.use_bundle_adjustment = false;
-    if (variant == 3) { o.detector.harris.subpixel = true; o.use_bundle_adjustment = false; }
-    const std::vector<OdometryResult> rs = RunCorridor(o);
-    std::printf("variant %d\n", variant);
-    for (size_t i = 1; i < rs.size(); ++i) {
-      const Eigen::Isometry3d step = CorridorPose(i - 1).inverse() * CorridorPose(i);
-      const Eigen::Isometry3d cum = TrueMotionFromFirst(i), est = EstimatedMotionFromFirst(rs, i);
-      std::printf("%zu feat %d/%d m %d in %d rms %.2f step %.2f mm %.3f deg cum %.2f mm %.3f deg t %.1f ms (d %.1f f %.1f z %.1f m %.1f r %.1f b %.1f)\n", i,
-        rs[i].num_features, rs[i].num_features_with_depth, rs[i].num_matches, rs[i].num_inliers, rs[i].rms_reprojection_px,
-        1e3 * (rs[i].T_prev_curr.translation() - step.translation()).norm(), RotationAngleRad(rs[i].T_prev_curr.linear(), step.linear()) / kDeg,
-        1e3 * (est.translation() - cum.translation()).norm(), RotationAngleRad(est.linear(), cum.linear()) / kDeg,
-        rs[i].times.total_ms, rs[i].times.disparity_ms, rs[i].times.detect_ms, rs[i].times.depth_ms, rs[i].times.match_ms, rs[i].times.motion_ms, rs[i].times.ba_ms);
-    }
-  }
-}
-
 // ---- (2) Rendered sequence ------------------------------------------------------------------
 
-constexpr double kRenderedTolM = 0.01;           // end of 44 cm travel: < 1 cm
-constexpr double kRenderedTolRad = 0.3 * kDeg;   // after an 11° turn: < 0.3°
-constexpr double kStepTolM = 0.004;              // per frame (4 cm steps): < 4 mm
-constexpr double kStepTolRad = 0.15 * kDeg;      // per frame (1° steps): < 0.15°
+constexpr double kRenderedTolM = 0.01;          // end of 44 cm travel: < 1 cm
+constexpr double kRenderedTolRad = 0.3 * kDeg;  // after an 11° turn: < 0.3°
+// Per frame (4 cm, 1° steps). T_prev_curr is taken against the previous frame's OUTPUT pose,
+// which the later windows still refine, so a step carries up to two frames' errors. Measured:
+// 2–6 mm, < 0.07° (integer Harris positions, StereoBM disparity rms 0.1 px).
+constexpr double kStepTolM = 0.008;
+constexpr double kStepTolRad = 0.15 * kDeg;
 constexpr double kOrientationTolRad = 1.0 * kDeg;  // plane-based initial orientation
 
 TEST(OdometryRenderedTest, ReproducesTheCorridorMotion) {
@@ -451,8 +458,7 @@ TEST(OdometryRenderedTest, ReproducesTheCorridorMotion) {
 
 TEST(OdometryRenderedTest, InitialOrientationIsTheHallwayFrame) {
   StereoOdometry vo(HallwayCamera(), OdometryOptions());
-  const OdometryResult r =
-      vo.Process(CorridorSequence()[0].left, CorridorSequence()[0].right, 0.0);
+  const OdometryResult r = vo.Process(CorridorSequence()[0].left, CorridorSequence()[0].right, 0.0);
   ASSERT_TRUE(r.initial_orientation_ok) << r.message;
   EXPECT_LT(RotationAngleRad(vo.R_hall_cam0_initial(), CorridorPose(0).linear()),
             kOrientationTolRad);
@@ -465,8 +471,7 @@ TEST(OdometryRenderedTest, WithoutOrientationTheWorldIsTheFirstCamera) {
   OdometryOptions options;
   options.estimate_initial_orientation = false;
   StereoOdometry vo(HallwayCamera(), options);
-  const OdometryResult r =
-      vo.Process(CorridorSequence()[0].left, CorridorSequence()[0].right, 0.0);
+  const OdometryResult r = vo.Process(CorridorSequence()[0].left, CorridorSequence()[0].right, 0.0);
   EXPECT_FALSE(r.initial_orientation_ok);
   EXPECT_TRUE(r.T_world_cam0.isApprox(Eigen::Isometry3d::Identity()));
 }
@@ -491,8 +496,8 @@ TEST(OdometryRenderedTest, StageTimesAreFilled) {
   EXPECT_GT(t.match_ms, 0.0);
   EXPECT_GT(t.motion_ms, 0.0);
   EXPECT_GT(t.ba_ms, 0.0);
-  EXPECT_GE(t.total_ms, t.disparity_ms + t.detect_ms + t.depth_ms + t.match_ms + t.motion_ms +
-                            t.ba_ms);
+  EXPECT_GE(t.total_ms,
+            t.disparity_ms + t.detect_ms + t.depth_ms + t.match_ms + t.motion_ms + t.ba_ms);
   EXPECT_GT(results[0].times.orientation_ms, 0.0);
 }
 
@@ -528,10 +533,11 @@ TEST(OdometryLostTest, BlackFirstFramesWaitForTheFirstUsableFrame) {
   for (const OdometryResult& r : results) EXPECT_TRUE(AllFinite(r.T_world_cam0));
 }
 
-TEST(OdometryLostTest, SeveralBlackFramesRecoverOrReinitialise) {
+TEST(OdometryLostTest, SeveralBlackFramesAreBridged) {
   const std::vector<OdometryResult> results = RunCorridor(OdometryOptions(), {4, 5, 6});
   for (int i : {4, 5, 6}) EXPECT_EQ(results[i].status, TrackingStatus::kLost);
   EXPECT_EQ(results[7].status, TrackingStatus::kRecovered) << results[7].message;
+  EXPECT_EQ(results[7].reference_frame_index, 3);  // bridged a 4-frame gap (16 cm, 4°)
   EXPECT_EQ(results[8].status, TrackingStatus::kTracking) << results[8].message;
   for (const OdometryResult& r : results) EXPECT_TRUE(AllFinite(r.T_world_cam0));
   // Constant-velocity bridging over 4 frames keeps the end pose within a few centimetres.
@@ -557,12 +563,9 @@ TEST(OdometryLostTest, InvalidInputIsLostWithAMessage) {
     cv::Mat left, right;
     const char* expected;
   } cases[] = {
-      {cv::Mat(), f.right, "empty"},
-      {f.left, cv::Mat(), "empty"},
-      {colour, f.right, "CV_8UC1"},
-      {left16, f.right, "CV_8UC1"},
-      {f.left, small, "differ in size"},
-      {wide_left, wide_right, "camera"},
+      {cv::Mat(), f.right, "empty"},     {f.left, cv::Mat(), "empty"},
+      {colour, f.right, "CV_8UC1"},      {left16, f.right, "CV_8UC1"},
+      {f.left, small, "differ in size"}, {wide_left, wide_right, "camera"},
   };
   for (const auto& c : cases) {
     const OdometryResult r = vo.Process(c.left, c.right, 0.1);
@@ -632,6 +635,8 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
   rejects([](OdometryOptions* o) { o->disparity_min_depth_m = 0.0; }, "disparity_min_depth_m");
   rejects([](OdometryOptions* o) { o->max_num_disparities = 40; }, "max_num_disparities");
   rejects([](OdometryOptions* o) { o->reinit_after_lost_frames = 0; }, "reinit_after_lost");
+  rejects([](OdometryOptions* o) { o->ba_max_points = -1; }, "ba_max_points");
+  rejects([](OdometryOptions* o) { o->ba_max_correction_m = 0.0; }, "ba_max_correction");
   rejects([](OdometryOptions* o) { o->orientation_sample_step_px = 0; }, "orientation_sample");
   rejects([](OdometryOptions* o) { o->matcher.type = MatcherType::kSiftRatio; }, "kSift");
   rejects([](OdometryOptions* o) { o->detector.max_features = -1; }, "detector");
@@ -655,10 +660,10 @@ TEST(OdometryOptionsTest, InvalidCameraIsRejectedByCreate) {
 }
 
 TEST(OdometryOptionsTest, DisparityRangeIsDerivedFromTheCamera) {
-  // Hallway rig: 230 · 0.09 / 0.4 = 51.75 px → 64.
+  // Hallway rig: 230 · 0.09 / 0.5 = 41.4 px → 48.
   StereoOdometry hallway(HallwayCamera(), OdometryOptions());
-  EXPECT_EQ(hallway.options().disparity.num_disparities, 64);
-  // KITTI: 718 · 0.54 / 0.4 = 969 px → clamped to 256.
+  EXPECT_EQ(hallway.options().disparity.num_disparities, 48);
+  // KITTI: 718 · 0.54 / 0.5 = 776 px → clamped to 256.
   StereoCamera kitti;
   kitti.width = 1241;
   kitti.height = 376;

@@ -1,0 +1,110 @@
+#include "harness/metrics.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace harness {
+
+double RotationAngle(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
+  const Eigen::Matrix3d R = R_a.transpose() * R_b;
+  const double c = (R.trace() - 1.0) / 2.0;
+  const double s = 0.5 * Eigen::Vector3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1)).norm();
+  return std::atan2(s, c);
+}
+
+std::vector<Eigen::Isometry3d> RelativeToFirst(const std::vector<Eigen::Isometry3d>& poses) {
+  std::vector<Eigen::Isometry3d> out;
+  if (poses.empty()) return out;
+  const Eigen::Isometry3d inv0 = poses.front().inverse();
+  for (const auto& T : poses) out.push_back(inv0 * T);
+  return out;
+}
+
+std::vector<double> CumulativeDistance(const std::vector<Eigen::Isometry3d>& poses) {
+  std::vector<double> d(poses.size(), 0.0);
+  for (size_t i = 1; i < poses.size(); ++i)
+    d[i] = d[i - 1] + (poses[i].translation() - poses[i - 1].translation()).norm();
+  return d;
+}
+
+double Median(std::vector<double> v) { return Percentile(std::move(v), 50.0); }
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t rank = static_cast<size_t>(std::ceil(p / 100.0 * v.size()));
+  return v[std::clamp<size_t>(rank, 1, v.size()) - 1];
+}
+
+TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>& estimate,
+                                           const std::vector<Eigen::Isometry3d>& ground_truth) {
+  TrajectoryMetrics m;
+  const size_t n = std::min(estimate.size(), ground_truth.size());
+  m.frames = static_cast<int>(n);
+  if (n < 2) return m;
+  const std::vector<Eigen::Isometry3d> est = RelativeToFirst({estimate.begin(), estimate.begin() + n});
+  const std::vector<Eigen::Isometry3d> gt = RelativeToFirst({ground_truth.begin(), ground_truth.begin() + n});
+  const std::vector<double> dist = CumulativeDistance(gt);
+  m.path_length_m = dist.back();
+
+  // End pose.
+  m.end_pose_error_m = (est.back().translation() - gt.back().translation()).norm();
+  m.end_pose_error_pct = m.path_length_m > 0 ? 100.0 * m.end_pose_error_m / m.path_length_m : 0.0;
+  m.end_rotation_error_deg = RotationAngle(est.back().linear(), gt.back().linear()) * 180.0 / M_PI;
+
+  // ATE: unaligned (common start) and after SE(3) Umeyama alignment of the positions.
+  Eigen::Matrix3Xd P_est(3, n), P_gt(3, n);
+  for (size_t i = 0; i < n; ++i) {
+    P_est.col(i) = est[i].translation();
+    P_gt.col(i) = gt[i].translation();
+  }
+  m.ate_rmse_unaligned_m = std::sqrt((P_est - P_gt).colwise().squaredNorm().mean());
+  const Eigen::Matrix4d S = Eigen::umeyama(P_est, P_gt, false);
+  const Eigen::Matrix3Xd aligned = (S.topLeftCorner<3, 3>() * P_est).colwise() + S.topRightCorner<3, 1>();
+  m.ate_rmse_m = std::sqrt((aligned - P_gt).colwise().squaredNorm().mean());
+
+  // RPE over one frame step.
+  double st = 0.0, sr = 0.0;
+  for (size_t i = 1; i < n; ++i) {
+    const Eigen::Isometry3d d_est = est[i - 1].inverse() * est[i];
+    const Eigen::Isometry3d d_gt = gt[i - 1].inverse() * gt[i];
+    const Eigen::Isometry3d e = d_gt.inverse() * d_est;
+    st += e.translation().squaredNorm();
+    const double r = RotationAngle(Eigen::Matrix3d::Identity(), e.linear());
+    sr += r * r;
+  }
+  m.rpe_trans_rmse_m = std::sqrt(st / (n - 1));
+  m.rpe_rot_rmse_deg = std::sqrt(sr / (n - 1)) * 180.0 / M_PI;
+
+  // KITTI-style drift: for sub-path lengths L = k/8 of the path (k = 1..8), from every
+  // 10th start frame, the relative pose error at the first frame at least L further along,
+  // divided by the length of that sub-path.
+  double t_sum = 0.0, r_sum = 0.0;
+  int count = 0;
+  for (int k = 1; k <= 8; ++k) {
+    const double L = m.path_length_m * k / 8.0;
+    if (L <= 0.0) continue;
+    for (size_t first = 0; first < n; first += 10) {
+      size_t last = first;
+      while (last < n && dist[last] - dist[first] < L) ++last;
+      if (last >= n) break;
+      const Eigen::Isometry3d d_est = est[first].inverse() * est[last];
+      const Eigen::Isometry3d d_gt = gt[first].inverse() * gt[last];
+      const Eigen::Isometry3d e = d_gt.inverse() * d_est;
+      // Divided by the sub-path's actual length (>= L: frames are discrete).
+      const double len = dist[last] - dist[first];
+      t_sum += e.translation().norm() / len;
+      r_sum += RotationAngle(Eigen::Matrix3d::Identity(), e.linear()) * 180.0 / M_PI / len;
+      ++count;
+    }
+  }
+  if (count > 0) {
+    m.drift_pct = 100.0 * t_sum / count;
+    m.drift_deg_per_m = r_sum / count;
+  }
+  return m;
+}
+
+}  // namespace harness

@@ -1,0 +1,281 @@
+#include "harness/run.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "harness/plots.h"
+#include "harness/progress.h"
+#include "harness/render.h"
+#include "harness/trajectory_io.h"
+#include "harness/vo_config.h"
+#include "sim/simulator.h"
+
+namespace harness {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<StampedPose> Stamped(const std::vector<double>& t, const std::vector<Eigen::Isometry3d>& T) {
+  std::vector<StampedPose> out;
+  for (size_t i = 0; i < T.size(); ++i) out.push_back({t[i], T[i]});
+  return out;
+}
+
+// Replaces `dir` with the finished `partial` folder; refuses to delete a folder that does not
+// look like a run folder.
+bool Publish(const fs::path& partial, const fs::path& dir, std::string* error) {
+  std::error_code ec;
+  if (fs::exists(dir)) {
+    if (!fs::exists(dir / "metrics.json")) {
+      *error = dir.string() + ": exists and is not a vobench run folder (no metrics.json); not replacing it";
+      return false;
+    }
+    fs::remove_all(dir, ec);
+  }
+  fs::rename(partial, dir, ec);
+  if (ec) {
+    *error = dir.string() + ": cannot move the finished run into place: " + ec.message();
+    return false;
+  }
+  return true;
+}
+
+// Removes the partial folder unless released.
+struct PartialGuard {
+  fs::path path;
+  bool keep = false;
+  ~PartialGuard() {
+    std::error_code ec;
+    if (!keep && !path.empty()) fs::remove_all(path, ec);
+  }
+};
+
+std::string Fmt(double v, int prec = 4) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(prec);
+  s << v;
+  return s.str();
+}
+
+std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml) {
+  const TrajectoryMetrics& m = s.metrics;
+  std::ostringstream r;
+  r << "# vobench run: " << s.name << "\n\n";
+  r << "| metric | value |\n| --- | --- |\n";
+  r << "| frames | " << m.frames << " |\n";
+  if (s.has_ground_truth) {
+    r << "| path length (ground truth) | " << Fmt(m.path_length_m, 3) << " m |\n";
+    r << "| end-pose error | " << Fmt(m.end_pose_error_m) << " m (" << Fmt(m.end_pose_error_pct, 2) << " % of the path) |\n";
+    r << "| end rotation error | " << Fmt(m.end_rotation_error_deg, 3) << " deg |\n";
+    r << "| ATE RMSE (SE(3)-aligned) | " << Fmt(m.ate_rmse_m) << " m |\n";
+    r << "| ATE RMSE (from the common start) | " << Fmt(m.ate_rmse_unaligned_m) << " m |\n";
+    r << "| RPE per frame (translation / rotation) | " << Fmt(m.rpe_trans_rmse_m * 1000, 2) << " mm / " << Fmt(m.rpe_rot_rmse_deg, 4) << " deg |\n";
+    r << "| drift (KITTI-style, 1/8..8/8 of the path) | " << Fmt(m.drift_pct, 3) << " % / " << Fmt(m.drift_deg_per_m, 4) << " deg/m |\n";
+    if (s.initial_orientation_error_deg >= 0)
+      r << "| initial orientation from planes (error vs GT) | " << (s.initial_orientation_ok ? "found" : "not found") << ", " << Fmt(s.initial_orientation_error_deg, 2) << " deg |\n";
+  }
+  r << "| lost frames | " << s.lost_frames << " |\n";
+  r << "| VO time per frame, median / p95 | " << Fmt(s.vo_ms_median, 2) << " / " << Fmt(s.vo_ms_p95, 2) << " ms |\n";
+  for (const auto& [k, v] : s.stage_ms_median) r << "| stage median: " << k << " | " << Fmt(v, 2) << " ms |\n";
+  r << "\n![trajectory](trajectory.png)\n\n![errors](errors.png)\n\n![timing](timing.png)\n\n";
+  r << "Effective VO options (`vobench run --config` accepts this file as `vo_options.yaml`):\n\n```yaml\n" << options_yaml << "```\n";
+  return r.str();
+}
+
+}  // namespace
+
+std::string MetricsJson(const RunSummary& s) {
+  nlohmann::ordered_json j;
+  const TrajectoryMetrics& m = s.metrics;
+  j["name"] = s.name;
+  j["frames"] = m.frames;
+  j["has_ground_truth"] = s.has_ground_truth;
+  j["path_length_m"] = m.path_length_m;
+  j["end_pose_error_m"] = m.end_pose_error_m;
+  j["end_pose_error_pct"] = m.end_pose_error_pct;
+  j["end_rotation_error_deg"] = m.end_rotation_error_deg;
+  j["ate_rmse_m"] = m.ate_rmse_m;
+  j["ate_rmse_unaligned_m"] = m.ate_rmse_unaligned_m;
+  j["rpe_trans_rmse_m"] = m.rpe_trans_rmse_m;
+  j["rpe_rot_rmse_deg"] = m.rpe_rot_rmse_deg;
+  j["drift_pct"] = m.drift_pct;
+  j["drift_deg_per_m"] = m.drift_deg_per_m;
+  j["lost_frames"] = s.lost_frames;
+  j["vo_ms_median"] = s.vo_ms_median;
+  j["vo_ms_p95"] = s.vo_ms_p95;
+  for (const auto& [k, v] : s.stage_ms_median) j["stage_ms_median"][k] = v;
+  j["features_median"] = s.features_median;
+  j["inliers_median"] = s.inliers_median;
+  j["initial_orientation_ok"] = s.initial_orientation_ok;
+  j["initial_orientation_error_deg"] = s.initial_orientation_error_deg;
+  return j.dump(2) + "\n";
+}
+
+bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameSource source,
+                 int expected_frames, const vo::OdometryOptions& vo_options, const RunOptions& options,
+                 const std::string& scenario_yaml, RunSummary* summary, std::string* error) {
+  auto odometry = vo::StereoOdometry::Create(camera, vo_options, error);
+  if (!odometry) {
+    *error = "invalid VO options or camera: " + *error;
+    return false;
+  }
+  const fs::path dir = options.out_dir;
+  if (fs::exists(dir) && !fs::exists(dir / "metrics.json")) {
+    *error = dir.string() + ": exists and is not a vobench run folder (no metrics.json); choose another --out";
+    return false;
+  }
+  PartialGuard guard;
+  guard.path = dir.string() + ".partial";
+  std::error_code ec;
+  fs::remove_all(guard.path, ec);
+  fs::create_directories(guard.path, ec);
+  if (ec) {
+    *error = guard.path.string() + ": cannot create: " + ec.message();
+    return false;
+  }
+
+  std::vector<double> times;
+  std::vector<Eigen::Isometry3d> est, gt;
+  std::vector<vo::OdometryResult> results;
+  bool has_gt = true;
+  Progress progress("vo " + name, expected_frames, options.progress);
+  DatasetFrame frame;
+  while ((options.max_frames <= 0 || static_cast<int>(results.size()) < options.max_frames) && source(&frame, error)) {
+    results.push_back(odometry->Process(frame.left, frame.right, frame.time_s));
+    times.push_back(frame.time_s);
+    est.push_back(results.back().T_world_cam0);
+    has_gt = has_gt && frame.has_gt;
+    gt.push_back(frame.T_world_cam0);
+    progress.Update(static_cast<int>(results.size()));
+  }
+  if (!error->empty()) return false;
+  progress.Finish(static_cast<int>(results.size()));
+  if (results.size() < 2) {
+    *error = name + ": fewer than 2 frames";
+    return false;
+  }
+
+  // Summary.
+  RunSummary& s = *summary;
+  s = RunSummary();
+  s.name = name;
+  s.has_ground_truth = has_gt;
+  if (has_gt) s.metrics = ComputeTrajectoryMetrics(est, gt);
+  s.metrics.frames = static_cast<int>(results.size());
+  std::vector<double> total, feats, inl;
+  std::map<std::string, std::vector<double>> stages;
+  for (const auto& r : results) {
+    if (r.status == vo::TrackingStatus::kLost) ++s.lost_frames;
+    total.push_back(r.times.total_ms);
+    feats.push_back(r.num_features_with_depth);
+    inl.push_back(r.num_inliers);
+    stages["disparity"].push_back(r.times.disparity_ms);
+    stages["detect"].push_back(r.times.detect_ms);
+    stages["depth"].push_back(r.times.depth_ms);
+    stages["match"].push_back(r.times.match_ms);
+    stages["motion"].push_back(r.times.motion_ms);
+    stages["ba"].push_back(r.times.ba_ms);
+  }
+  // Timing excludes the first frame (initialisation with the plane fit).
+  s.vo_ms_median = Median({total.begin() + 1, total.end()});
+  s.vo_ms_p95 = Percentile({total.begin() + 1, total.end()}, 95.0);
+  for (auto& [k, v] : stages) s.stage_ms_median[k] = Median({v.begin() + 1, v.end()});
+  s.features_median = Median(feats);
+  s.inliers_median = Median({inl.begin() + 1, inl.end()});
+  s.initial_orientation_ok = results.front().initial_orientation_ok;
+  if (has_gt && s.initial_orientation_ok)
+    s.initial_orientation_error_deg = RotationAngle(est.front().linear(), gt.front().linear()) * 180.0 / M_PI;
+
+  // Files.
+  const fs::path p = guard.path;
+  std::vector<Eigen::Isometry3d> anchored;
+  if (has_gt)
+    for (const auto& T : est) anchored.push_back(gt.front() * est.front().inverse() * T);
+  const std::vector<Eigen::Isometry3d> est_rel = RelativeToFirst(est), gt_rel = RelativeToFirst(gt);
+  const std::vector<double> dist = CumulativeDistance(gt_rel);
+  std::ostringstream csv;
+  csv << "frame,time_s,status,features,features_with_depth,matches,inliers,rms_reprojection_px,ba_ran,"
+         "disparity_ms,detect_ms,depth_ms,match_ms,motion_ms,ba_ms,total_ms,x_m,y_m,z_m,gt_distance_m,"
+         "translation_error_m,rotation_error_deg\n";
+  for (size_t i = 0; i < results.size(); ++i) {
+    const auto& r = results[i];
+    const Eigen::Vector3d t = est[i].translation();
+    const double te = has_gt ? (est_rel[i].translation() - gt_rel[i].translation()).norm() : 0.0;
+    const double re = has_gt ? RotationAngle(est_rel[i].linear(), gt_rel[i].linear()) * 180.0 / M_PI : 0.0;
+    csv << i << "," << FormatDouble(times[i]) << "," << vo::ToString(r.status) << "," << r.num_features << ","
+        << r.num_features_with_depth << "," << r.num_matches << "," << r.num_inliers << "," << Fmt(r.rms_reprojection_px)
+        << "," << (r.ba_ran ? 1 : 0) << "," << Fmt(r.times.disparity_ms, 3) << "," << Fmt(r.times.detect_ms, 3) << ","
+        << Fmt(r.times.depth_ms, 3) << "," << Fmt(r.times.match_ms, 3) << "," << Fmt(r.times.motion_ms, 3) << ","
+        << Fmt(r.times.ba_ms, 3) << "," << Fmt(r.times.total_ms, 3) << "," << FormatDouble(t.x()) << ","
+        << FormatDouble(t.y()) << "," << FormatDouble(t.z()) << "," << Fmt(has_gt ? dist[i] : 0.0) << ","
+        << Fmt(te, 6) << "," << Fmt(re, 5) << "\n";
+  }
+  const std::string options_yaml = VoConfigToYaml(odometry->options());
+  if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(times, est), error) ||
+      !WriteKittiPoses((p / "trajectory_kitti.txt").string(), est, error) ||
+      !WriteTextFile((p / "per_frame.csv").string(), csv.str(), error) ||
+      !WriteTextFile((p / "vo_options.yaml").string(), options_yaml, error) ||
+      !WriteTextFile((p / "metrics.json").string(), MetricsJson(s), error))
+    return false;
+  if (!scenario_yaml.empty() && !WriteTextFile((p / "scenario.yaml").string(), scenario_yaml, error)) return false;
+  if (has_gt) {
+    if (!WriteTum((p / "groundtruth_tum.txt").string(), Stamped(times, gt), error) ||
+        !WriteKittiPoses((p / "groundtruth_kitti.txt").string(), gt, error) ||
+        !WriteTum((p / "estimate_in_gt_world_tum.txt").string(), Stamped(times, anchored), error))
+      return false;
+  }
+  if (options.plots) {
+    std::string plot_error;
+    bool ok = true;
+    if (has_gt) {
+      std::vector<std::string> args = {"trajectory", (p / "groundtruth_tum.txt").string(),
+                                       (p / "estimate_in_gt_world_tum.txt").string(), (p / "trajectory.png").string()};
+      if (!options.outline.empty()) {
+        args.push_back("--outline");
+        args.push_back(options.outline);
+      }
+      ok = RunPlot(args, &plot_error) && RunPlot({"errors", p.string(), (p / "errors.png").string()}, &plot_error);
+    }
+    ok = ok && RunPlot({"timing", p.string(), (p / "timing.png").string()}, &plot_error);
+    if (!ok) std::fprintf(stderr, "warning: plots not made: %s\n", plot_error.c_str());
+  }
+  if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(s, options_yaml), error)) return false;
+  if (!Publish(guard.path, dir, error)) return false;
+  guard.keep = true;
+  return true;
+}
+
+bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_options,
+                 const RunOptions& options, RunSummary* summary, std::string* error) {
+  auto simulator = sim::Simulator::Create(scenario, error);
+  if (!simulator) return false;
+  RunOptions o = options;
+  if (o.outline.empty()) o.outline = fs::path(scenario.scene_path).stem().string();
+  sim::StereoFrame f;
+  FrameSource source = [&](DatasetFrame* frame, std::string* err) {
+    if (!simulator->Next(&f, err)) return false;
+    *frame = ToDatasetFrame(f);
+    return true;
+  };
+  return RunOdometry(scenario.name, ToStereoCamera(simulator->calibration()), source, simulator->EstimatedFrames(),
+                     vo_options, o, sim::ScenarioToYaml(scenario), summary, error);
+}
+
+bool RunKittiDataset(const std::string& dir, const vo::OdometryOptions& vo_options, const RunOptions& options,
+                     RunSummary* summary, std::string* error) {
+  KittiReader reader;
+  if (!reader.Open(dir, error)) return false;
+  size_t next = 0;
+  FrameSource source = [&](DatasetFrame* frame, std::string* err) {
+    if (next >= reader.size()) return false;
+    return reader.ReadFrame(next++, frame, err);
+  };
+  return RunOdometry(fs::path(dir).filename().string(), reader.camera(), source, static_cast<int>(reader.size()),
+                     vo_options, options, "", summary, error);
+}
+
+}  // namespace harness

@@ -1,0 +1,254 @@
+#include "harness/vo_config.h"
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+namespace harness {
+namespace {
+
+// One supported key: how to read it from a scalar and how to print it.
+struct Entry {
+  std::function<bool(const YAML::Node&, std::string*)> read;  // false + what was expected
+  std::function<void(YAML::Emitter&)> write;
+};
+
+template <typename T>
+Entry Number(T* field, T lo, T hi) {
+  return {[field, lo, hi](const YAML::Node& n, std::string* why) {
+            T v;
+            try {
+              v = n.as<T>();
+            } catch (const YAML::Exception&) {
+              *why = std::string("expected a ") + (std::is_integral<T>::value ? "integer" : "number") + ", got '" + n.Scalar() + "'";
+              return false;
+            }
+            if (!std::isfinite(static_cast<double>(v)) || v < lo || v > hi) {
+              std::ostringstream s;
+              s << "expected a finite value in [" << lo << ", " << hi << "], got " << n.Scalar();
+              *why = s.str();
+              return false;
+            }
+            *field = v;
+            return true;
+          },
+          [field](YAML::Emitter& e) { e << *field; }};
+}
+
+Entry Bool(bool* field) {
+  return {[field](const YAML::Node& n, std::string* why) {
+            try {
+              *field = n.as<bool>();
+              return true;
+            } catch (const YAML::Exception&) {
+              *why = "expected true or false, got '" + n.Scalar() + "'";
+              return false;
+            }
+          },
+          [field](YAML::Emitter& e) { e << *field; }};
+}
+
+Entry Matcher(vo::MatcherType* field) {
+  return {[field](const YAML::Node& n, std::string* why) {
+            if (vo::ParseMatcherType(n.Scalar(), field)) return true;
+            *why = "expected one of svd_proximity, svd_ncc, svd_ncc_gabor, ncc_mutual, lucas_kanade, kalman, sift_ratio; got '" + n.Scalar() + "'";
+            return false;
+          },
+          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
+}
+
+Entry Detector(vo::DetectorType* field) {
+  return {[field](const YAML::Node& n, std::string* why) {
+            if (n.Scalar() == "harris") *field = vo::DetectorType::kHarris;
+            else if (n.Scalar() == "sift") *field = vo::DetectorType::kSift;
+            else {
+              *why = "expected harris or sift, got '" + n.Scalar() + "'";
+              return false;
+            }
+            return true;
+          },
+          [field](YAML::Emitter& e) { e << (*field == vo::DetectorType::kHarris ? "harris" : "sift"); }};
+}
+
+Entry Wavelengths(std::vector<double>* field) {
+  return {[field](const YAML::Node& n, std::string* why) {
+            std::vector<double> v;
+            try {
+              if (!n.IsSequence()) throw YAML::Exception(n.Mark(), "");
+              for (const auto& x : n) v.push_back(x.as<double>());
+            } catch (const YAML::Exception&) {
+              *why = "expected a list of wavelengths in pixels";
+              return false;
+            }
+            for (double x : v)
+              if (!(std::isfinite(x) && x >= 2.0 && x <= 64.0)) {
+                *why = "expected wavelengths in [2, 64] pixels";
+                return false;
+              }
+            if (v.empty()) {
+              *why = "expected at least one wavelength";
+              return false;
+            }
+            *field = v;
+            return true;
+          },
+          [field](YAML::Emitter& e) {
+            e << YAML::Flow << YAML::BeginSeq;
+            for (double x : *field) e << x;
+            e << YAML::EndSeq;
+          }};
+}
+
+// The supported keys, in output order, bound to `o`'s fields.
+std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
+  const double kInf = 1e12;
+  return {
+      {"detector.type", Detector(&o->detector.type)},
+      {"detector.max_features", Number(&o->detector.max_features, 0, 100000)},
+      {"detector.border_margin_px", Number(&o->detector.border_margin_px, 0, 1000)},
+      {"detector.bucket_cols", Number(&o->detector.bucket_cols, 0, 1000)},
+      {"detector.bucket_rows", Number(&o->detector.bucket_rows, 0, 1000)},
+      {"detector.max_per_bucket", Number(&o->detector.max_per_bucket, 1, 100000)},
+      {"detector.harris.quality_level", Number(&o->detector.harris.quality_level, 0.0, 0.999)},
+      {"detector.harris.nms_radius_px", Number(&o->detector.harris.nms_radius_px, 1.0, 100.0)},
+      {"detector.harris.k", Number(&o->detector.harris.k, 1e-6, 0.25)},
+      {"disparity.block_size", Number(&o->disparity.block_size, 5, 255)},
+      {"disparity.uniqueness_ratio", Number(&o->disparity.uniqueness_ratio, 0, 100)},
+      {"disparity.left_right_max_diff_px", Number(&o->disparity.left_right_max_diff_px, -1.0, 1000.0)},
+      {"disparity_min_depth_m", Number(&o->disparity_min_depth_m, 0.01, kInf)},
+      {"matcher.type", Matcher(&o->matcher.type)},
+      {"matcher.ncc.window_px", Number(&o->matcher.ncc.window_px, 3, 63)},
+      {"matcher.gabor.wavelengths_px", Wavelengths(&o->matcher.gabor.wavelengths_px)},
+      {"matcher.gabor.phase_exponent", Number(&o->matcher.gabor.phase_exponent, 0.0, 100.0)},
+      {"matcher.svd.sigma_px", Number(&o->matcher.svd.sigma_px, 0.1, 1000.0)},
+      {"matcher.svd.min_weight", Number(&o->matcher.svd.min_weight, 0.0, 1.0)},
+      {"matcher.svd.min_pairing", Number(&o->matcher.svd.min_pairing, 0.0, 1.0)},
+      {"matcher.svd.dense", Bool(&o->matcher.svd.dense)},
+      {"matcher.ncc_mutual.search_radius_px", Number(&o->matcher.ncc_mutual.search_radius_px, 0.1, 10000.0)},
+      {"matcher.ncc_mutual.min_score", Number(&o->matcher.ncc_mutual.min_score, 0.0, 1.0)},
+      {"matcher.lucas_kanade.window_px", Number(&o->matcher.lucas_kanade.window_px, 5, 101)},
+      {"matcher.lucas_kanade.max_level", Number(&o->matcher.lucas_kanade.max_level, 0, 8)},
+      {"matcher.sift_ratio.ratio", Number(&o->matcher.sift_ratio.ratio, 0.01, 1.0)},
+      {"ransac.inlier_threshold_px", Number(&o->ransac.inlier_threshold_px, 0.01, 1000.0)},
+      {"ransac.confidence", Number(&o->ransac.confidence, 0.5, 0.999999)},
+      {"ransac.max_iterations", Number(&o->ransac.max_iterations, 1, 100000)},
+      {"ransac.seed", Number<uint64_t>(&o->ransac.seed, 0, UINT64_MAX)},
+      {"use_bundle_adjustment", Bool(&o->use_bundle_adjustment)},
+      {"ba_window_frames", Number(&o->ba_window_frames, 3, 10)},
+      {"ba.max_num_iterations", Number(&o->ba.max_num_iterations, 1, 1000)},
+      {"ba.loss_scale_px", Number(&o->ba.loss_scale_px, 0.01, 100.0)},
+      {"prior_weight", Number(&o->prior_weight, 0.0, 1.0)},
+      {"estimate_initial_orientation", Bool(&o->estimate_initial_orientation)},
+      {"min_features", Number(&o->min_features, 0, 100000)},
+      {"min_inliers", Number(&o->min_inliers, 3, 100000)},
+  };
+}
+
+// Walks the mapping; leaves (scalars and the wavelength list) are applied by dotted key.
+bool Apply(const YAML::Node& node, const std::string& prefix, const std::string& source,
+           std::map<std::string, Entry>& entries, std::string* error) {
+  for (const auto& kv : node) {
+    const std::string key = prefix.empty() ? kv.first.Scalar() : prefix + "." + kv.first.Scalar();
+    const YAML::Node& v = kv.second;
+    const std::string where = source + ":" + std::to_string(kv.first.Mark().line + 1) + ": key '" + key + "': ";
+    auto it = entries.find(key);
+    if (it == entries.end()) {
+      if (v.IsMap()) {
+        bool any = false;
+        for (const auto& e : entries) any |= e.first.rfind(key + ".", 0) == 0;
+        if (any) {
+          if (!Apply(v, key, source, entries, error)) return false;
+          continue;
+        }
+      }
+      *error = where + "unknown key (see `vobench run --help` and results' vo_options.yaml for the supported keys)";
+      return false;
+    }
+    std::string why;
+    if (!(v.IsScalar() || (v.IsSequence() && key == "matcher.gabor.wavelengths_px")) || !it->second.read(v, &why)) {
+      *error = where + (why.empty() ? "expected a single value" : why);
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool ParseVoConfig(const std::string& yaml_text, const std::string& source_name,
+                   vo::OdometryOptions* options, std::string* error) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::ParserException& ex) {
+    *error = source_name + ":" + std::to_string(ex.mark.line + 1) + ": malformed YAML: " + ex.msg;
+    return false;
+  }
+  if (root.IsNull()) return true;  // an empty file: defaults
+  if (!root.IsMap()) {
+    *error = source_name + ": expected a YAML mapping of VO options";
+    return false;
+  }
+  vo::OdometryOptions o = *options;
+  std::map<std::string, Entry> entries;
+  for (auto& e : Registry(&o)) entries.emplace(e.first, e.second);
+  if (!Apply(root, "", source_name, entries, error)) return false;
+  std::string why;
+  if (!o.IsValid(&why)) {
+    *error = source_name + ": invalid VO options: " + why;
+    return false;
+  }
+  *options = o;
+  return true;
+}
+
+bool LoadVoConfig(const std::string& path, vo::OdometryOptions* options, std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    *error = path + ": cannot open VO config file";
+    return false;
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseVoConfig(text.str(), path, options, error);
+}
+
+std::string VoConfigToYaml(const vo::OdometryOptions& options) {
+  vo::OdometryOptions o = options;
+  // Nested output: group consecutive keys by their dotted prefixes.
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  std::vector<std::string> open;
+  for (auto& [key, entry] : Registry(&o)) {
+    std::vector<std::string> parts;
+    std::stringstream ss(key);
+    std::string p;
+    while (std::getline(ss, p, '.')) parts.push_back(p);
+    size_t common = 0;
+    while (common < open.size() && common + 1 < parts.size() && open[common] == parts[common]) ++common;
+    while (open.size() > common) {
+      out << YAML::EndMap;
+      open.pop_back();
+    }
+    for (size_t i = common; i + 1 < parts.size(); ++i) {
+      out << YAML::Key << parts[i] << YAML::Value << YAML::BeginMap;
+      open.push_back(parts[i]);
+    }
+    out << YAML::Key << parts.back() << YAML::Value;
+    entry.write(out);
+  }
+  while (!open.empty()) {
+    out << YAML::EndMap;
+    open.pop_back();
+  }
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace harness
