@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 # Hallway outlines (x, y polygons in the world, metres), as in scenes/*.xml.
 OUTLINES = {
-    "hallway_l": [(-1.5, -1), (9, -1), (9, 10), (7, 10), (7, 1), (-1.5, 1), (-1.5, -1)],
+    "hallway_l": [(-1.5, -1), (9, -1), (9, 12), (7, 12), (7, 1), (-1.5, 1), (-1.5, -1)],
     "corridor_plain": [(-1.5, -1), (14, -1), (14, 1), (-1.5, 1), (-1.5, -1)],
 }
 

@@ -136,6 +136,10 @@ DetectorOptions DefaultOdometryDetectorOptions() {
   options.bucket_cols = 8;
   options.bucket_rows = 6;
   options.max_per_bucket = 10;
+  // A lower relative threshold than the detector's 0.01: one bright ceiling light or door
+  // edge otherwise sets the bar so high that a weakly textured wall in front of the camera
+  // yields 10-15 corners and tracking is lost (seen on the L-hallway's corner approach).
+  options.harris.quality_level = 0.001;
   return options;
 }
 

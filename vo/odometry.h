@@ -77,7 +77,7 @@ namespace vo {
 // camera system tiny, so DENSE_SCHUR beats the sparse factorisation.
 BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions();
 // Detector defaults for the pipeline: Harris, at most 300 features, bucketed on an 8 × 6 grid
-// (at most 10 per cell) so they spread over the image.
+// (at most 10 per cell) so they spread over the image, Harris quality_level 0.001.
 DetectorOptions DefaultOdometryDetectorOptions();
 
 struct OdometryOptions {

@@ -63,6 +63,10 @@ struct ProjectionCase {
   double fovy_deg, pitch_deg, baseline_m;
 };
 
+void PrintTo(const ProjectionCase& c, std::ostream* os) {
+  *os << c.width << "x" << c.height << " fovy " << c.fovy_deg << " pitch " << c.pitch_deg << " baseline " << c.baseline_m;
+}
+
 class ProjectionTest : public ::testing::TestWithParam<ProjectionCase> {};
 
 TEST_P(ProjectionTest, MarkersLandWhereCalibrationAndPoseProjectThem) {

@@ -519,6 +519,9 @@ constexpr double kMinDensitySgbm = 0.80;
 // The search range is not tight around the ground truth, as in real use.
 constexpr double kRangeHeadroomPx = 8.0;
 
+// Names the pair in test output instead of dumping its bytes.
+void PrintTo(const MiddleburyPair& p, std::ostream* os) { *os << p.name; }
+
 class MiddleburyTest : public ::testing::TestWithParam<MiddleburyPair> {};
 
 TEST_P(MiddleburyTest, BadPixelRateAndDensity) {

@@ -1,0 +1,57 @@
+// The disparity stage against the simulator's ground-truth depth on the L-hallway
+// (bad-pixel rate > 1 px and density over pixels with ground truth).
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "harness/render.h"
+#include "sim/simulator.h"
+#include "vo/disparity.h"
+
+namespace {
+
+constexpr double kBadPixelPx = 1.0;
+// Bounds from measured values with headroom (see the printed figures).
+constexpr double kMaxBadRate = 0.10;
+constexpr double kMinDensity = 0.35;
+
+TEST(DisparitySimTest, HallwayDisparityAgreesWithGroundTruthDepth) {
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(harness::ResolveScenario("l_hallway", &s, &error)) << error;
+  s.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(2.0, 0)};
+  auto simulator = sim::Simulator::Create(s, &error);
+  ASSERT_TRUE(simulator) << error;
+  const vo::StereoCamera cam = harness::ToStereoCamera(simulator->calibration());
+  vo::DisparityOptions o;
+  o.num_disparities = 48;  // depths down to 0.43 m
+  vo::DisparityEstimator estimator(o);
+  long with_gt = 0, valid = 0, bad = 0;
+  sim::StereoFrame f;
+  int frames = 0;
+  while (simulator->Next(&f, &error)) {
+    if (frames++ % 5 != 0) continue;
+    const vo::DisparityResult r = estimator.Compute(f.left, f.right);
+    ASSERT_TRUE(r.ok) << r.message;
+    for (int y = 0; y < f.depth_m.rows; ++y)
+      for (int x = 0; x < f.depth_m.cols; ++x) {
+        const float z = f.depth_m.at<float>(y, x);
+        if (!(z > 0)) continue;
+        const double d_gt = cam.DisparityFromDepth(z);
+        if (d_gt >= o.num_disparities) continue;
+        ++with_gt;
+        const float d = r.disparity_px.at<float>(y, x);
+        if (d < 0) continue;
+        ++valid;
+        if (std::abs(d - d_gt) > kBadPixelPx) ++bad;
+      }
+  }
+  ASSERT_GT(with_gt, 0);
+  const double bad_rate = static_cast<double>(bad) / valid;
+  const double density = static_cast<double>(valid) / with_gt;
+  std::printf("[ hallway disparity vs GT depth ] bad (>1 px) %.2f %%, density %.2f %%\n", 100 * bad_rate, 100 * density);
+  EXPECT_LT(bad_rate, kMaxBadRate);
+  EXPECT_GT(density, kMinDensity);
+}
+
+}  // namespace
