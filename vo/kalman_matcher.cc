@@ -101,10 +101,7 @@ const std::vector<Eigen::Vector2f>& KalmanMatcher::Gradients(const MatchFrame& f
 std::vector<Match> KalmanMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
                                               MatcherSummary* summary) {
   MatcherSummary local;
-  MatcherSummary& s = summary != nullptr ? *summary : local;
-  s = MatcherSummary();
-  s.num_prev = static_cast<int>(prev.features.size());
-  s.num_curr = static_cast<int>(curr.features.size());
+  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (prev.image.empty() || curr.image.empty() || prev.image.type() != CV_8UC1 ||
       curr.image.type() != CV_8UC1) {
     s.ok = false;

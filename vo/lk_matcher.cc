@@ -40,10 +40,7 @@ const std::vector<cv::Mat>& LucasKanadeMatcher::Pyramid(const MatchFrame& frame)
 std::vector<Match> LucasKanadeMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
                                                    MatcherSummary* summary) {
   MatcherSummary local;
-  MatcherSummary& s = summary != nullptr ? *summary : local;
-  s = MatcherSummary();
-  s.num_prev = static_cast<int>(prev.features.size());
-  s.num_curr = static_cast<int>(curr.features.size());
+  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (s.num_prev == 0 || s.num_curr == 0) return {};
   if (prev.image.empty() || curr.image.empty() || prev.image.type() != CV_8UC1 ||
       curr.image.type() != CV_8UC1 || prev.image.size() != curr.image.size()) {

@@ -295,4 +295,13 @@ bool IsOneToOne(const std::vector<Match>& matches) {
          std::adjacent_find(curr.begin(), curr.end()) == curr.end();
 }
 
+MatcherSummary& StartSummary(const MatchFrame& prev, const MatchFrame& curr,
+                             MatcherSummary* summary, MatcherSummary* local) {
+  MatcherSummary& s = summary != nullptr ? *summary : *local;
+  s = MatcherSummary();
+  s.num_prev = static_cast<int>(prev.features.size());
+  s.num_curr = static_cast<int>(curr.features.size());
+  return s;
+}
+
 }  // namespace vo

@@ -292,6 +292,11 @@ struct CandidatePair {
 std::vector<Match> GreedyOneToOne(std::vector<CandidatePair> candidates,
                                   const std::function<double(double)>& score_of);
 
+// The summary a MatchFrames() call fills: *summary, or *local when summary is null; reset,
+// with the frames' feature counts set.
+MatcherSummary& StartSummary(const MatchFrame& prev, const MatchFrame& curr,
+                             MatcherSummary* summary, MatcherSummary* local);
+
 // True when no prev index and no curr index appears twice.
 bool IsOneToOne(const std::vector<Match>& matches);
 

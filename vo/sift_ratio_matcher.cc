@@ -64,10 +64,7 @@ SiftRatioMatcher::SiftRatioMatcher(const Options& options) : options_(options) {
 std::vector<Match> SiftRatioMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
                                                  MatcherSummary* summary) {
   MatcherSummary local;
-  MatcherSummary& s = summary != nullptr ? *summary : local;
-  s = MatcherSummary();
-  s.num_prev = static_cast<int>(prev.features.size());
-  s.num_curr = static_cast<int>(curr.features.size());
+  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (s.num_prev == 0 || s.num_curr == 0) return {};
   if (!DescriptorsUsable(prev) || !DescriptorsUsable(curr) ||
       prev.descriptors.cols != curr.descriptors.cols) {

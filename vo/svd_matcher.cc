@@ -270,10 +270,7 @@ MatcherType SvdMatcher::type() const {
 std::vector<Match> SvdMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
                                            MatcherSummary* summary) {
   MatcherSummary local;
-  MatcherSummary& s = summary != nullptr ? *summary : local;
-  s = MatcherSummary();
-  s.num_prev = static_cast<int>(prev.features.size());
-  s.num_curr = static_cast<int>(curr.features.size());
+  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (s.num_prev == 0 || s.num_curr == 0) return {};
   const bool use_ncc = cues_ != Cues::kProximity;
   const bool use_gabor = cues_ == Cues::kProximityNccGabor;
