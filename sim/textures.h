@@ -16,9 +16,8 @@
 #pragma once
 
 #include <cstdint>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace sim {
 
@@ -41,25 +40,29 @@ const char* TextureKindName(TextureKind kind);
 bool IsPlainTexture(TextureKind kind);
 
 struct TextureOptions {
-  double px_per_m = 256.0;  // texture resolution (texels per metre), > 0
-  double grain_amplitude = 5.0;     // rich kinds: peak of the per-texel grain (grey levels), >= 0
-  double shading_amplitude = 12.0;  // rich kinds: peak of the low-frequency shading (grey levels), >= 0
+  double px_per_m = 256.0;       // texture resolution (texels per metre), > 0
+  double grain_amplitude = 5.0;  // rich kinds: peak of the per-texel grain (grey levels), >= 0
+  double shading_amplitude =
+      12.0;                     // rich kinds: peak of the low-frequency shading (grey levels), >= 0
   double detail_density = 1.0;  // rich kinds: multiplier on the number of objects and marks
                                 // (1 = default hallway, 0 = bare plaster/tiles/panels), >= 0
-  double door_gap_min_m = 1.2;  // rich walls: least wall length between two door frames (metres), > 0
-  double door_gap_max_m = 5.0;  // rich walls: largest wall length between two door frames
-                                // (metres), >= door_gap_min_m
-  double plain_door_spacing_m = 6.0;  // plain walls: mean distance between doors (metres), > 0;
-                                      // each gap varies by +-15 %
-  double skirting_height_m = 0.1;     // height of the dark skirting strip on walls (metres), >= 0
-  double floor_tile_m = 0.5;          // floor tile edge length (metres), > grout_width_m
-  double grout_width_m = 0.005;       // grout line width between floor tiles (metres), >= 0;
-                                      // drawn at least one texel wide
-  double ceiling_panel_m = 0.6;       // suspended-ceiling panel edge length (metres),
-                                      // > ceiling_grid_width_m
-  double ceiling_grid_width_m = 0.024;  // width of the ceiling's T-bar grid (metres), >= 0
-  double plain_shading_amplitude = 2.0;  // plain kinds: peak low-frequency shading (grey levels), >= 0
-  double plain_grain_amplitude = 0.8;    // plain kinds: peak per-texel grain (grey levels), >= 0
+  double door_gap_min_m =
+      1.2;  // rich walls: least wall length between two door frames (metres), > 0
+  double door_gap_max_m = 5.0;          // rich walls: largest wall length between two door frames
+                                        // (metres), >= door_gap_min_m
+  double plain_door_spacing_m = 6.0;    // plain walls: mean distance between door centres
+                                        // (metres), > 0; each spacing varies by +-15 %
+  double skirting_height_m = 0.1;       // height of the dark skirting strip on walls (metres), >= 0
+  double floor_tile_m = 0.5;            // floor tile edge length (metres), > grout_width_m
+  double grout_width_m = 0.005;         // grout line width between floor tiles (metres), >= 0;
+                                        // drawn at least one texel wide
+  double ceiling_panel_m = 0.6;         // suspended-ceiling panel edge length (metres),
+                                        // > ceiling_grid_width_m
+  double ceiling_grid_width_m = 0.024;  // width of the ceiling's T-bar grid (metres), >= 0;
+                                        // drawn at least one texel wide
+  double plain_shading_amplitude =
+      2.0;  // plain kinds: peak low-frequency shading (grey levels), >= 0
+  double plain_grain_amplitude = 0.8;  // plain kinds: peak per-texel grain (grey levels), >= 0
   bool tinted = true;  // true: slightly coloured surfaces and objects; false: B = G = R everywhere
 
   // True when every field is finite and in range; otherwise fills *error (may be null).
@@ -70,7 +73,8 @@ struct TextureOptions {
 constexpr int kMaxTextureSidePx = 32768;
 
 // Size in texels of the texture of a width_m x height_m surface:
-// (round(width_m * px_per_m), round(height_m * px_per_m)).
+// (round(width_m * px_per_m), round(height_m * px_per_m)); a side that is not finite, negative
+// or beyond 4 * kMaxTextureSidePx comes back as 0.
 cv::Size TextureSizePx(double width_m, double height_m, const TextureOptions& options = {});
 
 // Returns an 8-bit 3-channel (CV_8UC3, BGR; grey or slightly tinted) image of
