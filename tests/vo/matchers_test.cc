@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/synthetic_images.h"
 #include "vo/kalman_matcher.h"
 #include "vo/matcher.h"
 
@@ -26,22 +27,7 @@ namespace {
 constexpr double kMinCornerDistancePx = 6.0;
 constexpr double kCorrectTolPx = 0.5 * kMinCornerDistancePx;
 
-// Smooth random texture (three octaves of blurred noise), 8-bit, deterministic.
-cv::Mat RandomTexture(int width, int height, uint64_t seed) {
-  cv::RNG rng(seed);
-  cv::Mat sum = cv::Mat::zeros(height, width, CV_32F);
-  for (double sigma : {1.5, 3.0, 6.0}) {
-    cv::Mat noise(height, width, CV_32F);
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
-    cv::GaussianBlur(noise, noise, cv::Size(), sigma);
-    cv::normalize(noise, noise, 0.0, 1.0, cv::NORM_MINMAX);
-    sum += noise;
-  }
-  cv::normalize(sum, sum, 20.0, 235.0, cv::NORM_MINMAX);
-  cv::Mat out;
-  sum.convertTo(out, CV_8U);
-  return out;
-}
+using vobench_test::RandomTexture;
 
 // Known motion: similarity about the image centre + translation (pixels, degrees).
 struct Motion {

@@ -2,6 +2,7 @@
 // exactness of the component decomposition, sparse vs dense agreement, the size guard.
 #include "vo/svd_matcher.h"
 
+#include "tests/synthetic_images.h"
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -168,21 +169,7 @@ TEST(SvdMatcherTest, SingleRowComponentIsNormalisedRow) {
 
 // ---- Realistic data: a textured image pair with known motion -------------------------------
 
-cv::Mat RandomTexture(int width, int height, uint64_t seed) {
-  cv::RNG rng(seed);
-  cv::Mat sum = cv::Mat::zeros(height, width, CV_32F);
-  for (double sigma : {1.5, 3.0, 6.0}) {
-    cv::Mat noise(height, width, CV_32F);
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
-    cv::GaussianBlur(noise, noise, cv::Size(), sigma);
-    cv::normalize(noise, noise, 0.0, 1.0, cv::NORM_MINMAX);
-    sum += noise;
-  }
-  cv::normalize(sum, sum, 20.0, 235.0, cv::NORM_MINMAX);
-  cv::Mat out;
-  sum.convertTo(out, CV_8U);
-  return out;
-}
+using vobench_test::RandomTexture;
 
 struct ImagePair {
   cv::Mat A;  // prev → curr, 2×3
