@@ -38,8 +38,21 @@ double Percentile(std::vector<double> v, double p) {
   return v[std::clamp<size_t>(rank, 1, v.size()) - 1];
 }
 
+namespace {
+
+// Error of the estimated motion from frame i to frame j against the ground truth's.
+Eigen::Isometry3d RelativeError(const std::vector<Eigen::Isometry3d>& est,
+                                const std::vector<Eigen::Isometry3d>& gt, size_t i, size_t j) {
+  const Eigen::Isometry3d d_est = est[i].inverse() * est[j];
+  const Eigen::Isometry3d d_gt = gt[i].inverse() * gt[j];
+  return d_gt.inverse() * d_est;
+}
+
+}  // namespace
+
 TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>& estimate,
-                                           const std::vector<Eigen::Isometry3d>& ground_truth) {
+                                           const std::vector<Eigen::Isometry3d>& ground_truth,
+                                           double rpe_distance_step_m) {
   TrajectoryMetrics m;
   const size_t n = std::min(estimate.size(), ground_truth.size());
   m.frames = static_cast<int>(n);
@@ -68,15 +81,35 @@ TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>&
   // RPE over one frame step.
   double st = 0.0, sr = 0.0;
   for (size_t i = 1; i < n; ++i) {
-    const Eigen::Isometry3d d_est = est[i - 1].inverse() * est[i];
-    const Eigen::Isometry3d d_gt = gt[i - 1].inverse() * gt[i];
-    const Eigen::Isometry3d e = d_gt.inverse() * d_est;
+    const Eigen::Isometry3d e = RelativeError(est, gt, i - 1, i);
     st += e.translation().squaredNorm();
     const double r = RotationAngle(Eigen::Matrix3d::Identity(), e.linear());
     sr += r * r;
   }
   m.rpe_trans_rmse_m = std::sqrt(st / (n - 1));
   m.rpe_rot_rmse_deg = std::sqrt(sr / (n - 1)) * 180.0 / M_PI;
+
+  // RPE over a distance step: from every frame to the first frame at least the step further
+  // along the ground-truth path (frames are discrete, so the pair spans >= the step).
+  m.rpe_distance_step_m = rpe_distance_step_m;
+  if (rpe_distance_step_m > 0.0) {
+    double dt = 0.0, dr = 0.0;
+    size_t j = 0;
+    for (size_t i = 0; i < n; ++i) {
+      j = std::max(j, i + 1);
+      while (j < n && dist[j] - dist[i] < rpe_distance_step_m) ++j;
+      if (j >= n) break;
+      const Eigen::Isometry3d e = RelativeError(est, gt, i, j);
+      dt += e.translation().squaredNorm();
+      const double r = RotationAngle(Eigen::Matrix3d::Identity(), e.linear());
+      dr += r * r;
+      ++m.rpe_distance_pairs;
+    }
+    if (m.rpe_distance_pairs > 0) {
+      m.rpe_distance_trans_rmse_m = std::sqrt(dt / m.rpe_distance_pairs);
+      m.rpe_distance_rot_rmse_deg = std::sqrt(dr / m.rpe_distance_pairs) * 180.0 / M_PI;
+    }
+  }
 
   // KITTI-style drift: for sub-path lengths L = k/8 of the path (k = 1..8), from every
   // 10th start frame, the relative pose error at the first frame at least L further along,
@@ -90,9 +123,7 @@ TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>&
       size_t last = first;
       while (last < n && dist[last] - dist[first] < L) ++last;
       if (last >= n) break;
-      const Eigen::Isometry3d d_est = est[first].inverse() * est[last];
-      const Eigen::Isometry3d d_gt = gt[first].inverse() * gt[last];
-      const Eigen::Isometry3d e = d_gt.inverse() * d_est;
+      const Eigen::Isometry3d e = RelativeError(est, gt, first, last);
       // Divided by the sub-path's actual length (>= L: frames are discrete).
       const double len = dist[last] - dist[first];
       t_sum += e.translation().norm() / len;

@@ -62,6 +62,23 @@ Entry Matcher(vo::MatcherType* field) {
           [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
 }
 
+Entry DisparityAlgorithmEntry(vo::DisparityAlgorithm* field) {
+  return {[field](const YAML::Node& n, std::string* why) {
+            for (vo::DisparityAlgorithm a :
+                 {vo::DisparityAlgorithm::kBlockMatching, vo::DisparityAlgorithm::kSemiGlobal,
+                  vo::DisparityAlgorithm::kBlockMatchingOneVolume}) {
+              if (n.Scalar() == vo::ToString(a)) {
+                *field = a;
+                return true;
+              }
+            }
+            *why = "expected block_matching, block_matching_one_volume or semi_global; got '" +
+                   n.Scalar() + "'";
+            return false;
+          },
+          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
+}
+
 Entry Detector(vo::DetectorType* field) {
   return {[field](const YAML::Node& n, std::string* why) {
             if (n.Scalar() == "harris") *field = vo::DetectorType::kHarris;
@@ -117,6 +134,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"detector.harris.quality_level", Number(&o->detector.harris.quality_level, 0.0, 0.999)},
       {"detector.harris.nms_radius_px", Number(&o->detector.harris.nms_radius_px, 1.0, 100.0)},
       {"detector.harris.k", Number(&o->detector.harris.k, 1e-6, 0.25)},
+      {"disparity.algorithm", DisparityAlgorithmEntry(&o->disparity.algorithm)},
       {"disparity.block_size", Number(&o->disparity.block_size, 5, 255)},
       {"disparity.uniqueness_ratio", Number(&o->disparity.uniqueness_ratio, 0, 100)},
       {"disparity.left_right_max_diff_px", Number(&o->disparity.left_right_max_diff_px, -1.0, 1000.0)},

@@ -1,5 +1,7 @@
 #include "vo/disparity.h"
 
+#include "vo/sad_block_matcher.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -91,16 +93,33 @@ const char* ToString(DisparityAlgorithm algorithm) {
       return "block_matching";
     case DisparityAlgorithm::kSemiGlobal:
       return "semi_global";
+    case DisparityAlgorithm::kBlockMatchingOneVolume:
+      return "block_matching_one_volume";
   }
   return "unknown";
+}
+
+static SadBlockMatcherOptions ToSadOptions(const DisparityOptions& o) {
+  SadBlockMatcherOptions s;
+  s.min_disparity_px = o.min_disparity_px;
+  s.num_disparities = o.num_disparities;
+  s.block_size = o.block_size;
+  s.prefilter_cap = o.prefilter_cap;
+  s.uniqueness_ratio = o.uniqueness_ratio;
+  return s;
 }
 
 bool DisparityOptions::IsValid(std::string* error) const {
   std::ostringstream msg;
   const bool bm = algorithm == DisparityAlgorithm::kBlockMatching;
+  std::string sad_error;
   if (algorithm != DisparityAlgorithm::kBlockMatching &&
-      algorithm != DisparityAlgorithm::kSemiGlobal) {
+      algorithm != DisparityAlgorithm::kSemiGlobal &&
+      algorithm != DisparityAlgorithm::kBlockMatchingOneVolume) {
     msg << "algorithm: unknown value " << static_cast<int>(algorithm);
+  } else if (algorithm == DisparityAlgorithm::kBlockMatchingOneVolume &&
+             !ToSadOptions(*this).IsValid(&sad_error)) {
+    msg << sad_error;
   } else if (min_disparity_px < 0) {
     msg << "min_disparity_px must be >= 0, got " << min_disparity_px;
   } else if (num_disparities < 16 || num_disparities % 16 != 0) {
@@ -150,10 +169,11 @@ bool DepthSamplingOptions::IsValid(std::string* error) const {
 
 struct DisparityEstimator::Impl {
   cv::Ptr<cv::StereoMatcher> matcher;  // both views (the right one on the mirrored pair)
+  std::unique_ptr<SadBlockMatcher> sad;  // kBlockMatchingOneVolume: both views at once
   // Scratch buffers, reused between calls.
   cv::Mat padded_a, padded_b, flipped_a, flipped_b, raw_fixed;
   cv::Mat left_fixed, right_fixed;  // CV_16S, 1/16 px, cropped to the image
-  cv::Mat gradient, texture;
+  cv::Mat gradient, texture, low_texture;
 };
 
 namespace {
@@ -189,7 +209,11 @@ DisparityEstimator::DisparityEstimator(const DisparityOptions& options)
   // unique match vetoes the left estimate that lands on it. Measured on Middlebury, matching
   // the right view without the uniqueness filter gains ~2 points of density for ~0.3 points
   // more bad pixels (and ~1.5 ms at 320x240); we keep the stricter check.
-  impl_->matcher = CreateMatcher(options_);
+  if (options_.algorithm == DisparityAlgorithm::kBlockMatchingOneVolume) {
+    impl_->sad = std::make_unique<SadBlockMatcher>(ToSadOptions(options_));
+  } else {
+    impl_->matcher = CreateMatcher(options_);
+  }
 }
 
 DisparityEstimator::~DisparityEstimator() = default;
@@ -250,28 +274,40 @@ DisparityResult DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& 
     }
   };
 
-  // Correlation along the epipolar lines, sub-pixel (1/16 px), left view.
-  match(*s.matcher, left, right, &s.left_fixed);
-  // Right view for the left-right check: matching the mirrored pair (flip(right) as the
-  // reference image, flip(left) as the target) gives, per right-image pixel, the disparity
-  // to its left-image match with the same sign convention; flipping back indexes it by x_r.
-  const bool lr_check = o.left_right_max_diff_px > 0.0;
-  if (lr_check) {
-    cv::flip(right, s.flipped_a, 1);
-    cv::flip(left, s.flipped_b, 1);
-    match(*s.matcher, s.flipped_a, s.flipped_b, &s.right_fixed);
-    cv::flip(s.right_fixed, s.right_fixed, 1);
-  }
-
   // Confidence (texture) filter input, SVS style: mean |I(x+1) - I(x-1)| over the window.
   const bool texture_filter = o.min_texture > 0.0;
+  const float min_texture_sum = static_cast<float>(2.0 * o.min_texture);
   if (texture_filter) {
     cv::Sobel(left, s.gradient, CV_16S, 1, 0, /*ksize=*/1, 1.0, 0.0, cv::BORDER_REPLICATE);
     cv::convertScaleAbs(s.gradient, s.gradient);  // |I(x+1) - I(x-1)|, CV_8U
     cv::boxFilter(s.gradient, s.texture, CV_32F, cv::Size(o.block_size, o.block_size),
                   cv::Point(-1, -1), /*normalize=*/true, cv::BORDER_REPLICATE);
   }
-  const float min_texture_sum = static_cast<float>(2.0 * o.min_texture);
+
+  const bool lr_check = o.left_right_max_diff_px > 0.0;
+  if (s.sad) {
+    // Both views from one cost volume; the padding is the matcher's own (same rule). Pixels
+    // the texture filter removes below skip the matcher's uniqueness test (same result).
+    const cv::Mat* discard = nullptr;
+    if (texture_filter) {
+      cv::compare(s.texture, min_texture_sum, s.low_texture, cv::CMP_LT);
+      discard = &s.low_texture;
+    }
+    s.sad->Compute(left, right, &s.left_fixed, lr_check ? &s.right_fixed : nullptr, discard);
+  } else {
+    // Correlation along the epipolar lines, sub-pixel (1/16 px), left view.
+    match(*s.matcher, left, right, &s.left_fixed);
+    // Right view for the left-right check: matching the mirrored pair (flip(right) as the
+    // reference image, flip(left) as the target) gives, per right-image pixel, the disparity
+    // to its left-image match with the same sign convention; flipping back indexes it by x_r.
+    if (lr_check) {
+      cv::flip(right, s.flipped_a, 1);
+      cv::flip(left, s.flipped_b, 1);
+      match(*s.matcher, s.flipped_a, s.flipped_b, &s.right_fixed);
+      cv::flip(s.right_fixed, s.right_fixed, 1);
+    }
+  }
+
   const int min_fixed = o.min_disparity_px * kDisparityScale;
   const double lr_max_diff_fixed = o.left_right_max_diff_px * kDisparityScale;
 

@@ -7,7 +7,9 @@
 // consistency check. Features without a valid disparity are dropped.
 //
 // Here the correlation itself is OpenCV's StereoBM (SAD block matching on an x-Sobel
-// prefiltered image, the closest relative of SVS) or StereoSGBM for comparison. The texture
+// prefiltered image, the closest relative of SVS), our own implementation of the same
+// correlation that yields both views from one cost volume (sad_block_matcher.h; the pipeline's
+// default, for speed), or StereoSGBM for comparison. The texture
 // filter, the left-right check, the border handling and the speckle filter are ours, so they
 // behave the same for both algorithms and need no opencv_contrib (ximgproc).
 //
@@ -31,6 +33,10 @@ constexpr float kInvalidDisparity = -1.0f;
 enum class DisparityAlgorithm {
   kBlockMatching,  // cv::StereoBM: SAD window correlation (SVS-like; the paper's choice)
   kSemiGlobal,     // cv::StereoSGBM: semi-global matching (Hirschmüller 2008), for comparison
+  kBlockMatchingOneVolume,  // our SAD block matcher (vo/sad_block_matcher.h): the same
+                            // correlation as kBlockMatching, but the left-right check's right
+                            // view comes from the same cost volume instead of a second pass
+                            // (about half the time with the check on); block_size <= 21
 };
 
 const char* ToString(DisparityAlgorithm algorithm);

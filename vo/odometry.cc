@@ -129,6 +129,14 @@ BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions() {
   return options;
 }
 
+DisparityOptions DefaultOdometryDisparityOptions() {
+  DisparityOptions options;
+  // The same correlation as cv::StereoBM, with the left-right check's right view taken from
+  // the same cost volume instead of a second pass (vo/sad_block_matcher.h).
+  options.algorithm = DisparityAlgorithm::kBlockMatchingOneVolume;
+  return options;
+}
+
 DetectorOptions DefaultOdometryDetectorOptions() {
   DetectorOptions options;
   options.type = DetectorType::kHarris;

@@ -79,17 +79,25 @@ BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions();
 // Detector defaults for the pipeline: Harris, at most 300 features, bucketed on an 8 × 6 grid
 // (at most 10 per cell) so they spread over the image, Harris quality_level 0.001.
 DetectorOptions DefaultOdometryDetectorOptions();
+// Disparity defaults for the pipeline: block matching with the left-right check, both views
+// from one cost volume (kBlockMatchingOneVolume; the same disparities as cv::StereoBM run
+// twice, in about half the time).
+DisparityOptions DefaultOdometryDisparityOptions();
 
 struct OdometryOptions {
   DetectorOptions detector = DefaultOdometryDetectorOptions();  // feature detection (left)
-  DisparityOptions disparity;          // dense disparity; num_disparities is replaced by the value
+  DisparityOptions disparity = DefaultOdometryDisparityOptions();  // dense disparity;
+                                       // num_disparities is replaced by the value
                                        // derived from the camera when derive_num_disparities
   bool derive_num_disparities = true;  // search range from the camera: the smallest multiple
                                        // of 16 >= fx · baseline / disparity_min_depth_m, clamped
                                        // to [16, max_num_disparities] (and < image width)
-  double disparity_min_depth_m = 0.5;  // nearest depth the derived search range covers (metres),
-                                       // > 0. Hallway rig (fx 230 px, 0.09 m): 41.4 px → 48;
-                                       // KITTI (718 px, 0.54 m): clamped to 256 (≈ 1.5 m)
+  double disparity_min_depth_m = 0.7;  // nearest depth the derived search range covers (metres),
+                                       // > 0. Hallway rig (fx 230 px, 0.09 m): 29.6 px → 32
+                                       // disparities, depth >= 0.67 m (the L-path's nearest
+                                       // surface, at the corner turn, is 0.735 m from the camera
+                                       // in the simulator's depth); KITTI (718 px, 0.54 m):
+                                       // clamped to 256 (≈ 1.5 m)
   int max_num_disparities = 256;       // upper clamp of the derived range (pixels), multiple
                                        // of 16, >= 16
   DepthSamplingOptions depth;          // how features read the disparity map

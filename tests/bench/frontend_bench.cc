@@ -120,6 +120,21 @@ void BM_DisparityBlockMatching(benchmark::State& state) {
 BENCHMARK(BM_DisparityBlockMatching)
     ->ArgNames({"ndisp", "lr"})
     ->Args({32, 1})
+    ->Args({48, 1})
+    ->Args({64, 1})
+    ->Args({64, 0})
+    ->Unit(benchmark::kMillisecond);
+
+// Our block matcher: both views from one cost volume (the pipeline's default).
+void BM_DisparityOneVolume(benchmark::State& state) {
+  vo::DisparityOptions options;
+  options.algorithm = vo::DisparityAlgorithm::kBlockMatchingOneVolume;
+  RunDisparity(state, options);
+}
+BENCHMARK(BM_DisparityOneVolume)
+    ->ArgNames({"ndisp", "lr"})
+    ->Args({32, 1})
+    ->Args({48, 1})
     ->Args({64, 1})
     ->Args({64, 0})
     ->Unit(benchmark::kMillisecond);

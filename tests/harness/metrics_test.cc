@@ -55,6 +55,39 @@ TEST(MetricsTest, HandComputedStraightLine) {
   EXPECT_NEAR(m.drift_deg_per_m, 0.0, kTol);
 }
 
+TEST(MetricsTest, RpeOverADistanceStep) {
+  // Ground truth every 0.25 m along x; the estimate's steps are 10 % too long. With a 1 m
+  // step, frame i pairs with i + 4 (exactly 1 m further): error 0.1 m for each of the
+  // 9 - 4 = 5 pairs of the 9 frames, no rotation.
+  std::vector<Eigen::Isometry3d> gt, est;
+  for (int i = 0; i <= 8; ++i) {
+    gt.push_back(Pose(0.25 * i, 0, 0));
+    est.push_back(Pose(0.275 * i, 0, 0));
+  }
+  harness::TrajectoryMetrics m = harness::ComputeTrajectoryMetrics(est, gt, 1.0);
+  EXPECT_EQ(m.rpe_distance_pairs, 5);
+  EXPECT_NEAR(m.rpe_distance_step_m, 1.0, kTol);
+  EXPECT_NEAR(m.rpe_distance_trans_rmse_m, 0.1, kTol);
+  EXPECT_NEAR(m.rpe_distance_rot_rmse_deg, 0.0, kTol);
+  // A 0.6 m step pairs i with i + 3 (0.75 m): error 0.075 m, 6 pairs.
+  m = harness::ComputeTrajectoryMetrics(est, gt, 0.6);
+  EXPECT_EQ(m.rpe_distance_pairs, 6);
+  EXPECT_NEAR(m.rpe_distance_trans_rmse_m, 0.075, kTol);
+  // A step longer than the path: no pair, zeros.
+  m = harness::ComputeTrajectoryMetrics(est, gt, 5.0);
+  EXPECT_EQ(m.rpe_distance_pairs, 0);
+  EXPECT_EQ(m.rpe_distance_trans_rmse_m, 0.0);
+  // Rotation: a constant yaw-rate error of 0.01 rad per frame over 4 frames -> 0.04 rad.
+  gt.clear();
+  est.clear();
+  for (int i = 0; i <= 8; ++i) {
+    gt.push_back(Pose(0.25 * i, 0, 0));
+    est.push_back(Pose(0.25 * i, 0, 0, 0.01 * i));
+  }
+  m = harness::ComputeTrajectoryMetrics(est, gt, 1.0);
+  EXPECT_NEAR(m.rpe_distance_rot_rmse_deg, 0.04 * 180 / M_PI, 1e-9);
+}
+
 TEST(MetricsTest, EndRotationError) {
   std::vector<Eigen::Isometry3d> gt = {Pose(0, 0, 0), Pose(1, 0, 0, M_PI / 2)};
   std::vector<Eigen::Isometry3d> est = {Pose(0, 0, 0), Pose(1, 0, 0, M_PI / 2 + 0.1)};

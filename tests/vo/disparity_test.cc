@@ -104,6 +104,12 @@ DisparityOptions SemiGlobal() {
   return o;
 }
 
+DisparityOptions OneVolume() {
+  DisparityOptions o;
+  o.algorithm = DisparityAlgorithm::kBlockMatchingOneVolume;
+  return o;
+}
+
 TEST(DisparityOptionsTest, DefaultsAreValid) {
   std::string error;
   EXPECT_TRUE(DisparityOptions().IsValid(&error)) << error;
@@ -186,7 +192,7 @@ TEST(DisparityTest, RejectsInvalidInputs) {
 TEST(DisparityTest, ConstantIntegerShiftIsRecovered) {
   constexpr double kShiftPx = 10.0;
   const SyntheticPair p = PlanarPair(kShiftPx, 0.0, 0.0, 2);
-  for (const DisparityOptions& o : {DisparityOptions(), SemiGlobal()}) {
+  for (const DisparityOptions& o : {DisparityOptions(), SemiGlobal(), OneVolume()}) {
     const DisparityResult r = ComputeDisparity(p.left, p.right, o);
     ASSERT_TRUE(r.ok) << r.message;
     ASSERT_EQ(r.disparity_px.type(), CV_32FC1);
@@ -205,7 +211,7 @@ TEST(DisparityTest, SlantedPlaneSubpixelDisparityIsRecovered) {
   constexpr double kA = 6.3, kB = 0.02, kC = 0.015;
   const double max_gt = kA + kB * (kWidth - 1) + kC * (kHeight - 1);
   const SyntheticPair p = PlanarPair(kA, kB, kC, 3);
-  for (const DisparityOptions& o : {DisparityOptions(), SemiGlobal()}) {
+  for (const DisparityOptions& o : {DisparityOptions(), SemiGlobal(), OneVolume()}) {
     const DisparityResult r = ComputeDisparity(p.left, p.right, o);
     ASSERT_TRUE(r.ok) << r.message;
     const double good = GoodFraction(r.disparity_px, p.gt_px, Interior(o, max_gt), kSubpixelTolPx);
@@ -249,7 +255,7 @@ TEST(DisparityTest, TexturelessImageGivesAlmostNoValidPixels) {
   cv::Mat ramp(kHeight, kWidth, CV_8UC1);
   for (int x = 0; x < kWidth; ++x) ramp.col(x).setTo(60 + x / 8);
   for (const cv::Mat& image : {flat, ramp}) {
-    for (const DisparityOptions& o : {DisparityOptions(), SemiGlobal()}) {
+    for (const DisparityOptions& o : {DisparityOptions(), SemiGlobal(), OneVolume()}) {
       const DisparityResult r = ComputeDisparity(image, image, o);
       ASSERT_TRUE(r.ok) << r.message;
       const double valid = static_cast<double>(r.num_valid) / image.total();
@@ -320,7 +326,7 @@ TEST(DisparityTest, LeftRightCheckRemovesOccludedBand) {
   constexpr double kMinValidWithoutCheck = 0.8;
   constexpr double kMaxValidWithCheck = 0.1;
   const OcclusionScene s = MakeOcclusionScene();
-  for (DisparityOptions o : {DisparityOptions(), SemiGlobal()}) {
+  for (DisparityOptions o : {DisparityOptions(), SemiGlobal(), OneVolume()}) {
     o.uniqueness_ratio = 0;
     o.speckle_window_size = 0;
     o.left_right_max_diff_px = -1.0;
@@ -336,7 +342,7 @@ TEST(DisparityTest, LeftRightCheckRemovesOccludedBand) {
         ToString(o.algorithm), valid_off,
         WrongFraction(off.disparity_px, s.pair.gt_px, s.occluded, kBadPixelThresholdPx), valid_on,
         WrongFraction(on.disparity_px, s.pair.gt_px, s.occluded, kBadPixelThresholdPx));
-    if (o.algorithm == DisparityAlgorithm::kBlockMatching) {
+    if (o.algorithm != DisparityAlgorithm::kSemiGlobal) {
       EXPECT_GT(valid_off, kMinValidWithoutCheck);
     }
     EXPECT_LT(valid_on, kMaxValidWithCheck) << ToString(o.algorithm);
@@ -365,6 +371,61 @@ TEST(DisparityTest, EstimatorIsReusableAndDeterministic) {
   const DisparityResult c = estimator.Compute(p.left(roi), p.right(roi));
   ASSERT_TRUE(c.ok) << c.message;
   EXPECT_EQ(c.disparity_px.size(), roi.size());
+}
+
+// Our one-volume block matcher is cv::StereoBM's correlation: the left view agrees with
+// StereoBM's pixel for pixel (ties and the image border aside), and the right view it takes
+// from the same cost volume gives the same left-right check as StereoBM on the mirrored pair.
+TEST(DisparityTest, OneVolumeMatcherAgreesWithStereoBm) {
+  // Fractions of the pixels valid in both results (measured: see the printout).
+  constexpr double kMinSameLeftView = 0.99;    // identical 1/16 px values, checks off
+  constexpr double kMinSameValidity = 0.98;    // same valid/invalid decision, all filters on
+  const SyntheticPair p = PlanarPair(6.3, 0.02, 0.015, 11);
+  for (bool lr_check : {false, true}) {
+    DisparityOptions bm;
+    bm.left_right_max_diff_px = lr_check ? 1.0 : -1.0;
+    if (!lr_check) {
+      bm.speckle_window_size = 0;
+      bm.min_texture = 0.0;
+    }
+    DisparityOptions one = bm;
+    one.algorithm = DisparityAlgorithm::kBlockMatchingOneVolume;
+    const DisparityResult a = ComputeDisparity(p.left, p.right, bm);
+    const DisparityResult b = ComputeDisparity(p.left, p.right, one);
+    ASSERT_TRUE(a.ok && b.ok) << a.message << b.message;
+    int both = 0, same = 0, same_validity = 0;
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        const float da = a.disparity_px.at<float>(y, x), db = b.disparity_px.at<float>(y, x);
+        same_validity += (da >= 0.0f) == (db >= 0.0f);
+        if (da >= 0.0f && db >= 0.0f) {
+          ++both;
+          same += da == db;
+        }
+      }
+    }
+    const double total = static_cast<double>(kWidth) * kHeight;
+    std::printf("[ one volume vs StereoBM, lr check %d ] valid %d / %d, same value %.4f, "
+                "same validity %.4f\n",
+                lr_check, b.num_valid, a.num_valid, static_cast<double>(same) / both,
+                same_validity / total);
+    ASSERT_GT(both, 0.5 * total);
+    if (!lr_check) {
+      EXPECT_GT(static_cast<double>(same) / both, kMinSameLeftView);
+    }
+    EXPECT_GT(same_validity / total, kMinSameValidity);
+  }
+}
+
+TEST(DisparityOptionsTest, OneVolumeRejectsWindowsThatOverflowItsCosts) {
+  DisparityOptions o = OneVolume();
+  std::string error;
+  EXPECT_TRUE(o.IsValid(&error)) << error;
+  o.block_size = 23;  // 23² · 62 > 32767
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("block_size"), std::string::npos) << error;
+  EXPECT_FALSE(ComputeDisparity(cv::Mat(64, 64, CV_8UC1, cv::Scalar(0)),
+                                cv::Mat(64, 64, CV_8UC1, cv::Scalar(0)), o).ok);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -537,7 +598,7 @@ TEST_P(MiddleburyTest, BadPixelRateAndDensity) {
   cv::minMaxLoc(gt, nullptr, &max_gt);
   max_gt /= p.gt_scale;
 
-  for (DisparityOptions o : {DisparityOptions(), SemiGlobal()}) {
+  for (DisparityOptions o : {DisparityOptions(), SemiGlobal(), OneVolume()}) {
     // Search range: the ground truth's largest disparity plus headroom, rounded up to 16.
     o.num_disparities = 16 * static_cast<int>(std::ceil((max_gt + kRangeHeadroomPx) / 16.0));
     const DisparityResult r = ComputeDisparity(left, right, o);
@@ -548,7 +609,7 @@ TEST_P(MiddleburyTest, BadPixelRateAndDensity) {
                 100.0 * s.bad_rate, 100.0 * s.density);
     EXPECT_LT(s.bad_rate, kMaxBadRate) << p.name << " " << ToString(o.algorithm);
     EXPECT_GT(s.density,
-              o.algorithm == DisparityAlgorithm::kBlockMatching ? kMinDensityBm : kMinDensitySgbm)
+              o.algorithm == DisparityAlgorithm::kSemiGlobal ? kMinDensitySgbm : kMinDensityBm)
         << p.name << " " << ToString(o.algorithm);
   }
 }

@@ -660,10 +660,14 @@ TEST(OdometryOptionsTest, InvalidCameraIsRejectedByCreate) {
 }
 
 TEST(OdometryOptionsTest, DisparityRangeIsDerivedFromTheCamera) {
-  // Hallway rig: 230 · 0.09 / 0.5 = 41.4 px → 48.
+  // Hallway rig: 230 · 0.09 / 0.7 = 29.6 px → 32; nearer cover 0.5 m: 41.4 px → 48.
   StereoOdometry hallway(HallwayCamera(), OdometryOptions());
-  EXPECT_EQ(hallway.options().disparity.num_disparities, 48);
-  // KITTI: 718 · 0.54 / 0.5 = 776 px → clamped to 256.
+  EXPECT_EQ(hallway.options().disparity.num_disparities, 32);
+  OdometryOptions near;
+  near.disparity_min_depth_m = 0.5;
+  StereoOdometry hallway_near(HallwayCamera(), near);
+  EXPECT_EQ(hallway_near.options().disparity.num_disparities, 48);
+  // KITTI: 718 · 0.54 / 0.7 = 555 px → clamped to 256.
   StereoCamera kitti;
   kitti.width = 1241;
   kitti.height = 376;
