@@ -167,6 +167,37 @@ bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::Ste
   return true;
 }
 
+void AccumulateVoMatchStats(const vo::StereoCamera& camera, const GroundTruthFrame& reference,
+                            const GroundTruthFrame& current,
+                            const std::vector<vo::Feature>& reference_features,
+                            const std::vector<vo::Feature>& features,
+                            const std::vector<vo::Match>& matches,
+                            const std::vector<bool>& inlier_mask, const MatchEvalOptions& o,
+                            VoMatchStats* stats) {
+  if (reference.depth_m.empty() || current.depth_m.empty() || matches.empty()) return;
+  bool any = false;
+  for (size_t k = 0; k < matches.size(); ++k) {
+    const vo::Match& m = matches[k];
+    if (m.prev < 0 || m.curr < 0 || m.prev >= static_cast<int>(reference_features.size()) ||
+        m.curr >= static_cast<int>(features.size()))
+      continue;
+    const Eigen::Vector2d& uv = reference_features[m.prev].uv_px;
+    const double z = FeatureDepth(reference.depth_m, uv, o.ambiguous_depth_rel);
+    if (z <= 0.0) continue;
+    Eigen::Vector2d uv_gt;
+    const bool correct =
+        ProjectGroundTruth(camera, reference, current, uv, z, o.depth_agree_rel, &uv_gt) &&
+        (features[m.curr].uv_px - uv_gt).norm() <= o.correct_px;
+    const bool inlier = k < inlier_mask.size() && inlier_mask[k];
+    ++stats->matches;
+    stats->correct += correct;
+    stats->inliers += inlier;
+    stats->inliers_correct += inlier && correct;
+    any = true;
+  }
+  stats->frames += any;
+}
+
 bool WriteMatchEvalCsv(const std::string& path, const std::vector<MatchEvalRow>& rows, std::string* error) {
   std::ostringstream out;
   out << "matcher,stride,pairs,matches,correct,possible,precision,recall,f1,ms_per_pair\n";

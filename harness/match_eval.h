@@ -76,6 +76,29 @@ bool ProjectGroundTruth(const vo::StereoCamera& camera, const GroundTruthFrame& 
                         const GroundTruthFrame& b, const Eigen::Vector2d& uv_px, double depth_m,
                         double depth_agree_rel, Eigen::Vector2d* uv_b_px);
 
+// The VO's own matches of one frame (reference frame -> current) checked against the ground
+// truth, as EvaluateMatchers checks a matcher's: a match counts when its reference feature has
+// an unambiguous ground-truth depth; it is correct when the current feature lies within
+// correct_px of the reference feature's ground-truth projection. Sums over a run.
+struct VoMatchStats {
+  long matches = 0;          // evaluated matches
+  long correct = 0;          // of which correct
+  long inliers = 0;          // evaluated matches that were RANSAC inliers
+  long inliers_correct = 0;  // of which correct
+  int frames = 0;            // frames that contributed
+  double precision() const { return matches > 0 ? static_cast<double>(correct) / matches : 0.0; }
+  double inlier_precision() const {
+    return inliers > 0 ? static_cast<double>(inliers_correct) / inliers : 0.0;
+  }
+};
+void AccumulateVoMatchStats(const vo::StereoCamera& camera, const GroundTruthFrame& reference,
+                            const GroundTruthFrame& current,
+                            const std::vector<vo::Feature>& reference_features,
+                            const std::vector<vo::Feature>& features,
+                            const std::vector<vo::Match>& matches,
+                            const std::vector<bool>& inlier_mask, const MatchEvalOptions& options,
+                            VoMatchStats* stats);
+
 // Writes rows as CSV (header: matcher,stride,pairs,matches,correct,possible,precision,recall,f1,ms_per_pair).
 bool WriteMatchEvalCsv(const std::string& path, const std::vector<MatchEvalRow>& rows,
                        std::string* error);

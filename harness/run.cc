@@ -74,6 +74,9 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
     r << "| ATE RMSE (SE(3)-aligned) | " << Fmt(m.ate_rmse_m) << " m |\n";
     r << "| ATE RMSE (from the common start) | " << Fmt(m.ate_rmse_unaligned_m) << " m |\n";
     r << "| RPE per frame (translation / rotation) | " << Fmt(m.rpe_trans_rmse_m * 1000, 2) << " mm / " << Fmt(m.rpe_rot_rmse_deg, 4) << " deg |\n";
+    if (s.match_stats.matches > 0)
+      r << "| VO matches correct (all / RANSAC inliers), vs ground truth | " << Fmt(100.0 * s.match_stats.precision(), 2) << " % / " << Fmt(100.0 * s.match_stats.inlier_precision(), 2) << " % of " << s.match_stats.matches << " |\n";
+    r << "| RPE per " << Fmt(m.rpe_distance_step_m, 1) << " m (translation / rotation) | " << Fmt(m.rpe_distance_trans_rmse_m * 1000, 1) << " mm / " << Fmt(m.rpe_distance_rot_rmse_deg, 3) << " deg |\n";
     r << "| drift (KITTI-style, 1/8..8/8 of the path) | " << Fmt(m.drift_pct, 3) << " % / " << Fmt(m.drift_deg_per_m, 4) << " deg/m |\n";
     if (s.initial_orientation_error_deg >= 0)
       r << "| initial orientation from planes (error vs GT) | " << (s.initial_orientation_ok ? "found" : "not found") << ", " << Fmt(s.initial_orientation_error_deg, 2) << " deg |\n";
@@ -102,6 +105,14 @@ std::string MetricsJson(const RunSummary& s) {
   j["ate_rmse_unaligned_m"] = m.ate_rmse_unaligned_m;
   j["rpe_trans_rmse_m"] = m.rpe_trans_rmse_m;
   j["rpe_rot_rmse_deg"] = m.rpe_rot_rmse_deg;
+  if (s.match_stats.matches > 0) {
+    j["matches_evaluated"] = s.match_stats.matches;
+    j["match_precision"] = s.match_stats.precision();
+    j["inlier_match_precision"] = s.match_stats.inlier_precision();
+  }
+  j["rpe_distance_step_m"] = m.rpe_distance_step_m;
+  j["rpe_distance_trans_rmse_m"] = m.rpe_distance_trans_rmse_m;
+  j["rpe_distance_rot_rmse_deg"] = m.rpe_distance_rot_rmse_deg;
   j["drift_pct"] = m.drift_pct;
   j["drift_deg_per_m"] = m.drift_deg_per_m;
   j["lost_frames"] = s.lost_frames;
@@ -144,8 +155,30 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   bool has_gt = true;
   Progress progress("vo " + name, expected_frames, options.progress);
   DatasetFrame frame;
+  // Matcher statistics where the ground truth allows (frames with depth and pose): the VO's
+  // matches to its reference frame (the last frame that was not lost) checked against them.
+  VoMatchStats match_stats;
+  const MatchEvalOptions match_eval_options;
+  GroundTruthFrame reference_gt;
+  bool have_reference_gt = false;
   while ((options.max_frames <= 0 || static_cast<int>(results.size()) < options.max_frames) && source(&frame, error)) {
     results.push_back(odometry->Process(frame.left, frame.right, frame.time_s));
+    if (frame.has_gt && !frame.depth_m.empty()) {
+      GroundTruthFrame current;
+      current.depth_m = frame.depth_m;
+      current.T_world_cam0 = frame.T_world_cam0;
+      if (have_reference_gt && results.back().status == vo::TrackingStatus::kTracking) {
+        AccumulateVoMatchStats(camera, reference_gt, current, odometry->last_reference_features(),
+                               odometry->last_features(), odometry->last_matches(),
+                               odometry->last_inlier_mask(), match_eval_options, &match_stats);
+      }
+      if (results.back().status != vo::TrackingStatus::kLost) {
+        reference_gt = current;
+        have_reference_gt = true;
+      }
+    } else {
+      have_reference_gt = false;
+    }
     times.push_back(frame.time_s);
     est.push_back(results.back().T_world_cam0);
     has_gt = has_gt && frame.has_gt;
@@ -185,6 +218,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   s.vo_ms_p95 = Percentile({total.begin() + 1, total.end()}, 95.0);
   for (auto& [k, v] : stages) s.stage_ms_median[k] = Median({v.begin() + 1, v.end()});
   s.features_median = Median(feats);
+  s.match_stats = match_stats;
   s.inliers_median = Median({inl.begin() + 1, inl.end()});
   s.initial_orientation_ok = results.front().initial_orientation_ok;
   if (has_gt && s.initial_orientation_ok)

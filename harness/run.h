@@ -20,6 +20,7 @@
 #include <string>
 
 #include "harness/dataset.h"
+#include "harness/match_eval.h"
 #include "harness/metrics.h"
 #include "sim/scenario.h"
 #include "vo/odometry.h"
@@ -38,6 +39,8 @@ struct RunSummary {
   bool initial_orientation_ok = false;
   double initial_orientation_error_deg = -1.0;  // vs ground truth; < 0 when not known
   bool has_ground_truth = false;
+  VoMatchStats match_stats;  // the VO's matches against the ground truth (simulated runs and
+                             // datasets with depth); matches == 0 when not available
 };
 
 struct RunOptions {

@@ -45,13 +45,21 @@ TEST(RunTest, PapersConfigurationOnTheLHallwayMeetsThePapersFigure) {
   EXPECT_LE(s.metrics.ate_rmse_m, kMaxAteM);
   EXPECT_LE(s.lost_frames, kMaxLostFrames);
   EXPECT_NEAR(s.metrics.path_length_m, 16.0, 0.5);
+  // Matcher statistics from the simulator's depth: the matcher's own precision (match-eval:
+  // 0.986 at stride 1) and that of the RANSAC inliers, which must be nearly all correct.
+  std::printf("VO matches: %ld evaluated, precision %.4f, inliers %.4f\n", s.match_stats.matches,
+              s.match_stats.precision(), s.match_stats.inlier_precision());
+  EXPECT_GT(s.match_stats.matches, 10000);
+  EXPECT_GT(s.match_stats.precision(), 0.95);
+  EXPECT_GT(s.match_stats.inlier_precision(), 0.99);
   // The run folder has what the issue names.
   for (const char* f : {"trajectory_tum.txt", "trajectory_kitti.txt", "groundtruth_tum.txt", "per_frame.csv",
                         "vo_options.yaml", "scenario.yaml", "metrics.json", "report.md"})
     EXPECT_TRUE(fs::exists(fs::path(options.out_dir) / f)) << f;
   const nlohmann::json j = ReadJson(options.out_dir + "/metrics.json");
   for (const char* k : {"frames", "path_length_m", "end_pose_error_m", "end_pose_error_pct", "ate_rmse_m",
-                        "lost_frames", "vo_ms_median", "vo_ms_p95"})
+                        "lost_frames", "vo_ms_median", "vo_ms_p95", "match_precision",
+                        "inlier_match_precision", "rpe_distance_trans_rmse_m"})
     EXPECT_TRUE(j.contains(k)) << k;
   EXPECT_EQ(j["frames"].get<int>(), s.metrics.frames);
   EXPECT_FALSE(fs::exists(options.out_dir + ".partial"));
