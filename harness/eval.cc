@@ -1,0 +1,163 @@
+#include "harness/eval.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <vector>
+
+#include "harness/trajectory_io.h"
+
+namespace harness {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool Fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+int ExpectedFrames(size_t dataset_frames, const RunOptions& options) {
+  const size_t n = options.max_frames > 0
+                       ? std::min(dataset_frames, static_cast<size_t>(options.max_frames))
+                       : dataset_frames;
+  return static_cast<int>(n);
+}
+
+bool EvalKitti(const std::string& dir, const EvalOptions& options,
+               const vo::OdometryOptions& vo_options, const RunOptions& run_options,
+               RunSummary* summary, EvalInfo* info, std::string* error) {
+  KittiReader reader;
+  if (!reader.Open(dir, error)) return false;
+  info->dataset_frames = reader.size();
+  info->camera = reader.camera();
+  // --gt: a TUM trajectory of the left camera, associated by stamp; replaces poses.txt.
+  std::vector<StampedPose> external;
+  std::vector<long> gt_index;
+  if (!options.gt_path.empty()) {
+    if (!ReadTum(options.gt_path, &external, error)) return false;
+    gt_index = AssociateGroundTruth(reader.times_s(), external, info->max_difference_s);
+    info->ground_truth_frames =
+        std::count_if(gt_index.begin(), gt_index.end(), [](long i) { return i >= 0; });
+    if (info->ground_truth_frames == 0)
+      return Fail(error, options.gt_path + ": no ground-truth pose within " +
+                             FormatDouble(info->max_difference_s) + " s of any of the " +
+                             std::to_string(reader.size()) + " frames in " + dir +
+                             "/times.txt: a different clock or the wrong file?");
+    info->ground_truth_path = options.gt_path;
+  } else if (reader.has_ground_truth()) {
+    info->ground_truth_path = (fs::path(dir) / "poses.txt").string();
+    info->ground_truth_frames = reader.size();
+  }
+  size_t next = 0;
+  FrameSource source = [&](DatasetFrame* frame, std::string* err) {
+    if (next >= reader.size()) return false;
+    const size_t i = next++;
+    if (!reader.ReadFrame(i, frame, err)) return false;
+    if (!gt_index.empty()) {
+      frame->has_gt = gt_index[i] >= 0;
+      frame->T_world_cam0 =
+          frame->has_gt ? external[gt_index[i]].T_world_cam : Eigen::Isometry3d::Identity();
+    }
+    return true;
+  };
+  return RunOdometry(DatasetName(dir), reader.camera(), source,
+                     ExpectedFrames(reader.size(), run_options), vo_options, run_options, "",
+                     summary, error);
+}
+
+bool EvalEuroc(const std::string& dir, const EvalOptions& options,
+               const vo::OdometryOptions& vo_options, const RunOptions& run_options,
+               RunSummary* summary, EvalInfo* info, std::string* error) {
+  EurocReader reader;
+  EurocReader::Options reader_options;
+  reader_options.gt_path = options.gt_path;
+  reader_options.gt_max_difference_s = info->max_difference_s;
+  if (!reader.Open(dir, reader_options, error)) return false;
+  StereoRectification rectification;
+  if (!reader.Rectification(options.rectification, &rectification, error)) return false;
+  info->dataset_frames = reader.size();
+  info->unpaired_frames = reader.unpaired_frames();
+  info->ground_truth_path = reader.ground_truth_path();
+  info->ground_truth_frames = reader.ground_truth_frames();
+  info->rectified = !rectification.IsIdentity();
+  info->camera = rectification.camera;
+  size_t next = 0;
+  FrameSource source = [&](DatasetFrame* frame, std::string* err) {
+    if (next >= reader.size()) return false;
+    if (!reader.ReadFrame(next++, frame, err)) return false;
+    RectifyFrame(rectification, frame);
+    return true;
+  };
+  return RunOdometry(DatasetName(dir), rectification.camera, source,
+                     ExpectedFrames(reader.size(), run_options), vo_options, run_options, "",
+                     summary, error);
+}
+
+bool EvalTum(const std::string& dir, const EvalOptions& options,
+             const vo::OdometryOptions& vo_options, const RunOptions& run_options,
+             RunSummary* summary, EvalInfo* info, std::string* error) {
+  TumReader reader;
+  TumReader::Options reader_options;
+  reader_options.gt_path = options.gt_path;
+  reader_options.gt_max_difference_s = info->max_difference_s;
+  if (!reader.Open(dir, reader_options, error)) return false;
+  info->dataset_frames = reader.size();
+  info->unpaired_frames = reader.unpaired_frames();
+  info->ground_truth_path = reader.ground_truth_path();
+  info->ground_truth_frames = reader.ground_truth_frames();
+  info->camera = reader.camera();
+  size_t next = 0;
+  FrameSource source = [&](DatasetFrame* frame, std::string* err) {
+    if (next >= reader.size()) return false;
+    return reader.ReadFrame(next++, frame, err);
+  };
+  return RunOdometry(DatasetName(dir), reader.camera(), source,
+                     ExpectedFrames(reader.size(), run_options), vo_options, run_options, "",
+                     summary, error);
+}
+
+}  // namespace
+
+bool EvalOptions::IsValid(std::string* error) const {
+  if (format != DatasetFormat::kKitti && format != DatasetFormat::kEuroc &&
+      format != DatasetFormat::kTum)
+    return Fail(error, "format must be kitti, euroc or tum");
+  if (!std::isfinite(max_difference_s) || max_difference_s < 0.0)
+    return Fail(error, "max difference must be finite and >= 0 (0 = the format's default), got " +
+                           FormatDouble(max_difference_s));
+  return rectification.IsValid(error);
+}
+
+double DefaultMaxDifference(DatasetFormat format) {
+  return format == DatasetFormat::kEuroc ? EurocReader::Options().gt_max_difference_s
+                                         : TumReader::Options().gt_max_difference_s;
+}
+
+std::string DatasetName(const std::string& dir) {
+  fs::path p = fs::path(dir).lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();  // "seq/" -> "seq"
+  const std::string name = p.filename().string();
+  return name.empty() || name == "." || name == ".." ? "dataset" : name;
+}
+
+bool EvalDataset(const std::string& dir, const EvalOptions& options,
+                 const vo::OdometryOptions& vo_options, const RunOptions& run_options,
+                 RunSummary* summary, EvalInfo* info, std::string* error) {
+  std::string why;
+  if (!options.IsValid(&why)) return Fail(error, "eval options: " + why);
+  *info = EvalInfo();
+  info->max_difference_s =
+      options.max_difference_s > 0.0 ? options.max_difference_s : DefaultMaxDifference(options.format);
+  switch (options.format) {
+    case DatasetFormat::kKitti:
+      return EvalKitti(dir, options, vo_options, run_options, summary, info, error);
+    case DatasetFormat::kEuroc:
+      return EvalEuroc(dir, options, vo_options, run_options, summary, info, error);
+    case DatasetFormat::kTum:
+      return EvalTum(dir, options, vo_options, run_options, summary, info, error);
+  }
+  return Fail(error, "unknown dataset format");
+}
+
+}  // namespace harness
