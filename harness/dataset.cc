@@ -186,15 +186,11 @@ bool ParseInt64(std::string_view text, int64_t* value) {
 
 double NsToSeconds(int64_t t_ns) { return static_cast<double>(t_ns) / 1e9; }
 
-// File name stem of a TUM-style image: the stamp with 9 decimals, from the integer nanoseconds
-// (exact, unique per frame because the writer's stamps are distinct in ns).
-std::string TumStampName(int64_t t_ns) {
-  const bool negative = t_ns < 0;
-  const uint64_t a = negative ? 0 - static_cast<uint64_t>(t_ns) : static_cast<uint64_t>(t_ns);
-  char name[48];
-  std::snprintf(name, sizeof(name), "%s%llu.%09llu", negative ? "-" : "",
-                static_cast<unsigned long long>(a / 1000000000ull),
-                static_cast<unsigned long long>(a % 1000000000ull));
+// File name stem of a TUM-style image: the stamp with 9 decimals (the decimal value of the
+// double, correctly rounded; t_ns = llround(t * 1e9) is off by ~100 ns at 1.3e9 s).
+std::string TumStampName(double time_s) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "%.9f", time_s);
   return name;
 }
 
@@ -317,6 +313,10 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
   if (index > 0 && t_ns <= times_ns_.back())
     return Fail(error, what + "time " + FormatDouble(frame.time_s) +
                            " s is not after the previous frame's (need strictly increasing ns)");
+  if (options_.format == DatasetFormat::kTum && index > 0 &&
+      TumStampName(frame.time_s) == TumStampName(times_s_.back()))
+    return Fail(error, what + "time " + FormatDouble(frame.time_s) +
+                           " s gives the previous frame's TUM image name (stamps closer than 1 ns)");
   if (frame.left.type() != CV_8UC1 || frame.left.size() != size)
     return Fail(error, what + "left image must be CV_8UC1 " + std::to_string(size.width) + "x" +
                            std::to_string(size.height) + ", got type " +
@@ -358,7 +358,8 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
         !WriteBytes(Join(partial_dir_, "mav0/cam" + cam_name + "/data/" + png_ns), png, error))
       return false;
     if (options_.format == DatasetFormat::kTum &&
-        !WriteBytes(Join(partial_dir_, (cam == 0 ? "left/" : "right/") + TumStampName(t_ns) + ".png"),
+        !WriteBytes(Join(partial_dir_, (cam == 0 ? "left/" : "right/") + TumStampName(frame.time_s) +
+                                           ".png"),
                     png, error))
       return false;
   }
@@ -431,7 +432,7 @@ bool DatasetWriter::WriteTumText(std::string* error) const {
     std::string list = std::string("# ") + names[cam] +
                        " images (vobench TUM-style stereo layout)\n# timestamp filename\n";
     for (size_t i = 0; i < times_s_.size(); ++i)
-      list += FormatDouble(times_s_[i]) + " " + names[cam] + "/" + TumStampName(times_ns_[i]) +
+      list += FormatDouble(times_s_[i]) + " " + names[cam] + "/" + TumStampName(times_s_[i]) +
               ".png\n";
     if (!WriteTextFile(Join(partial_dir_, std::string(names[cam]) + ".txt"), list, error))
       return false;
