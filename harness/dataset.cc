@@ -315,8 +315,9 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
                            " s is not after the previous frame's (need strictly increasing ns)");
   if (options_.format == DatasetFormat::kTum && index > 0 &&
       TumStampName(frame.time_s) == TumStampName(times_s_.back()))
-    return Fail(error, what + "time " + FormatDouble(frame.time_s) +
-                           " s gives the previous frame's TUM image name (stamps closer than 1 ns)");
+    return Fail(error,
+                what + "time " + FormatDouble(frame.time_s) +
+                    " s gives the previous frame's TUM image name (stamps closer than 1 ns)");
   if (frame.left.type() != CV_8UC1 || frame.left.size() != size)
     return Fail(error, what + "left image must be CV_8UC1 " + std::to_string(size.width) + "x" +
                            std::to_string(size.height) + ", got type " +
@@ -358,8 +359,8 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
         !WriteBytes(Join(partial_dir_, "mav0/cam" + cam_name + "/data/" + png_ns), png, error))
       return false;
     if (options_.format == DatasetFormat::kTum &&
-        !WriteBytes(Join(partial_dir_, (cam == 0 ? "left/" : "right/") + TumStampName(frame.time_s) +
-                                           ".png"),
+        !WriteBytes(Join(partial_dir_,
+                         (cam == 0 ? "left/" : "right/") + TumStampName(frame.time_s) + ".png"),
                     png, error))
       return false;
   }
@@ -432,8 +433,8 @@ bool DatasetWriter::WriteTumText(std::string* error) const {
     std::string list = std::string("# ") + names[cam] +
                        " images (vobench TUM-style stereo layout)\n# timestamp filename\n";
     for (size_t i = 0; i < times_s_.size(); ++i)
-      list += FormatDouble(times_s_[i]) + " " + names[cam] + "/" + TumStampName(times_s_[i]) +
-              ".png\n";
+      list +=
+          FormatDouble(times_s_[i]) + " " + names[cam] + "/" + TumStampName(times_s_[i]) + ".png\n";
     if (!WriteTextFile(Join(partial_dir_, std::string(names[cam]) + ".txt"), list, error))
       return false;
   }
@@ -829,7 +830,8 @@ std::vector<long> AssociateGroundTruth(const std::vector<double>& frame_times_s,
 namespace {
 
 size_t CountAssociated(const std::vector<long>& index) {
-  return static_cast<size_t>(std::count_if(index.begin(), index.end(), [](long i) { return i >= 0; }));
+  return static_cast<size_t>(
+      std::count_if(index.begin(), index.end(), [](long i) { return i >= 0; }));
 }
 
 // Error for a ground truth that no frame associates with (different clocks, wrong file).
@@ -907,8 +909,8 @@ bool ComputeStereoRectification(const EurocCameraCalibration& cam0,
   const EurocCameraCalibration* cams[2] = {&cam0, &cam1};
   for (int k = 0; k < 2; ++k) {
     const EurocCameraCalibration& c = *cams[k];
-    const std::string where = (c.path.empty() ? "cam" + std::to_string(k) + " calibration"
-                                              : c.path) + ": ";
+    const std::string where =
+        (c.path.empty() ? "cam" + std::to_string(k) + " calibration" : c.path) + ": ";
     if (c.camera_model != "pinhole")
       return Fail(error, where + "camera_model '" + c.camera_model +
                              "' is not supported (expected pinhole)");
@@ -940,9 +942,11 @@ bool ComputeStereoRectification(const EurocCameraCalibration& cam0,
   // Already rectified: the identity, images used as they are.
   double max_distortion = 0.0;
   for (const EurocCameraCalibration* c : cams)
-    for (double d : c->distortion_coefficients) max_distortion = std::max(max_distortion, std::abs(d));
-  const double dk = std::max({std::abs(cam0.fu_px - cam1.fu_px), std::abs(cam0.fv_px - cam1.fv_px),
-                              std::abs(cam0.cu_px - cam1.cu_px), std::abs(cam0.cv_px - cam1.cv_px)});
+    for (double d : c->distortion_coefficients)
+      max_distortion = std::max(max_distortion, std::abs(d));
+  const double dk =
+      std::max({std::abs(cam0.fu_px - cam1.fu_px), std::abs(cam0.fv_px - cam1.fv_px),
+                std::abs(cam0.cu_px - cam1.cu_px), std::abs(cam0.cv_px - cam1.cv_px)});
   const double dr = (T_cam0_cam1.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!equidistant && max_distortion <= options.identity_distortion_tolerance &&
       dk <= options.identity_intrinsics_tolerance_px && dr <= options.identity_rotation_tolerance &&
@@ -998,12 +1002,13 @@ bool ComputeStereoRectification(const EurocCameraCalibration& cam0,
         cv::initUndistortRectifyMap(K0, D0, R1, P1, size, CV_32FC1, r.map0_x, r.map0_y);
         cv::initUndistortRectifyMap(K1, D1, R2, P2, size, CV_32FC1, r.map1_x, r.map1_y);
       }
-      if (options.alpha > 0.0 || (MapInside(r.map0_x, r.map0_y, size) &&
-                                  MapInside(r.map1_x, r.map1_y, size)))
+      if (options.alpha > 0.0 ||
+          (MapInside(r.map0_x, r.map0_y, size) && MapInside(r.map1_x, r.map1_y, size)))
         break;
       if (attempt == kMaxRectificationZoomSteps)
-        return Fail(error, where + "rectification: no zoom puts every rectified pixel inside the "
-                                   "raw images (extreme distortion?); try a larger alpha");
+        return Fail(error, where +
+                               "rectification: no zoom puts every rectified pixel inside the "
+                               "raw images (extreme distortion?); try a larger alpha");
       for (cv::Mat* P : {&P1, &P2}) {
         P->at<double>(0, 0) *= kRectificationZoomStep;
         P->at<double>(1, 1) *= kRectificationZoomStep;
@@ -1203,8 +1208,9 @@ bool TumReader::Open(const std::string& dir, const Options& options, std::string
   dir_ = NormalizeDir(dir);
   if (!(options_.gt_max_difference_s > 0.0) || !std::isfinite(options_.gt_max_difference_s) ||
       !(options_.stereo_max_difference_s > 0.0) || !std::isfinite(options_.stereo_max_difference_s))
-    return Fail(error, "TumReader options: gt_max_difference_s and stereo_max_difference_s must "
-                       "be finite and > 0");
+    return Fail(error,
+                "TumReader options: gt_max_difference_s and stereo_max_difference_s must "
+                "be finite and > 0");
   std::error_code ec;
   if (!fs::is_directory(dir_, ec)) return Fail(error, dir_ + ": dataset folder not found");
   if (!ReadKittiCalib(Join(dir_, "calib.txt"), &camera_, error)) return false;

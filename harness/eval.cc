@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <vector>
 
 #include "harness/trajectory_io.h"
@@ -24,17 +25,41 @@ int ExpectedFrames(size_t dataset_frames, const RunOptions& options) {
   return static_cast<int>(n);
 }
 
+// Number of fields on the first line that is not blank or a comment (0 when none or unreadable).
+size_t FirstLineFields(const std::string& path) {
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, nullptr)) return 0;
+  for (const std::string& line : lines) {
+    if (IsBlankOrComment(line)) continue;
+    std::string text = line;
+    std::replace(text.begin(), text.end(), ',', ' ');
+    std::istringstream in(text);
+    size_t n = 0;
+    for (std::string field; in >> field;) ++n;
+    return n;
+  }
+  return 0;
+}
+
 bool EvalKitti(const std::string& dir, const EvalOptions& options,
                const vo::OdometryOptions& vo_options, const RunOptions& run_options,
                RunSummary* summary, EvalInfo* info, std::string* error) {
+  // --gt in the KITTI poses format (12 numbers per line, one per frame, the KITTI benchmark's
+  // poses/NN.txt) goes to the reader; a TUM trajectory is associated by stamp below.
+  const bool kitti_poses = !options.gt_path.empty() && FirstLineFields(options.gt_path) == 12;
   KittiReader reader;
-  if (!reader.Open(dir, error)) return false;
+  KittiReader::Options reader_options;
+  if (kitti_poses) reader_options.poses_path = options.gt_path;
+  if (!reader.Open(dir, reader_options, error)) return false;
   info->dataset_frames = reader.size();
   info->camera = reader.camera();
   // --gt: a TUM trajectory of the left camera, associated by stamp; replaces poses.txt.
   std::vector<StampedPose> external;
   std::vector<long> gt_index;
-  if (!options.gt_path.empty()) {
+  if (kitti_poses) {
+    info->ground_truth_path = options.gt_path;
+    info->ground_truth_frames = reader.size();
+  } else if (!options.gt_path.empty()) {
     if (!ReadTum(options.gt_path, &external, error)) return false;
     gt_index = AssociateGroundTruth(reader.times_s(), external, info->max_difference_s);
     info->ground_truth_frames =
@@ -147,8 +172,8 @@ bool EvalDataset(const std::string& dir, const EvalOptions& options,
   std::string why;
   if (!options.IsValid(&why)) return Fail(error, "eval options: " + why);
   *info = EvalInfo();
-  info->max_difference_s =
-      options.max_difference_s > 0.0 ? options.max_difference_s : DefaultMaxDifference(options.format);
+  info->max_difference_s = options.max_difference_s > 0.0 ? options.max_difference_s
+                                                          : DefaultMaxDifference(options.format);
   switch (options.format) {
     case DatasetFormat::kKitti:
       return EvalKitti(dir, options, vo_options, run_options, summary, info, error);

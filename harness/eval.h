@@ -2,7 +2,8 @@
 // layout (dataset.h), with the same run folder, table and metrics as `vobench run`.
 //
 //   kitti  calib.txt, times.txt, image_0/, image_1/; ground truth: poses.txt (one per frame,
-//          with T_world_cam0first.txt when present) or --gt (TUM, left camera, associated).
+//          with T_world_cam0first.txt when present) or --gt (TUM, left camera, associated; or
+//          KITTI poses such as the benchmark's poses/NN.txt).
 //   euroc  mav0/cam{0,1}/{data.csv,sensor.yaml,data/}; the raw pair is undistorted and
 //          rectified from the two sensor.yaml files (ComputeStereoRectification) before the VO
 //          sees it; ground truth: the body pose (EuRoC's data.csv, or TUM groundtruth_tum.txt /
@@ -31,9 +32,11 @@ struct EvalOptions {
   DatasetFormat format = DatasetFormat::kKitti;  // layout of the dataset folder
   std::string gt_path;  // ground truth, TUM format ("t tx ty tz qx qy qz qw"): the left camera
                         // for kitti/tum, the body (IMU) frame for euroc (a .csv name: EuRoC's
-                        // state_groundtruth_estimate0 format). "" = the layout's own, if any
-  double max_difference_s = 0.0;  // largest |t_frame - t_gt| associated (seconds), >= 0;
-                                  // 0 = DefaultMaxDifference(format)
+                        // state_groundtruth_estimate0 format). For kitti also a KITTI poses file
+                        // (12 numbers per line, one per frame, in the first camera's frame),
+                        // told by its field count. "" = the layout's own, if any
+  double max_difference_s = 0.0;       // largest |t_frame - t_gt| associated (seconds), >= 0;
+                                       // 0 = DefaultMaxDifference(format)
   RectificationOptions rectification;  // EuRoC raw pairs
 
   bool IsValid(std::string* error) const;
@@ -44,11 +47,11 @@ double DefaultMaxDifference(DatasetFormat format);
 
 // What the dataset held, for the report.
 struct EvalInfo {
-  size_t dataset_frames = 0;   // stereo frames in the dataset (before --max-frames)
-  size_t unpaired_frames = 0;  // images without a partner in the other camera (euroc, tum)
+  size_t dataset_frames = 0;       // stereo frames in the dataset (before --max-frames)
+  size_t unpaired_frames = 0;      // images without a partner in the other camera (euroc, tum)
   std::string ground_truth_path;   // "" when there is none
   size_t ground_truth_frames = 0;  // dataset frames with an associated ground-truth pose
-  double max_difference_s = 0.0;  // the association tolerance used (seconds)
+  double max_difference_s = 0.0;   // the association tolerance used (seconds)
   bool rectified = false;          // the raw pair was remapped (euroc with a real raw pair)
   vo::StereoCamera camera;         // the camera the VO ran with (rectified for euroc)
 };

@@ -10,14 +10,17 @@ namespace harness {
 std::shared_ptr<EvalCommand> AddEvalCommand(CLI::App& app) {
   auto c = std::make_shared<EvalCommand>();
   c->app = app.add_subcommand(
-      "eval", "Run the VO on a recorded stereo sequence (KITTI, EuRoC or TUM-style layout) and, "
-              "where ground truth is present, compute the same metrics as `run`");
+      "eval",
+      "Run the VO on a recorded stereo sequence (KITTI, EuRoC or TUM-style layout) and, "
+      "where ground truth is present, compute the same metrics as `run`");
   c->app->add_option("--dataset", c->dataset, "Dataset folder")->required();
   c->app->add_option("--format", c->format, "Dataset layout: kitti, euroc or tum")->required();
   c->app->add_option("--gt", c->gt,
                      "Ground truth, TUM format (t tx ty tz qx qy qz qw): the left camera for "
-                     "kitti/tum, the body/IMU for euroc (default: the dataset's own, if any)");
-  c->app->add_option("--config", c->config, "VO options (YAML; see a run folder's vo_options.yaml)");
+                     "kitti/tum, the body/IMU for euroc; for kitti also KITTI poses (12 numbers "
+                     "per line). Default: the dataset's own, if any");
+  c->app->add_option("--config", c->config,
+                     "VO options (YAML; see a run folder's vo_options.yaml)");
   c->app->add_option("--out,-o", c->out,
                      "Run folder (default out/eval/<dataset folder name>); an earlier run there is "
                      "replaced");
@@ -80,7 +83,7 @@ int EvalCommand::Run(const PrintTable& print_table) const {
   if (info.ground_truth_path.empty()) {
     std::printf("ground truth    none: trajectory and per-frame log only, no accuracy metrics\n");
   } else {
-    std::printf("ground truth    %s: %zu of %zu frames associated (max difference %g s)", 
+    std::printf("ground truth    %s: %zu of %zu frames associated (max difference %g s)",
                 info.ground_truth_path.c_str(), info.ground_truth_frames, info.dataset_frames,
                 info.max_difference_s);
     std::printf("; metrics over the %d run frames with ground truth\n",

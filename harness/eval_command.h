@@ -5,11 +5,10 @@
 // arguments or VO config. Nothing is written to --out on failure.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <memory>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "harness/run.h"
 

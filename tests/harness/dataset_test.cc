@@ -667,7 +667,8 @@ TEST_F(EurocMalformedTest, RealEurocSensorYamlReadsAndResolutionsMustAgree) {
   ASSERT_TRUE(reader.Open(dir_, &error)) << error;
   StereoRectification rect;
   EXPECT_FALSE(reader.Rectification(&rect, &error));
-  EXPECT_THAT(error, HasSubstr(dir_ + "/mav0/cam0/sensor.yaml, " + dir_ + "/mav0/cam1/sensor.yaml"));
+  EXPECT_THAT(error,
+              HasSubstr(dir_ + "/mav0/cam0/sensor.yaml, " + dir_ + "/mav0/cam1/sensor.yaml"));
   EXPECT_THAT(error, HasSubstr("cam0 and cam1 resolutions differ (752x480 vs 64x48)"));
   DatasetFrame f;  // the images are 64x48, the yaml says 752x480
   EXPECT_FALSE(reader.ReadFrame(0, &f, &error));

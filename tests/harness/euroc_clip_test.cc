@@ -40,7 +40,7 @@ constexpr double kMaxStandStillDisplacementM = 0.03;
 constexpr double kMaxStandStillAteM = 0.01;
 constexpr int kMaxStandStillLostFrames = 1;
 
-#define SKIP_WITHOUT_CLIP()                                                     \
+#define SKIP_WITHOUT_CLIP() \
   if (!fs::is_directory(kClip)) GTEST_SKIP() << kClip << " not found: skipped"
 
 // Median |dy| of SIFT matches (ratio test + mutual) between a left and a right image, over
@@ -130,13 +130,15 @@ TEST(EurocClipTest, StandingStillRunStaysAtItsStart) {
   double max_displacement_m = 0.0;
   for (const StampedPose& p : est) {
     ASSERT_TRUE(p.T_world_cam.matrix().allFinite());
-    max_displacement_m = std::max(
-        max_displacement_m, (p.T_world_cam.translation() - est[0].T_world_cam.translation()).norm());
+    max_displacement_m =
+        std::max(max_displacement_m,
+                 (p.T_world_cam.translation() - est[0].T_world_cam.translation()).norm());
   }
-  std::printf("standing still: max displacement %.4f m, end-pose error %.4f m, ATE %.4f m, "
-              "ground-truth path %.4f m, lost %d\n",
-              max_displacement_m, s.metrics.end_pose_error_m, s.metrics.ate_rmse_m,
-              s.metrics.path_length_m, s.lost_frames);
+  std::printf(
+      "standing still: max displacement %.4f m, end-pose error %.4f m, ATE %.4f m, "
+      "ground-truth path %.4f m, lost %d\n",
+      max_displacement_m, s.metrics.end_pose_error_m, s.metrics.ate_rmse_m, s.metrics.path_length_m,
+      s.lost_frames);
   EXPECT_LE(max_displacement_m, kMaxStandStillDisplacementM);
   EXPECT_LE(s.metrics.ate_rmse_m, kMaxStandStillAteM);
   EXPECT_LE(s.metrics.end_pose_error_m, kMaxStandStillDisplacementM);
@@ -211,17 +213,21 @@ TEST(EurocClipTest, OneRealOdometryStepMatchesTheGroundTruth) {
   // The moving pairs' calibration files: the same camera, slightly different keys.
   EurocCameraCalibration cam[2];
   std::string error;
-  ASSERT_TRUE(ReadEurocSensorYaml(kClip + "/moving_pairs/sensorLeft.yaml", &cam[0], &error)) << error;
-  ASSERT_TRUE(ReadEurocSensorYaml(kClip + "/moving_pairs/sensorRight.yaml", &cam[1], &error)) << error;
+  ASSERT_TRUE(ReadEurocSensorYaml(kClip + "/moving_pairs/sensorLeft.yaml", &cam[0], &error))
+      << error;
+  ASSERT_TRUE(ReadEurocSensorYaml(kClip + "/moving_pairs/sensorRight.yaml", &cam[1], &error))
+      << error;
   StereoRectification r;
-  ASSERT_TRUE(ComputeStereoRectification(cam[0], cam[1], RectificationOptions(), &r, &error)) << error;
+  ASSERT_TRUE(ComputeStereoRectification(cam[0], cam[1], RectificationOptions(), &r, &error))
+      << error;
 
   MovingPair a, b;  // img_3 (earlier), img_2 (0.5 s later)
   ASSERT_TRUE(ReadMovingPair(3, &a, &error)) << error;
   ASSERT_TRUE(ReadMovingPair(2, &b, &error)) << error;
   ASSERT_NEAR(b.time_s - a.time_s, 0.5, 1e-3);
   // Ground-truth step of the rectified left camera, T_rect0(a)_rect0(b), from either body pose.
-  auto gt_step = [&](const Eigen::Isometry3d& T_world_body_a, const Eigen::Isometry3d& T_world_body_b) {
+  auto gt_step = [&](const Eigen::Isometry3d& T_world_body_a,
+                     const Eigen::Isometry3d& T_world_body_b) {
     DatasetFrame fa, fb;
     fa.has_gt = fb.has_gt = true;
     fa.T_world_cam0 = T_world_body_a * cam[0].T_body_cam;
@@ -231,7 +237,8 @@ TEST(EurocClipTest, OneRealOdometryStepMatchesTheGroundTruth) {
     RectifyFrame(r, &fb);
     return Eigen::Isometry3d(fa.T_world_cam0.inverse() * fb.T_world_cam0);
   };
-  const Eigen::Isometry3d T_a_b_original = gt_step(a.T_world_body_original, b.T_world_body_original);
+  const Eigen::Isometry3d T_a_b_original =
+      gt_step(a.T_world_body_original, b.T_world_body_original);
   const Eigen::Isometry3d T_a_b_recomputed =
       gt_step(a.T_world_body_recomputed, b.T_world_body_recomputed);
   EXPECT_NEAR(T_a_b_original.translation().norm(), 0.32, 0.01);

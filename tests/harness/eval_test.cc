@@ -73,8 +73,8 @@ RunOptions QuietRun(const std::string& out_dir) {
 class EvalTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() /
-                         ("vobench_eval_" + std::to_string(::getpid())));
+    root_ =
+        new fs::path(fs::temp_directory_path() / ("vobench_eval_" + std::to_string(::getpid())));
     fs::remove_all(*root_);
     fs::create_directories(*root_);
     const std::string scenario_path = (*root_ / "short.yaml").string();
@@ -142,8 +142,9 @@ sim::Scenario* EvalTest::scenario_ = nullptr;
 RunSummary* EvalTest::run_ = nullptr;
 
 void ExpectSameAccuracy(const nlohmann::json& a, const nlohmann::json& b, const std::string& what) {
-  for (const char* k : {"path_length_m", "end_pose_error_m", "end_rotation_error_deg", "ate_rmse_m",
-                        "ate_rmse_unaligned_m", "rpe_trans_rmse_m", "rpe_rot_rmse_deg", "drift_pct"}) {
+  for (const char* k :
+       {"path_length_m", "end_pose_error_m", "end_rotation_error_deg", "ate_rmse_m",
+        "ate_rmse_unaligned_m", "rpe_trans_rmse_m", "rpe_rot_rmse_deg", "drift_pct"}) {
     ASSERT_TRUE(a.contains(k) && b.contains(k)) << what << ": " << k;
     EXPECT_NEAR(a[k].get<double>(), b[k].get<double>(), kMetricTolerance) << what << ": " << k;
   }
@@ -171,7 +172,8 @@ TEST_F(EvalTest, SimulatorExportsInEachFormatGiveTheRunsTrajectoryAndMetrics) {
     EvalInfo info;
     std::string error;
     const std::string out = (dir_ / name).string();
-    ASSERT_TRUE(EvalDataset(c.dir, options, vo::OdometryOptions(), QuietRun(out), &s, &info, &error))
+    ASSERT_TRUE(
+        EvalDataset(c.dir, options, vo::OdometryOptions(), QuietRun(out), &s, &info, &error))
         << name << ": " << error;
     EXPECT_FALSE(info.rectified) << name;  // the simulator's pair is ideal: images untouched
     EXPECT_EQ(info.ground_truth_frames, static_cast<size_t>(run_->metrics.frames)) << name;
@@ -207,8 +209,8 @@ TEST_F(EvalTest, CommandPrintsTheRunTableAndWritesTheDefaultFolder) {
                      ReadJson(RunDir() + "/metrics.json"), "cli");
   // `vobench run --dataset` keeps reading the KITTI layout.
   const std::string kitti_run = (dir_ / "kitti_run").string();
-  const CommandResult k = RunVobench("run --dataset " + data + " --out " + kitti_run +
-                                     " -q --no-plots --max-frames 4");
+  const CommandResult k =
+      RunVobench("run --dataset " + data + " --out " + kitti_run + " -q --no-plots --max-frames 4");
   ASSERT_EQ(k.exit_code, 0) << k.output;
   EXPECT_EQ(ReadJson(kitti_run + "/metrics.json")["frames"], 4);
 }
@@ -266,7 +268,7 @@ TEST_F(EvalTest, GroundTruthAtAnotherRateCoveringPartOfTheFrames) {
   EXPECT_THAT(csv, HasSubstr(",nan,nan,nan\n"));  // frames without ground truth
 }
 
-TEST_F(EvalTest, KittiWithAGroundTruthFileInTumFormat) {
+TEST_F(EvalTest, KittiWithAGroundTruthFileInTumOrKittiFormat) {
   const std::string data = Copy(DatasetFormat::kTum);
   EvalOptions options;
   options.format = DatasetFormat::kKitti;
@@ -278,13 +280,22 @@ TEST_F(EvalTest, KittiWithAGroundTruthFileInTumFormat) {
       << error;
   EXPECT_EQ(info.ground_truth_path, data + "/groundtruth.txt");
   ExpectSameAccuracy(ReadJson(Out() + "/metrics.json"), ReadJson(RunDir() + "/metrics.json"), "gt");
+  // The KITTI benchmark's way: poses in a file of their own (poses/NN.txt), told by 12 fields.
+  fs::create_directories(data + "/poses");
+  fs::rename(data + "/poses.txt", data + "/poses/00.txt");
+  options.gt_path = data + "/poses/00.txt";
+  ASSERT_TRUE(EvalDataset(data, options, vo::OdometryOptions(), QuietRun(Out()), &s, &info, &error))
+      << error;
+  EXPECT_EQ(info.ground_truth_path, data + "/poses/00.txt");
+  ExpectSameAccuracy(ReadJson(Out() + "/metrics.json"), ReadJson(RunDir() + "/metrics.json"),
+                     "kitti poses");
 }
 
 TEST_F(EvalTest, WithoutGroundTruthTheRunHasNoAccuracyMetrics) {
   const std::string data = Copy(DatasetFormat::kTum);
   fs::remove(data + "/groundtruth.txt");
-  const CommandResult r = RunVobench("eval --dataset " + data + " --format tum --out " + Out() +
-                                     " -q --no-plots");
+  const CommandResult r =
+      RunVobench("eval --dataset " + data + " --format tum --out " + Out() + " -q --no-plots");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("ground truth    none: trajectory and per-frame log only"));
   EXPECT_THAT(r.output, Not(HasSubstr("ATE RMSE")));

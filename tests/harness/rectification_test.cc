@@ -36,8 +36,8 @@ Eigen::Vector2d ProjectEquidistant(const EurocCameraCalibration& c, const Eigen:
   const double x = p.x() / p.z(), y = p.y() / p.z(), r = std::hypot(x, y);
   const double theta = std::atan(r), t2 = theta * theta;
   const std::vector<double>& k = c.distortion_coefficients;
-  const double theta_d = theta * (1 + k[0] * t2 + k[1] * t2 * t2 + k[2] * t2 * t2 * t2 +
-                                  k[3] * t2 * t2 * t2 * t2);
+  const double theta_d =
+      theta * (1 + k[0] * t2 + k[1] * t2 * t2 + k[2] * t2 * t2 * t2 + k[3] * t2 * t2 * t2 * t2);
   const double s = r > 1e-12 ? theta_d / r : 1.0;
   return {c.fu_px * s * x + c.cu_px, c.fv_px * s * y + c.cv_px};
 }
@@ -51,7 +51,8 @@ Eigen::Isometry3d Pose(double angle_rad, const Eigen::Vector3d& axis, const Eige
 
 // A raw pair like EuRoC's: different intrinsics and distortion per camera, cam1 ~11 cm to the
 // right, turned by ~1 deg, both mounted rotated in the body.
-void MakePair(const std::string& model, EurocCameraCalibration* cam0, EurocCameraCalibration* cam1) {
+void MakePair(const std::string& model, EurocCameraCalibration* cam0,
+              EurocCameraCalibration* cam1) {
   for (EurocCameraCalibration* c : {cam0, cam1}) {
     c->camera_model = "pinhole";
     c->distortion_model = model;
@@ -88,7 +89,8 @@ void ExpectKnownAnswer(const EurocCameraCalibration& cam0, const EurocCameraCali
   // rect1 = rect0 moved by +baseline along x, same orientation.
   const Eigen::Matrix3d R_rect0_rect1 =
       r.R_cam0_rect0.transpose() * T_cam0_cam1.linear() * r.R_cam1_rect1;
-  EXPECT_LT((R_rect0_rect1 - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), kGeometryTolerance);
+  EXPECT_LT((R_rect0_rect1 - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(),
+            kGeometryTolerance);
   const Eigen::Vector3d t_rect0_rect1 = r.R_cam0_rect0.transpose() * T_cam0_cam1.translation();
   EXPECT_NEAR(t_rect0_rect1.x(), k.baseline_m, kGeometryTolerance);
   EXPECT_NEAR(t_rect0_rect1.y(), 0.0, kGeometryTolerance);
@@ -160,7 +162,7 @@ TEST(RectificationTest, AlphaZeroSamplesOnlyInsideTheRawImagesAlphaOneKeepsEvery
   };
   EXPECT_TRUE(inside(r0.map0_x, r0.map0_y));
   EXPECT_TRUE(inside(r0.map1_x, r0.map1_y));
-  EXPECT_FALSE(inside(r1.map0_x, r1.map0_y));  // black borders: the whole raw view is kept
+  EXPECT_FALSE(inside(r1.map0_x, r1.map0_y));   // black borders: the whole raw view is kept
   EXPECT_LT(r1.camera.fx_px, r0.camera.fx_px);  // ... at a smaller focal length
 }
 

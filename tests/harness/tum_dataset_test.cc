@@ -38,7 +38,8 @@ vo::StereoCamera TestCamera() {
 
 Eigen::Isometry3d PoseAt(double t) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(0.3 * t, Eigen::Vector3d(0.2, 1.0, 0.1).normalized()).toRotationMatrix();
+  T.linear() =
+      Eigen::AngleAxisd(0.3 * t, Eigen::Vector3d(0.2, 1.0, 0.1).normalized()).toRotationMatrix();
   T.translation() = Eigen::Vector3d(2.0 + t, -1.0 + 0.5 * t * t, 0.3);
   return T;
 }
@@ -232,9 +233,11 @@ TEST_F(TumDatasetTest, MissingCalibration) {
 }
 
 TEST_F(TumDatasetTest, NanInCalibration) {
-  WriteAll(dir_ + "/calib.txt", "P0: 35.5 0 19.5 0 0 35.5 nan 0 0 0 1 0\nP1: 35.5 0 19.5 -3.55 0 "
-                                "35.5 14.5 0 0 0 1 0\n");
-  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/calib.txt:1: P0: field 7 ('nan') is not finite"));
+  WriteAll(dir_ + "/calib.txt",
+           "P0: 35.5 0 19.5 0 0 35.5 nan 0 0 0 1 0\nP1: 35.5 0 19.5 -3.55 0 "
+           "35.5 14.5 0 0 0 1 0\n");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/calib.txt:1: P0: field 7 ('nan') is not finite"));
 }
 
 TEST_F(TumDatasetTest, MissingListFile) {
@@ -272,8 +275,10 @@ TEST_F(TumDatasetTest, MissingOrUnreadableImage) {
   EXPECT_THAT(OpenAndReadAll(),
               HasSubstr(dir_ + "/left/1305031102.375000000.png: cannot decode the image"));
   fs::remove(dir_ + "/right/1305031102.625000000.png");
-  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/right/1305031102.625000000.png: missing image "
-                                                 "file (listed in " + dir_ + "/right.txt)"));
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ +
+                                          "/right/1305031102.625000000.png: missing image "
+                                          "file (listed in " +
+                                          dir_ + "/right.txt)"));
 }
 
 TEST_F(TumDatasetTest, GroundTruthWithFewerPosesCoversTheFirstFrames) {
