@@ -1,7 +1,7 @@
 // `vobench eval` (harness/eval.h) on the simulator's exports: in each layout (kitti, euroc, tum)
 // the same frames give the same trajectory and metrics as `vobench run` on the scenario; ground
-// truth at another rate covering part of the frames; no ground truth; and bad input ends with a
-// message naming the file, a non-zero exit and no run folder.
+// truth at another rate covering part of the frames; no ground truth. And on small synthetic
+// datasets, bad input ends with a message naming the file, a non-zero exit and no run folder.
 #include "harness/eval.h"
 
 #include <gmock/gmock.h>
@@ -21,6 +21,7 @@
 #include "harness/metrics.h"
 #include "harness/render.h"
 #include "harness/trajectory_io.h"
+#include "sim/simulator.h"
 #include "tests/sim/sim_test_util.h"
 
 namespace harness {
@@ -68,8 +69,9 @@ RunOptions QuietRun(const std::string& out_dir) {
   return o;
 }
 
-// One short noisy scenario in the real hallway (0.6 m), rendered once for the whole file in the
-// euroc and tum layouts (both also hold the kitti layout), and run once with `vobench run`.
+// One short noisy scenario in the real hallway (0.5 m), simulated once per test process: its
+// frames written in the euroc and tum layouts (both also hold the kitti layout) with the writer
+// options of `vobench render`, and the VO run on the frames as `vobench run` runs it.
 class EvalTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -79,20 +81,37 @@ class EvalTest : public ::testing::Test {
     fs::create_directories(*root_);
     const std::string scenario_path = (*root_ / "short.yaml").string();
     WriteText(scenario_path, "name: short\nscene: " + std::string(VOBENCH_SOURCE_DIR) +
-                                 "/scenes/hallway_l.xml\npath:\n  - [0, 0]\n  - [0.6, 0]\n"
+                                 "/scenes/hallway_l.xml\npath:\n  - [0, 0]\n  - [0.5, 0]\n"
                                  "noise:\n  pixel_sigma: 1.5\n  gain_sigma: 0.02\n");
     std::string error;
     scenario_ = new sim::Scenario;
     ASSERT_TRUE(ResolveScenario(scenario_path, scenario_, &error)) << error;
+    auto simulator = sim::Simulator::Create(*scenario_, &error);
+    ASSERT_TRUE(simulator) << error;
+    std::vector<DatasetFrame> frames;
+    sim::StereoFrame f;
+    while (simulator->Next(&f, &error)) frames.push_back(ToDatasetFrame(f));
+    ASSERT_EQ(error, "");
+    const vo::StereoCamera camera = ToStereoCamera(simulator->calibration());
     for (DatasetFormat format : {DatasetFormat::kEuroc, DatasetFormat::kTum}) {
-      RenderOptions options;
+      DatasetWriter::Options options;  // as RenderScenario sets them
       options.format = format;
-      options.progress = false;
-      RenderSummary summary;
-      ASSERT_TRUE(RenderScenario(*scenario_, Export(format), options, &summary, &error)) << error;
+      options.T_body_cam0 = simulator->calibration().T_body_cam0;
+      options.rate_hz = scenario_->rate_hz;
+      DatasetWriter writer(options);
+      ASSERT_TRUE(writer.Open(Export(format), camera, &error)) << error;
+      for (const DatasetFrame& frame : frames) ASSERT_TRUE(writer.Add(frame, &error)) << error;
+      ASSERT_TRUE(writer.Finish(&error)) << error;
     }
     run_ = new RunSummary;
-    ASSERT_TRUE(RunScenario(*scenario_, vo::OdometryOptions(), QuietRun(RunDir()), run_, &error))
+    size_t next = 0;
+    FrameSource source = [&](DatasetFrame* frame, std::string*) {
+      if (next >= frames.size()) return false;
+      *frame = frames[next++];
+      return true;
+    };
+    ASSERT_TRUE(RunOdometry(scenario_->name, camera, source, static_cast<int>(frames.size()),
+                            vo::OdometryOptions(), QuietRun(RunDir()), "", run_, &error))
         << error;
   }
   static void TearDownTestSuite() {
@@ -113,23 +132,13 @@ class EvalTest : public ::testing::Test {
     return (*root_ / (std::string("export_") + DatasetFormatName(format))).string();
   }
   static std::string RunDir() { return (*root_ / "run").string(); }
-  // A private copy of an export, to break.
+  // A private copy of an export, to change.
   std::string Copy(DatasetFormat format) const {
     const std::string copy = (dir_ / "data").string();
     fs::copy(Export(format), copy, fs::copy_options::recursive);
     return copy;
   }
   std::string Out() const { return (dir_ / "out").string(); }
-
-  // Runs `vobench eval ARGS --out Out() -q --no-plots`; expects failure with a message holding
-  // `message` and no run folder (nor a partial one) left behind.
-  void ExpectCliFailure(const std::string& args, const std::string& message, int exit_code = 1) {
-    const CommandResult r = RunVobench("eval " + args + " --out " + Out() + " -q --no-plots");
-    EXPECT_EQ(r.exit_code, exit_code) << r.output;
-    EXPECT_THAT(r.output, HasSubstr(message));
-    EXPECT_FALSE(fs::exists(Out())) << args;
-    EXPECT_FALSE(fs::exists(Out() + ".partial")) << args;
-  }
 
   static fs::path* root_;
   static sim::Scenario* scenario_;
@@ -153,11 +162,18 @@ void ExpectSameAccuracy(const nlohmann::json& a, const nlohmann::json& b, const 
 }
 
 TEST_F(EvalTest, SimulatorExportsInEachFormatGiveTheRunsTrajectoryAndMetrics) {
-  const nlohmann::json run = ReadJson(RunDir() + "/metrics.json");
-  ASSERT_TRUE(run_->has_ground_truth);
-  EXPECT_GT(run_->metrics.frames, 15);
-  EXPECT_EQ(run["ground_truth_frames"], run_->metrics.frames);
-  const std::string run_trajectory = ReadAll(RunDir() + "/trajectory_kitti.txt");
+  // `vobench run` on the scenario itself (simulating again) is the reference.
+  const std::string scenario_run = (dir_ / "scenario_run").string();
+  RunSummary s0;
+  std::string error0;
+  ASSERT_TRUE(RunScenario(*scenario_, vo::OdometryOptions(), QuietRun(scenario_run), &s0, &error0))
+      << error0;
+  const nlohmann::json run = ReadJson(scenario_run + "/metrics.json");
+  ASSERT_TRUE(s0.has_ground_truth);
+  EXPECT_GT(s0.metrics.frames, 12);
+  EXPECT_EQ(run["ground_truth_frames"], s0.metrics.frames);
+  const std::string run_trajectory = ReadAll(scenario_run + "/trajectory_kitti.txt");
+  EXPECT_EQ(ReadAll(RunDir() + "/trajectory_kitti.txt"), run_trajectory);  // the fixture's run
   const struct {
     DatasetFormat format;
     std::string dir;
@@ -176,7 +192,7 @@ TEST_F(EvalTest, SimulatorExportsInEachFormatGiveTheRunsTrajectoryAndMetrics) {
         EvalDataset(c.dir, options, vo::OdometryOptions(), QuietRun(out), &s, &info, &error))
         << name << ": " << error;
     EXPECT_FALSE(info.rectified) << name;  // the simulator's pair is ideal: images untouched
-    EXPECT_EQ(info.ground_truth_frames, static_cast<size_t>(run_->metrics.frames)) << name;
+    EXPECT_EQ(info.ground_truth_frames, static_cast<size_t>(s0.metrics.frames)) << name;
     // Same frames -> the same trajectory, bit for bit, and the same metrics.
     EXPECT_EQ(ReadAll(out + "/trajectory_kitti.txt"), run_trajectory) << name;
     ExpectSameAccuracy(ReadJson(out + "/metrics.json"), run, name);
@@ -312,29 +328,96 @@ TEST_F(EvalTest, WithoutGroundTruthTheRunHasNoAccuracyMetrics) {
 
 // --- Bad input: a message naming the file, a non-zero exit, no run folder ----------------------
 
-TEST_F(EvalTest, KittiMissingCalibrationOrFewerPoses) {
-  const std::string data = Copy(DatasetFormat::kTum);
+// Small synthetic datasets (random images, a moving ground truth): no simulator needed.
+class EvalBadInputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("vobench_eval_bad_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    vo::StereoCamera camera;
+    camera.width = 160;
+    camera.height = 120;
+    camera.fx_px = camera.fy_px = 120.0;
+    camera.cx_px = 79.5;
+    camera.cy_px = 59.5;
+    camera.baseline_m = 0.1;
+    cv::RNG rng(3);
+    for (DatasetFormat format : {DatasetFormat::kEuroc, DatasetFormat::kTum}) {
+      DatasetWriter::Options options;
+      options.format = format;
+      DatasetWriter writer(options);
+      std::string error;
+      ASSERT_TRUE(writer.Open(Data(format), camera, &error)) << error;
+      for (int i = 0; i < 8; ++i) {
+        DatasetFrame f;
+        f.time_s = 0.1 * i;
+        f.left.create(120, 160, CV_8UC1);
+        rng.fill(f.left, cv::RNG::UNIFORM, 0, 256);
+        f.right = f.left.clone();
+        f.has_gt = true;
+        f.T_world_cam0.translation() = Eigen::Vector3d(0.0, 0.0, 0.05 * i);
+        ASSERT_TRUE(writer.Add(f, &error)) << error;
+      }
+      ASSERT_TRUE(writer.Finish(&error)) << error;
+    }
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Data(DatasetFormat format) const {
+    return (dir_ / (std::string("data_") + DatasetFormatName(format))).string();
+  }
+  std::string Out() const { return (dir_ / "out").string(); }
+
+  // Runs `vobench eval ARGS --out Out() -q --no-plots`; expects failure with a message holding
+  // `message` and no run folder (nor a partial one) left behind.
+  void ExpectCliFailure(const std::string& args, const std::string& message, int exit_code = 1) {
+    const CommandResult r = RunVobench("eval " + args + " --out " + Out() + " -q --no-plots");
+    EXPECT_EQ(r.exit_code, exit_code) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(message));
+    EXPECT_FALSE(fs::exists(Out())) << args;
+    EXPECT_FALSE(fs::exists(Out() + ".partial")) << args;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(EvalBadInputTest, WellFormedDatasetsRun) {
+  for (const char* format : {"kitti", "euroc", "tum"}) {
+    const std::string data =
+        Data(std::string(format) == "tum" ? DatasetFormat::kTum : DatasetFormat::kEuroc);
+    const CommandResult r = RunVobench("eval --dataset " + data + " --format " + format +
+                                       " --out " + Out() + " -q --no-plots");
+    EXPECT_EQ(r.exit_code, 0) << format << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr("8 of 8 frames associated")) << format;
+  }
+}
+
+TEST_F(EvalBadInputTest, KittiMissingCalibrationOrFewerPoses) {
+  const std::string data = Data(DatasetFormat::kTum);
   std::vector<Eigen::Isometry3d> poses;
   std::string error;
   ASSERT_TRUE(ReadKittiPoses(data + "/poses.txt", &poses, &error)) << error;
   poses.pop_back();
   ASSERT_TRUE(WriteKittiPoses(data + "/poses.txt", poses, &error)) << error;
   ExpectCliFailure("--dataset " + data + " --format kitti",
-                   data + "/poses.txt: has " + std::to_string(poses.size()) + " poses but");
+                   data + "/poses.txt: has 7 poses but " + data + "/times.txt lists 8 frames");
   fs::remove(data + "/calib.txt");
   ExpectCliFailure("--dataset " + data + " --format kitti", data + "/calib.txt: file not found");
 }
 
-TEST_F(EvalTest, UnreadableImageInTheMiddleLeavesNoRunFolder) {
+TEST_F(EvalBadInputTest, UnreadableImageInTheMiddleLeavesNoRunFolder) {
   // Open() checks only that the files exist: the broken frame is met during the run.
-  const std::string data = Copy(DatasetFormat::kTum);
+  const std::string data = Data(DatasetFormat::kTum);
   WriteText(data + "/image_1/000005.png", "not a png");
   ExpectCliFailure("--dataset " + data + " --format kitti",
                    data + "/image_1/000005.png: cannot decode the image");
 }
 
-TEST_F(EvalTest, EurocMissingOrBadCalibration) {
-  const std::string data = Copy(DatasetFormat::kEuroc);
+TEST_F(EvalBadInputTest, EurocMissingOrBadCalibration) {
+  const std::string data = Data(DatasetFormat::kEuroc);
   std::string yaml = ReadAll(data + "/mav0/cam1/sensor.yaml");
   const size_t at = yaml.find("intrinsics: [");
   ASSERT_NE(at, std::string::npos);
@@ -348,19 +431,19 @@ TEST_F(EvalTest, EurocMissingOrBadCalibration) {
                    data + "/mav0/cam0/sensor.yaml: file not found");
 }
 
-TEST_F(EvalTest, TumImagesOfDifferentSizesOrMissingList) {
-  const std::string data = Copy(DatasetFormat::kTum);
+TEST_F(EvalBadInputTest, TumImagesOfDifferentSizesOrMissingList) {
+  const std::string data = Data(DatasetFormat::kTum);
   const std::string right0 = data + "/right/0.000000000.png";
   ASSERT_TRUE(fs::exists(right0));
-  cv::imwrite(right0, cv::Mat::zeros(200, 320, CV_8UC1));
+  cv::imwrite(right0, cv::Mat::zeros(100, 160, CV_8UC1));
   ExpectCliFailure("--dataset " + data + " --format tum",
-                   right0 + ": size 320x200 differs from the left image's 320x240");
+                   right0 + ": size 160x100 differs from the left image's 160x120");
   fs::remove(data + "/left.txt");
   ExpectCliFailure("--dataset " + data + " --format tum", data + "/left.txt: file not found");
 }
 
-TEST_F(EvalTest, BadArguments) {
-  const std::string data = Export(DatasetFormat::kTum);
+TEST_F(EvalBadInputTest, BadArguments) {
+  const std::string data = Data(DatasetFormat::kTum);
   ExpectCliFailure("--dataset " + data + " --format asl", "--format: expected kitti, euroc or tum",
                    2);
   ExpectCliFailure("--dataset " + data + " --format tum --max-difference -1",
