@@ -86,8 +86,12 @@ int EvalCommand::Run(const PrintTable& print_table) const {
     std::printf("ground truth    %s: %zu of %zu frames associated (max difference %g s)",
                 info.ground_truth_path.c_str(), info.ground_truth_frames, info.dataset_frames,
                 info.max_difference_s);
-    std::printf("; metrics over the %d run frames with ground truth\n",
-                summary.ground_truth_frames);
+    if (summary.has_ground_truth)
+      std::printf("; metrics over the %d run frames with ground truth\n",
+                  summary.ground_truth_frames);
+    else
+      std::printf("; %d run frame(s) with ground truth: too few, no accuracy metrics\n",
+                  summary.ground_truth_frames);
   }
   print_table(summary, run_options.out_dir);
   std::printf("report          %s/report.md\n", run_options.out_dir.c_str());
