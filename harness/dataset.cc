@@ -14,7 +14,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 namespace harness {
@@ -25,11 +27,13 @@ namespace {
 constexpr const char* kWriterPidFile = ".writer_pid";
 // Tolerances for "is this a rotation" on options and EuRoC extrinsics.
 constexpr double kRotationTolerance = 1e-6;  // max |R^T R - I| entry
-// An EuRoC pair counts as already rectified within these.
-constexpr double kRectifiedIntrinsicsTolerancePx = 1e-6;
-constexpr double kRectifiedRotationTolerance = 1e-6;  // max |R_cam0_cam1 - I| entry
-constexpr double kRectifiedOffsetToleranceM = 1e-6;   // |y|, |z| of cam1 in cam0 (metres)
-constexpr double kRectifiedDistortionTolerance = 1e-12;
+// A rectified pair must have its baseline along x: |y|, |z| of rect1 in rect0 at most this
+// fraction of the baseline (cv::stereoRectify gives ~1e-16).
+constexpr double kRectifiedBaselineOffAxisFraction = 1e-6;
+// Rectification with alpha 0: the focal length grows by this factor per step until no
+// rectified pixel samples outside the raw images, at most kMaxRectificationZoomSteps times.
+constexpr double kRectificationZoomStep = 1.001;
+constexpr int kMaxRectificationZoomSteps = 200;  // 1.001^200 = 1.22
 
 constexpr const char* kEurocGroundTruthHeader =
     "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
@@ -182,6 +186,14 @@ bool ParseInt64(std::string_view text, int64_t* value) {
 
 double NsToSeconds(int64_t t_ns) { return static_cast<double>(t_ns) / 1e9; }
 
+// File name stem of a TUM-style image: the stamp with 9 decimals (the decimal value of the
+// double, correctly rounded; t_ns = llround(t * 1e9) is off by ~100 ns at 1.3e9 s).
+std::string TumStampName(double time_s) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "%.9f", time_s);
+  return name;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -191,6 +203,8 @@ bool ParseDatasetFormat(const std::string& name, DatasetFormat* format) {
     *format = DatasetFormat::kKitti;
   else if (name == "euroc")
     *format = DatasetFormat::kEuroc;
+  else if (name == "tum")
+    *format = DatasetFormat::kTum;
   else
     return false;
   return true;
@@ -202,6 +216,8 @@ const char* DatasetFormatName(DatasetFormat format) {
       return "kitti";
     case DatasetFormat::kEuroc:
       return "euroc";
+    case DatasetFormat::kTum:
+      return "tum";
   }
   return "unknown";
 }
@@ -212,8 +228,9 @@ int64_t TimeToNs(double time_s) { return std::llround(time_s * 1e9); }
 // DatasetWriter
 
 bool DatasetWriter::Options::IsValid(std::string* error) const {
-  if (format != DatasetFormat::kKitti && format != DatasetFormat::kEuroc)
-    return Fail(error, "format must be kitti or euroc");
+  if (format != DatasetFormat::kKitti && format != DatasetFormat::kEuroc &&
+      format != DatasetFormat::kTum)
+    return Fail(error, "format must be kitti, euroc or tum");
   if (png_compression < 0 || png_compression > 9)
     return Fail(error, "png_compression must be in [0, 9], got " + std::to_string(png_compression));
   if (!T_body_cam0.matrix().allFinite() || !IsRotation(T_body_cam0.linear(), kRotationTolerance))
@@ -271,6 +288,10 @@ bool DatasetWriter::Open(const std::string& dir, const vo::StereoCamera& camera,
     folders.push_back("mav0/cam0/data");
     folders.push_back("mav0/cam1/data");
   }
+  if (options_.format == DatasetFormat::kTum) {
+    folders.push_back("left");
+    folders.push_back("right");
+  }
   for (const std::string& f : folders) {
     if (!MakeDir(Join(partial_dir_, f), error)) {
       RemovePartial();
@@ -292,6 +313,11 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
   if (index > 0 && t_ns <= times_ns_.back())
     return Fail(error, what + "time " + FormatDouble(frame.time_s) +
                            " s is not after the previous frame's (need strictly increasing ns)");
+  if (options_.format == DatasetFormat::kTum && index > 0 &&
+      TumStampName(frame.time_s) == TumStampName(times_s_.back()))
+    return Fail(error,
+                what + "time " + FormatDouble(frame.time_s) +
+                    " s gives the previous frame's TUM image name (stamps closer than 1 ns)");
   if (frame.left.type() != CV_8UC1 || frame.left.size() != size)
     return Fail(error, what + "left image must be CV_8UC1 " + std::to_string(size.width) + "x" +
                            std::to_string(size.height) + ", got type " +
@@ -331,6 +357,11 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
       return false;
     if (options_.format == DatasetFormat::kEuroc &&
         !WriteBytes(Join(partial_dir_, "mav0/cam" + cam_name + "/data/" + png_ns), png, error))
+      return false;
+    if (options_.format == DatasetFormat::kTum &&
+        !WriteBytes(Join(partial_dir_,
+                         (cam == 0 ? "left/" : "right/") + TumStampName(frame.time_s) + ".png"),
+                    png, error))
       return false;
   }
   if (has_depth_) {
@@ -396,6 +427,23 @@ bool DatasetWriter::WriteEurocText(std::string* error) const {
   return WriteTextFile(Join(gt_dir, "data.csv"), csv, error);
 }
 
+bool DatasetWriter::WriteTumText(std::string* error) const {
+  const char* names[2] = {"left", "right"};
+  for (int cam = 0; cam < 2; ++cam) {
+    std::string list = std::string("# ") + names[cam] +
+                       " images (vobench TUM-style stereo layout)\n# timestamp filename\n";
+    for (size_t i = 0; i < times_s_.size(); ++i)
+      list +=
+          FormatDouble(times_s_[i]) + " " + names[cam] + "/" + TumStampName(times_s_[i]) + ".png\n";
+    if (!WriteTextFile(Join(partial_dir_, std::string(names[cam]) + ".txt"), list, error))
+      return false;
+  }
+  if (!has_gt_) return true;
+  std::vector<StampedPose> gt;
+  for (size_t i = 0; i < times_s_.size(); ++i) gt.push_back({times_s_[i], T_world_cam0_[i]});
+  return WriteTum(Join(partial_dir_, "groundtruth.txt"), gt, error);
+}
+
 bool DatasetWriter::Finish(std::string* error) {
   if (!is_open()) return Fail(error, "DatasetWriter::Finish: writer is not open");
   if (times_s_.empty()) return Fail(error, dir_ + ": no frames were added");
@@ -428,6 +476,7 @@ bool DatasetWriter::Finish(std::string* error) {
       return false;
   }
   if (options_.format == DatasetFormat::kEuroc && !WriteEurocText(error)) return false;
+  if (options_.format == DatasetFormat::kTum && !WriteTumText(error)) return false;
 
   std::error_code ec;
   fs::remove(Join(partial_dir_, kWriterPidFile), ec);
@@ -694,6 +743,7 @@ bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibr
   } catch (const std::exception& e) {
     return Fail(error, path + ": " + e.what());
   }
+  c.path = path;
   *calibration = c;
   return true;
 }
@@ -758,6 +808,265 @@ bool ReadEurocGroundTruth(const std::string& path, std::vector<int64_t>* t_ns,
 
 }  // namespace
 
+// ---------------------------------------------------------------------------------------------
+// Ground-truth association
+
+std::vector<long> AssociateGroundTruth(const std::vector<double>& frame_times_s,
+                                       const std::vector<StampedPose>& ground_truth,
+                                       double max_difference_s) {
+  std::vector<long> index(frame_times_s.size(), -1);
+  if (frame_times_s.empty() || ground_truth.empty()) return index;
+  const double t0 = frame_times_s.front();
+  std::vector<double> frame_s, gt_s;
+  for (double t : frame_times_s) frame_s.push_back(t - t0);
+  for (const StampedPose& p : ground_truth) gt_s.push_back(p.time_s - t0);
+  AssociateOptions assoc;
+  assoc.max_difference_s = max_difference_s;
+  for (const AssociatedPair& p : AssociateStamps(frame_s, gt_s, assoc))
+    index[p.first] = static_cast<long>(p.second);
+  return index;
+}
+
+namespace {
+
+size_t CountAssociated(const std::vector<long>& index) {
+  return static_cast<size_t>(
+      std::count_if(index.begin(), index.end(), [](long i) { return i >= 0; }));
+}
+
+// Error for a ground truth that no frame associates with (different clocks, wrong file).
+std::string NoAssociationMessage(const std::string& gt_path, const std::vector<double>& frame_s,
+                                 const std::vector<StampedPose>& gt, double max_difference_s) {
+  std::string m = gt_path + ": no ground-truth pose within " + FormatDouble(max_difference_s) +
+                  " s of any of the " + std::to_string(frame_s.size()) + " frames";
+  if (!gt.empty() && !frame_s.empty()) {
+    const auto [lo, hi] = std::minmax_element(frame_s.begin(), frame_s.end());
+    m += " (frames " + FormatDouble(*lo) + " .. " + FormatDouble(*hi) + " s, ground truth " +
+         FormatDouble(gt.front().time_s) + " .. " + FormatDouble(gt.back().time_s) +
+         " s): a different clock or the wrong file?";
+  } else if (gt.empty()) {
+    m += " (the file has no poses)";
+  }
+  return m;
+}
+
+// The calibration files, for error messages.
+std::string CalibrationFiles(const EurocCameraCalibration& cam0,
+                             const EurocCameraCalibration& cam1) {
+  const std::string a = cam0.path.empty() ? "cam0 calibration" : cam0.path;
+  const std::string b = cam1.path.empty() ? "cam1 calibration" : cam1.path;
+  return a + ", " + b;
+}
+
+// True when every (x, y) of the maps lies inside the raw image, so bilinear sampling never
+// reads the black border: 0 <= x <= width - 1, 0 <= y <= height - 1.
+bool MapInside(const cv::Mat& map_x, const cv::Mat& map_y, const cv::Size& raw) {
+  double x_min, x_max, y_min, y_max;
+  cv::minMaxLoc(map_x, &x_min, &x_max);
+  cv::minMaxLoc(map_y, &y_min, &y_max);
+  return x_min >= 0.0 && y_min >= 0.0 && x_max <= raw.width - 1 && y_max <= raw.height - 1;
+}
+
+cv::Mat CameraMatrix(const EurocCameraCalibration& c) {
+  return (cv::Mat_<double>(3, 3) << c.fu_px, 0.0, c.cu_px, 0.0, c.fv_px, c.cv_px, 0.0, 0.0, 1.0);
+}
+
+cv::Mat ToCv(const Eigen::Matrix3d& R) {
+  cv::Mat m(3, 3, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m.at<double>(r, c) = R(r, c);
+  return m;
+}
+
+Eigen::Matrix3d ToEigen3(const cv::Mat& m) {
+  Eigen::Matrix3d R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = m.at<double>(r, c);
+  return R;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Rectification
+
+bool RectificationOptions::IsValid(std::string* error) const {
+  if (!(alpha >= 0.0 && alpha <= 1.0))
+    return Fail(error, "rectification alpha must be in [0, 1], got " + FormatDouble(alpha));
+  for (double t : {identity_intrinsics_tolerance_px, identity_rotation_tolerance,
+                   identity_offset_tolerance_m, identity_distortion_tolerance})
+    if (!(t >= 0.0) || !std::isfinite(t))
+      return Fail(error, "rectification identity tolerances must be finite and >= 0");
+  return true;
+}
+
+bool ComputeStereoRectification(const EurocCameraCalibration& cam0,
+                                const EurocCameraCalibration& cam1,
+                                const RectificationOptions& options,
+                                StereoRectification* rectification, std::string* error) {
+  std::string why;
+  if (!options.IsValid(&why)) return Fail(error, "RectificationOptions: " + why);
+  const EurocCameraCalibration* cams[2] = {&cam0, &cam1};
+  for (int k = 0; k < 2; ++k) {
+    const EurocCameraCalibration& c = *cams[k];
+    const std::string where =
+        (c.path.empty() ? "cam" + std::to_string(k) + " calibration" : c.path) + ": ";
+    if (c.camera_model != "pinhole")
+      return Fail(error, where + "camera_model '" + c.camera_model +
+                             "' is not supported (expected pinhole)");
+    if (c.distortion_model != "radial-tangential" && c.distortion_model != "radtan" &&
+        c.distortion_model != "equidistant")
+      return Fail(error, where + "distortion_model '" + c.distortion_model +
+                             "' is not supported (expected radial-tangential or equidistant)");
+    if (c.distortion_coefficients.size() != 4)
+      return Fail(error, where + "distortion_coefficients: expected 4 numbers (" +
+                             (c.distortion_model == "equidistant" ? "k1 k2 k3 k4" : "k1 k2 p1 p2") +
+                             "), got " + std::to_string(c.distortion_coefficients.size()));
+    if (!(c.fu_px > 0.0) || !(c.fv_px > 0.0) || !std::isfinite(c.cu_px) ||
+        !std::isfinite(c.cv_px) || c.width <= 0 || c.height <= 0)
+      return Fail(error, where + "intrinsics and resolution must be finite and positive");
+  }
+  const std::string where = CalibrationFiles(cam0, cam1) + ": ";
+  const bool equidistant = cam0.distortion_model == "equidistant";
+  if (equidistant != (cam1.distortion_model == "equidistant"))
+    return Fail(error, where + "cam0 and cam1 use different distortion models ('" +
+                           cam0.distortion_model + "', '" + cam1.distortion_model +
+                           "'); expected the same");
+  if (cam0.width != cam1.width || cam0.height != cam1.height)
+    return Fail(error, where + "cam0 and cam1 resolutions differ (" + std::to_string(cam0.width) +
+                           "x" + std::to_string(cam0.height) + " vs " + std::to_string(cam1.width) +
+                           "x" + std::to_string(cam1.height) + ")");
+  const Eigen::Isometry3d T_cam0_cam1 = cam0.T_body_cam.inverse() * cam1.T_body_cam;
+  const Eigen::Vector3d t = T_cam0_cam1.translation();
+
+  // Already rectified: the identity, images used as they are.
+  double max_distortion = 0.0;
+  for (const EurocCameraCalibration* c : cams)
+    for (double d : c->distortion_coefficients)
+      max_distortion = std::max(max_distortion, std::abs(d));
+  const double dk =
+      std::max({std::abs(cam0.fu_px - cam1.fu_px), std::abs(cam0.fv_px - cam1.fv_px),
+                std::abs(cam0.cu_px - cam1.cu_px), std::abs(cam0.cv_px - cam1.cv_px)});
+  const double dr = (T_cam0_cam1.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!equidistant && max_distortion <= options.identity_distortion_tolerance &&
+      dk <= options.identity_intrinsics_tolerance_px && dr <= options.identity_rotation_tolerance &&
+      std::abs(t.y()) <= options.identity_offset_tolerance_m &&
+      std::abs(t.z()) <= options.identity_offset_tolerance_m && t.x() > 0.0) {
+    StereoRectification r;
+    r.camera.width = cam0.width;
+    r.camera.height = cam0.height;
+    r.camera.fx_px = cam0.fu_px;
+    r.camera.fy_px = cam0.fv_px;
+    r.camera.cx_px = cam0.cu_px;
+    r.camera.cy_px = cam0.cv_px;
+    r.camera.baseline_m = t.x();
+    if (!r.camera.IsValid(&why)) return Fail(error, where + why);
+    *rectification = r;
+    return true;
+  }
+  if (!(t.x() > 0.0) || std::abs(t.x()) <= std::max(std::abs(t.y()), std::abs(t.z())))
+    return Fail(error, where + "cam1 sits at (" + FormatDouble(t.x()) + ", " + FormatDouble(t.y()) +
+                           ", " + FormatDouble(t.z()) +
+                           ") m in cam0: expected it to the right of cam0 (mostly +x); vertical "
+                           "or swapped pairs are not supported");
+
+  // OpenCV's R, T map cam0 points into cam1: p_cam1 = R p_cam0 + T.
+  const Eigen::Isometry3d T_cam1_cam0 = T_cam0_cam1.inverse();
+  const cv::Mat R = ToCv(T_cam1_cam0.linear());
+  const cv::Mat T = (cv::Mat_<double>(3, 1) << T_cam1_cam0.translation().x(),
+                     T_cam1_cam0.translation().y(), T_cam1_cam0.translation().z());
+  const cv::Mat K0 = CameraMatrix(cam0), K1 = CameraMatrix(cam1);
+  const cv::Mat D0(cam0.distortion_coefficients, true), D1(cam1.distortion_coefficients, true);
+  const cv::Size size(cam0.width, cam0.height);
+  cv::Mat R1, R2, P1, P2, Q;
+  StereoRectification r;
+  try {
+    if (equidistant)
+      cv::fisheye::stereoRectify(K0, D0, K1, D1, size, R, T, R1, R2, P1, P2, Q,
+                                 cv::CALIB_ZERO_DISPARITY, size, options.alpha, 1.0);
+    else
+      cv::stereoRectify(K0, D0, K1, D1, size, R, T, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY,
+                        options.alpha, size);
+    P1.convertTo(P1, CV_64F);
+    P2.convertTo(P2, CV_64F);
+    R1.convertTo(R1, CV_64F);
+    R2.convertTo(R2, CV_64F);
+    // alpha 0 promises no invalid pixel, but OpenCV finds its zoom on a sparse grid of points
+    // (EuRoC: 26 map entries fall just outside the raw image). Zoom in further, about the
+    // principal point, until every rectified pixel samples inside both raw images.
+    for (int attempt = 0;; ++attempt) {
+      if (equidistant) {
+        cv::fisheye::initUndistortRectifyMap(K0, D0, R1, P1, size, CV_32FC1, r.map0_x, r.map0_y);
+        cv::fisheye::initUndistortRectifyMap(K1, D1, R2, P2, size, CV_32FC1, r.map1_x, r.map1_y);
+      } else {
+        cv::initUndistortRectifyMap(K0, D0, R1, P1, size, CV_32FC1, r.map0_x, r.map0_y);
+        cv::initUndistortRectifyMap(K1, D1, R2, P2, size, CV_32FC1, r.map1_x, r.map1_y);
+      }
+      if (options.alpha > 0.0 ||
+          (MapInside(r.map0_x, r.map0_y, size) && MapInside(r.map1_x, r.map1_y, size)))
+        break;
+      if (attempt == kMaxRectificationZoomSteps)
+        return Fail(error, where +
+                               "rectification: no zoom puts every rectified pixel inside the "
+                               "raw images (extreme distortion?); try a larger alpha");
+      for (cv::Mat* P : {&P1, &P2}) {
+        P->at<double>(0, 0) *= kRectificationZoomStep;
+        P->at<double>(1, 1) *= kRectificationZoomStep;
+        P->at<double>(0, 3) *= kRectificationZoomStep;  // -f * baseline follows f
+      }
+    }
+  } catch (const cv::Exception& e) {
+    return Fail(error, where + "rectification failed in OpenCV: " + e.what());
+  }
+  r.camera.width = cam0.width;
+  r.camera.height = cam0.height;
+  r.camera.fx_px = P1.at<double>(0, 0);
+  r.camera.fy_px = P1.at<double>(1, 1);
+  r.camera.cx_px = P1.at<double>(0, 2);
+  r.camera.cy_px = P1.at<double>(1, 2);
+  r.camera.baseline_m = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
+  r.R_cam0_rect0 = ToEigen3(R1).transpose();
+  r.R_cam1_rect1 = ToEigen3(R2).transpose();
+  // The result must be the ideal pair the VO assumes: rect1 at +baseline along rect0's x.
+  const Eigen::Vector3d t_rect0_rect1 = r.R_cam0_rect0.transpose() * t;
+  const double off_axis = std::max(std::abs(t_rect0_rect1.y()), std::abs(t_rect0_rect1.z()));
+  if (!r.camera.IsValid(&why) || !IsRotation(r.R_cam0_rect0, 1e-9) ||
+      !IsRotation(r.R_cam1_rect1, 1e-9) || std::abs(P2.at<double>(1, 3)) > 0.0 ||
+      off_axis > kRectifiedBaselineOffAxisFraction * t.norm() ||
+      std::abs(t_rect0_rect1.x() - r.camera.baseline_m) > 1e-9 * t.norm() + 1e-12)
+    return Fail(error, where + "rectification gave a degenerate pair" +
+                           (why.empty() ? std::string() : ": " + why));
+  *rectification = r;
+  return true;
+}
+
+void RectifyFrame(const StereoRectification& rectification, DatasetFrame* frame) {
+  if (rectification.IsIdentity()) return;
+  const cv::Size raw = rectification.map0_x.size();
+  if (frame->left.size() != raw || frame->right.size() != raw) {
+    std::fprintf(stderr, "harness::RectifyFrame: images %dx%d / %dx%d, maps made for %dx%d\n",
+                 frame->left.cols, frame->left.rows, frame->right.cols, frame->right.rows,
+                 raw.width, raw.height);
+    std::abort();
+  }
+  cv::Mat left, right;
+  cv::remap(frame->left, left, rectification.map0_x, rectification.map0_y, cv::INTER_LINEAR,
+            cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::remap(frame->right, right, rectification.map1_x, rectification.map1_y, cv::INTER_LINEAR,
+            cv::BORDER_CONSTANT, cv::Scalar(0));
+  frame->left = left;
+  frame->right = right;
+  frame->depth_m = cv::Mat();
+  if (frame->has_gt) {
+    Eigen::Isometry3d T_cam0_rect0 = Eigen::Isometry3d::Identity();
+    T_cam0_rect0.linear() = rectification.R_cam0_rect0;
+    frame->T_world_cam0 = frame->T_world_cam0 * T_cam0_rect0;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// EuRoC reader (continued)
+
 bool EurocReader::Open(const std::string& dir, const Options& options, std::string* error) {
   *this = EurocReader();
   options_ = options;
@@ -765,6 +1074,7 @@ bool EurocReader::Open(const std::string& dir, const Options& options, std::stri
   if (!std::isfinite(options_.gt_max_difference_s) || options_.gt_max_difference_s <= 0.0)
     return Fail(error, "EurocReader options: gt_max_difference_s must be finite and > 0");
   std::error_code ec;
+  if (!fs::is_directory(dir_, ec)) return Fail(error, dir_ + ": dataset folder not found");
   const std::string mav0 = Join(dir_, "mav0");
   if (!fs::is_directory(mav0, ec)) return Fail(error, mav0 + ": folder not found (EuRoC layout)");
 
@@ -792,65 +1102,40 @@ bool EurocReader::Open(const std::string& dir, const Options& options, std::stri
         return Fail(error, files_[cam][i] + ": missing image file (listed in cam" +
                                std::to_string(cam) + "/data.csv)");
 
-  // Ground truth (optional), associated to the frames by time.
+  // Ground truth (optional): the given file, else the first that exists.
   gt_index_.assign(t_ns_.size(), -1);
-  const std::string gt_path = Join(mav0, "state_groundtruth_estimate0/data.csv");
-  if (fs::exists(gt_path, ec)) {
-    std::vector<int64_t> gt_ns;
-    if (!ReadEurocGroundTruth(gt_path, &gt_ns, &gt_body_, error)) return false;
-    // Relative seconds keep nanosecond resolution in a double.
-    const int64_t t0 = t_ns_.front();
-    std::vector<double> frame_s, gt_s;
-    for (int64_t t : t_ns_) frame_s.push_back(NsToSeconds(t - t0));
-    for (int64_t t : gt_ns) gt_s.push_back(NsToSeconds(t - t0));
-    AssociateOptions assoc;
-    assoc.max_difference_s = options_.gt_max_difference_s;
-    for (const AssociatedPair& p : AssociateStamps(frame_s, gt_s, assoc))
-      gt_index_[p.first] = static_cast<long>(p.second);
+  gt_path_ = options_.gt_path;
+  if (gt_path_.empty()) {
+    for (const std::string& candidate :
+         {Join(mav0, "state_groundtruth_estimate0/data.csv"), Join(dir_, "groundtruth_tum.txt"),
+          Join(dir_, "groundtruth.txt")})
+      if (fs::exists(candidate, ec)) {
+        gt_path_ = candidate;
+        break;
+      }
   }
+  if (gt_path_.empty()) return true;
+  // EuRoC's own csv (by its .csv name) or a TUM trajectory.
+  if (fs::path(gt_path_).extension() == ".csv") {
+    std::vector<int64_t> gt_ns;
+    if (!ReadEurocGroundTruth(gt_path_, &gt_ns, &gt_body_, error)) return false;
+  } else if (!ReadTum(gt_path_, &gt_body_, error)) {
+    return false;
+  }
+  std::vector<double> frame_s;
+  for (int64_t t : t_ns_) frame_s.push_back(NsToSeconds(t));
+  gt_index_ = AssociateGroundTruth(frame_s, gt_body_, options_.gt_max_difference_s);
+  if (CountAssociated(gt_index_) == 0)
+    return Fail(error,
+                NoAssociationMessage(gt_path_, frame_s, gt_body_, options_.gt_max_difference_s));
   return true;
 }
 
-bool EurocReader::Rectification(StereoRectification* rectification, std::string* error) const {
-  const std::string where = Join(dir_, "mav0/cam{0,1}/sensor.yaml") + ": ";
-  for (int cam = 0; cam < 2; ++cam) {
-    if (cam_[cam].camera_model != "pinhole")
-      return Fail(error, where + "camera_model '" + cam_[cam].camera_model +
-                             "' needs rectification (not implemented yet; expected pinhole)");
-    for (double d : cam_[cam].distortion_coefficients)
-      if (std::abs(d) > kRectifiedDistortionTolerance)
-        return Fail(error, where + "cam" + std::to_string(cam) +
-                               " has non-zero distortion: rectification not implemented yet");
-  }
-  const EurocCameraCalibration& a = cam_[0];
-  const EurocCameraCalibration& b = cam_[1];
-  if (a.width != b.width || a.height != b.height)
-    return Fail(error, where + "cam0 and cam1 resolutions differ");
-  const double dk = std::max({std::abs(a.fu_px - b.fu_px), std::abs(a.fv_px - b.fv_px),
-                              std::abs(a.cu_px - b.cu_px), std::abs(a.cv_px - b.cv_px)});
-  if (dk > kRectifiedIntrinsicsTolerancePx)
-    return Fail(error,
-                where + "cam0 and cam1 intrinsics differ: rectification not implemented yet");
-  const Eigen::Isometry3d T_cam0_cam1 = a.T_body_cam.inverse() * b.T_body_cam;
-  const double dr = (T_cam0_cam1.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  const Eigen::Vector3d t = T_cam0_cam1.translation();
-  if (dr > kRectifiedRotationTolerance || std::abs(t.y()) > kRectifiedOffsetToleranceM ||
-      std::abs(t.z()) > kRectifiedOffsetToleranceM || !(t.x() > 0.0))
-    return Fail(error, where +
-                           "cam1 is not at +x of cam0 with the same orientation: "
-                           "rectification not implemented yet");
-  StereoRectification r;
-  r.camera.width = a.width;
-  r.camera.height = a.height;
-  r.camera.fx_px = a.fu_px;
-  r.camera.fy_px = a.fv_px;
-  r.camera.cx_px = a.cu_px;
-  r.camera.cy_px = a.cv_px;
-  r.camera.baseline_m = t.x();
-  std::string why;
-  if (!r.camera.IsValid(&why)) return Fail(error, where + why);
-  *rectification = r;
-  return true;
+size_t EurocReader::ground_truth_frames() const { return CountAssociated(gt_index_); }
+
+bool EurocReader::Rectification(const RectificationOptions& options,
+                                StereoRectification* rectification, std::string* error) const {
+  return ComputeStereoRectification(cam_[0], cam_[1], options, rectification, error);
 }
 
 bool EurocReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const {
@@ -877,6 +1162,138 @@ bool EurocReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* erro
   frame->has_gt = gt >= 0;
   frame->T_world_cam0 =
       frame->has_gt ? gt_body_[gt].T_world_cam * cam_[0].T_body_cam : Eigen::Isometry3d::Identity();
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// TUM-style stereo reader
+
+namespace {
+
+// Reads a TUM rgb.txt-style list: "timestamp filename" lines, '#' comments.
+bool ReadTumImageList(const std::string& path, const std::string& dir, std::vector<double>* times_s,
+                      std::vector<std::string>* files, std::string* error) {
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, error)) {
+    if (error) *error += " (expected the image list: 'timestamp filename' per line)";
+    return false;
+  }
+  std::map<double, int> seen;  // stamp -> line
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (IsBlankOrComment(lines[i])) continue;
+    const int line_no = static_cast<int>(i) + 1;
+    std::istringstream in(lines[i]);
+    std::string stamp, file, extra;
+    double t = 0.0;
+    if (!(in >> stamp >> file) || (in >> extra) || !ParseDouble(stamp, &t) || !std::isfinite(t))
+      return Fail(error, Where(path, line_no) +
+                             "expected 'timestamp filename' (seconds, a path relative to " + dir +
+                             ")");
+    const auto [it, inserted] = seen.emplace(t, line_no);
+    if (!inserted)
+      return Fail(error, Where(path, line_no) + "duplicate timestamp " + stamp + " (line " +
+                             std::to_string(it->second) + ")");
+    times_s->push_back(t);
+    files->push_back(Join(dir, file));
+  }
+  if (times_s->empty()) return Fail(error, path + ": no images listed");
+  return true;
+}
+
+}  // namespace
+
+bool TumReader::Open(const std::string& dir, const Options& options, std::string* error) {
+  *this = TumReader();
+  options_ = options;
+  dir_ = NormalizeDir(dir);
+  if (!(options_.gt_max_difference_s > 0.0) || !std::isfinite(options_.gt_max_difference_s) ||
+      !(options_.stereo_max_difference_s > 0.0) || !std::isfinite(options_.stereo_max_difference_s))
+    return Fail(error,
+                "TumReader options: gt_max_difference_s and stereo_max_difference_s must "
+                "be finite and > 0");
+  std::error_code ec;
+  if (!fs::is_directory(dir_, ec)) return Fail(error, dir_ + ": dataset folder not found");
+  if (!ReadKittiCalib(Join(dir_, "calib.txt"), &camera_, error)) return false;
+  std::vector<double> t[2];
+  std::vector<std::string> files[2];
+  const std::string lists[2] = {Join(dir_, "left.txt"), Join(dir_, "right.txt")};
+  for (int cam = 0; cam < 2; ++cam)
+    if (!ReadTumImageList(lists[cam], dir_, &t[cam], &files[cam], error)) return false;
+
+  // Stereo frames: left and right associated by stamp; a frame's time is its left stamp.
+  AssociateOptions stereo;
+  stereo.max_difference_s = options_.stereo_max_difference_s;
+  const double t0 = std::min(*std::min_element(t[0].begin(), t[0].end()),
+                             *std::min_element(t[1].begin(), t[1].end()));
+  std::vector<double> rel[2];
+  for (int cam = 0; cam < 2; ++cam)
+    for (double x : t[cam]) rel[cam].push_back(x - t0);
+  for (const AssociatedPair& p : AssociateStamps(rel[0], rel[1], stereo)) {
+    times_s_.push_back(t[0][p.first]);
+    files_[0].push_back(files[0][p.first]);
+    files_[1].push_back(files[1][p.second]);
+  }
+  unpaired_ = t[0].size() + t[1].size() - 2 * times_s_.size();
+  if (times_s_.empty())
+    return Fail(error, lists[0] + ": no left stamp within " +
+                           FormatDouble(options_.stereo_max_difference_s) + " s of a stamp in " +
+                           lists[1]);
+  for (size_t i = 0; i < times_s_.size(); ++i)
+    for (int cam = 0; cam < 2; ++cam)
+      if (!fs::is_regular_file(files_[cam][i], ec))
+        return Fail(error, files_[cam][i] + ": missing image file (listed in " + lists[cam] + ")");
+  const cv::Mat left = cv::imread(files_[0][0], cv::IMREAD_GRAYSCALE);
+  const cv::Mat right = cv::imread(files_[1][0], cv::IMREAD_GRAYSCALE);
+  if (left.empty()) return Fail(error, files_[0][0] + ": cannot decode the image");
+  if (right.empty()) return Fail(error, files_[1][0] + ": cannot decode the image");
+  if (left.size() != right.size())
+    return Fail(error, files_[1][0] + ": size " + SizeText(right) +
+                           " differs from the left image's " + SizeText(left) + " (" +
+                           files_[0][0] + ")");
+  camera_.width = left.cols;
+  camera_.height = left.rows;
+  std::string why;
+  if (!camera_.IsValid(&why)) return Fail(error, Join(dir_, "calib.txt") + ": " + why);
+
+  // Ground truth (optional).
+  gt_index_.assign(times_s_.size(), -1);
+  gt_path_ = options_.gt_path;
+  if (gt_path_.empty() && fs::exists(Join(dir_, "groundtruth.txt"), ec))
+    gt_path_ = Join(dir_, "groundtruth.txt");
+  if (gt_path_.empty()) return true;
+  if (!ReadTum(gt_path_, &gt_, error)) return false;
+  gt_index_ = AssociateGroundTruth(times_s_, gt_, options_.gt_max_difference_s);
+  if (CountAssociated(gt_index_) == 0)
+    return Fail(error, NoAssociationMessage(gt_path_, times_s_, gt_, options_.gt_max_difference_s));
+  return true;
+}
+
+size_t TumReader::ground_truth_frames() const { return CountAssociated(gt_index_); }
+
+bool TumReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const {
+  if (index >= size())
+    return Fail(error, dir_ + ": frame " + std::to_string(index) + " out of range (" +
+                           std::to_string(size()) + " frames)");
+  const cv::Size size(camera_.width, camera_.height);
+  cv::Mat images[2];
+  std::error_code ec;
+  for (int cam = 0; cam < 2; ++cam) {
+    const std::string& path = files_[cam][index];
+    if (!fs::is_regular_file(path, ec)) return Fail(error, path + ": missing image file");
+    images[cam] = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (images[cam].empty()) return Fail(error, path + ": cannot decode the image");
+    if (images[cam].size() != size)
+      return Fail(error, path + ": image size " + SizeText(images[cam]) + " differs from " +
+                             std::to_string(size.width) + "x" + std::to_string(size.height) +
+                             " (the size of the first pair)");
+  }
+  frame->time_s = times_s_[index];
+  frame->left = images[0];
+  frame->right = images[1];
+  frame->depth_m = cv::Mat();
+  const long gt = gt_index_[index];
+  frame->has_gt = gt >= 0;
+  frame->T_world_cam0 = frame->has_gt ? gt_[gt].T_world_cam : Eigen::Isometry3d::Identity();
   return true;
 }
 

@@ -1,5 +1,6 @@
 // vobench: the command-line front of the test bench.
-//   vobench render SCENARIO --out DIR [--format kitti|euroc]
+//   vobench render SCENARIO --out DIR [--format kitti|euroc|tum]
+//   vobench eval --dataset DIR --format kitti|euroc|tum ... (harness/eval_command.h)
 #include <cstdio>
 #include <string>
 
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "harness/eval_command.h"
 #include "harness/match_eval.h"
 #include "harness/plots.h"
 #include "harness/progress.h"
@@ -30,7 +32,7 @@ int RunRender(const std::string& scenario_arg, const std::string& out, const std
   }
   harness::RenderOptions options;
   if (!harness::ParseDatasetFormat(format, &options.format)) {
-    std::fprintf(stderr, "vobench render: --format: expected kitti or euroc, got '%s'\n", format.c_str());
+    std::fprintf(stderr, "vobench render: --format: expected kitti, euroc or tum, got '%s'\n", format.c_str());
     return 2;
   }
   options.overwrite = overwrite;
@@ -221,7 +223,7 @@ int main(int argc, char** argv) {
   CLI::App* render = app.add_subcommand("render", "Simulate a scenario and write its stereo sequence (KITTI layout, optionally EuRoC)");
   render->add_option("scenario", scenario, "Scenario YAML file or built-in name (l_hallway, plain_corridor)")->capture_default_str();
   render->add_option("--out,-o", out, "Output folder (must not exist unless --overwrite)")->required();
-  render->add_option("--format", format, "Dataset layout: kitti or euroc (euroc writes both)")->capture_default_str();
+  render->add_option("--format", format, "Dataset layout: kitti, euroc or tum (euroc and tum also write kitti)")->capture_default_str();
   render->add_flag("--overwrite", overwrite, "Replace an existing output folder");
   render->add_flag("-q,--quiet", quiet, "No progress display");
 
@@ -247,11 +249,14 @@ int main(int argc, char** argv) {
   run->add_flag("--no-plots", run_no_plots, "Skip the PNG plots");
   run->add_flag("-q,--quiet", quiet, "No progress display");
 
+  const auto eval = harness::AddEvalCommand(app);
+
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   spdlog::set_pattern("[%l] %v");
   if (*render) return RunRender(scenario, out, format, overwrite, quiet);
   if (*run) return RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_no_plots, quiet);
+  if (*eval->app) return eval->Run(PrintRunTable);
   if (*match_eval) return RunMatchEval(me_scenario, me_strides, me_matchers, me_out, me_max_frames, quiet);
   return 0;
 }

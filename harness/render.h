@@ -30,7 +30,7 @@ struct RenderSummary {
 };
 
 struct RenderOptions {
-  DatasetFormat format = DatasetFormat::kKitti;  // kEuroc also writes the mav0/ layout
+  DatasetFormat format = DatasetFormat::kKitti;  // kEuroc / kTum also write the mav0/ / TUM-style layout
   bool overwrite = false;                        // replace an existing output folder
   bool progress = true;                          // progress line on stderr
 };

@@ -67,6 +67,8 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
   r << "# vobench run: " << s.name << "\n\n";
   r << "| metric | value |\n| --- | --- |\n";
   r << "| frames | " << m.frames << " |\n";
+  r << "| frames with ground truth | " << s.ground_truth_frames
+    << (s.has_ground_truth ? " (the metrics below use these)" : " (no accuracy metrics)") << " |\n";
   if (s.has_ground_truth) {
     r << "| path length (ground truth) | " << Fmt(m.path_length_m, 3) << " m |\n";
     r << "| end-pose error | " << Fmt(m.end_pose_error_m) << " m (" << Fmt(m.end_pose_error_pct, 2) << " % of the path) |\n";
@@ -97,24 +99,27 @@ std::string MetricsJson(const RunSummary& s) {
   j["name"] = s.name;
   j["frames"] = m.frames;
   j["has_ground_truth"] = s.has_ground_truth;
-  j["path_length_m"] = m.path_length_m;
-  j["end_pose_error_m"] = m.end_pose_error_m;
-  j["end_pose_error_pct"] = m.end_pose_error_pct;
-  j["end_rotation_error_deg"] = m.end_rotation_error_deg;
-  j["ate_rmse_m"] = m.ate_rmse_m;
-  j["ate_rmse_unaligned_m"] = m.ate_rmse_unaligned_m;
-  j["rpe_trans_rmse_m"] = m.rpe_trans_rmse_m;
-  j["rpe_rot_rmse_deg"] = m.rpe_rot_rmse_deg;
+  j["ground_truth_frames"] = s.ground_truth_frames;
+  if (s.has_ground_truth) {  // without ground truth there is nothing to compare with
+    j["path_length_m"] = m.path_length_m;
+    j["end_pose_error_m"] = m.end_pose_error_m;
+    j["end_pose_error_pct"] = m.end_pose_error_pct;
+    j["end_rotation_error_deg"] = m.end_rotation_error_deg;
+    j["ate_rmse_m"] = m.ate_rmse_m;
+    j["ate_rmse_unaligned_m"] = m.ate_rmse_unaligned_m;
+    j["rpe_trans_rmse_m"] = m.rpe_trans_rmse_m;
+    j["rpe_rot_rmse_deg"] = m.rpe_rot_rmse_deg;
+    j["rpe_distance_step_m"] = m.rpe_distance_step_m;
+    j["rpe_distance_trans_rmse_m"] = m.rpe_distance_trans_rmse_m;
+    j["rpe_distance_rot_rmse_deg"] = m.rpe_distance_rot_rmse_deg;
+    j["drift_pct"] = m.drift_pct;
+    j["drift_deg_per_m"] = m.drift_deg_per_m;
+  }
   if (s.match_stats.matches > 0) {
     j["matches_evaluated"] = s.match_stats.matches;
     j["match_precision"] = s.match_stats.precision();
     j["inlier_match_precision"] = s.match_stats.inlier_precision();
   }
-  j["rpe_distance_step_m"] = m.rpe_distance_step_m;
-  j["rpe_distance_trans_rmse_m"] = m.rpe_distance_trans_rmse_m;
-  j["rpe_distance_rot_rmse_deg"] = m.rpe_distance_rot_rmse_deg;
-  j["drift_pct"] = m.drift_pct;
-  j["drift_deg_per_m"] = m.drift_deg_per_m;
   j["lost_frames"] = s.lost_frames;
   j["vo_ms_median"] = s.vo_ms_median;
   j["vo_ms_p95"] = s.vo_ms_p95;
@@ -152,7 +157,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   std::vector<double> times;
   std::vector<Eigen::Isometry3d> est, gt;
   std::vector<vo::OdometryResult> results;
-  bool has_gt = true;
+  std::vector<size_t> gt_frames;  // indices of the frames with ground truth
   Progress progress("vo " + name, expected_frames, options.progress);
   DatasetFrame frame;
   // Matcher statistics where the ground truth allows (frames with depth and pose): the VO's
@@ -181,7 +186,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     }
     times.push_back(frame.time_s);
     est.push_back(results.back().T_world_cam0);
-    has_gt = has_gt && frame.has_gt;
+    if (frame.has_gt) gt_frames.push_back(results.size() - 1);
     gt.push_back(frame.T_world_cam0);
     progress.Update(static_cast<int>(results.size()));
   }
@@ -196,8 +201,18 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   RunSummary& s = *summary;
   s = RunSummary();
   s.name = name;
+  const bool has_gt = gt_frames.size() >= 2;
+  const bool all_gt = gt_frames.size() == results.size();
   s.has_ground_truth = has_gt;
-  if (has_gt) s.metrics = ComputeTrajectoryMetrics(est, gt);
+  s.ground_truth_frames = static_cast<int>(gt_frames.size());
+  std::vector<Eigen::Isometry3d> est_at_gt, gt_at_gt;  // the frames with ground truth
+  std::vector<double> times_at_gt;
+  for (size_t i : gt_frames) {
+    est_at_gt.push_back(est[i]);
+    gt_at_gt.push_back(gt[i]);
+    times_at_gt.push_back(times[i]);
+  }
+  if (has_gt) s.metrics = ComputeTrajectoryMetrics(est_at_gt, gt_at_gt);
   s.metrics.frames = static_cast<int>(results.size());
   std::vector<double> total, feats, inl;
   std::map<std::string, std::vector<double>> stages;
@@ -221,16 +236,28 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   s.match_stats = match_stats;
   s.inliers_median = Median({inl.begin() + 1, inl.end()});
   s.initial_orientation_ok = results.front().initial_orientation_ok;
-  if (has_gt && s.initial_orientation_ok)
+  if (has_gt && gt_frames.front() == 0 && s.initial_orientation_ok)
     s.initial_orientation_error_deg = RotationAngle(est.front().linear(), gt.front().linear()) * 180.0 / M_PI;
 
   // Files.
   const fs::path p = guard.path;
+  // Errors per frame relative to the first frame with ground truth; "nan" for frames without.
+  const size_t g0 = gt_frames.empty() ? 0 : gt_frames.front();
   std::vector<Eigen::Isometry3d> anchored;
   if (has_gt)
-    for (const auto& T : est) anchored.push_back(gt.front() * est.front().inverse() * T);
-  const std::vector<Eigen::Isometry3d> est_rel = RelativeToFirst(est), gt_rel = RelativeToFirst(gt);
-  const std::vector<double> dist = CumulativeDistance(gt_rel);
+    for (const auto& T : est) anchored.push_back(gt[g0] * est[g0].inverse() * T);
+  std::vector<double> dist(results.size(), std::nan("")), te_m(results.size(), std::nan("")),
+      re_deg(results.size(), std::nan(""));
+  if (has_gt) {
+    const std::vector<double> d = CumulativeDistance(RelativeToFirst(gt_at_gt));
+    for (size_t k = 0; k < gt_frames.size(); ++k) {
+      const size_t i = gt_frames[k];
+      const Eigen::Isometry3d e = est[g0].inverse() * est[i], g = gt[g0].inverse() * gt[i];
+      dist[i] = d[k];
+      te_m[i] = (e.translation() - g.translation()).norm();
+      re_deg[i] = RotationAngle(e.linear(), g.linear()) * 180.0 / M_PI;
+    }
+  }
   std::ostringstream csv;
   csv << "frame,time_s,status,features,features_with_depth,matches,inliers,rms_reprojection_px,ba_ran,"
          "disparity_ms,detect_ms,depth_ms,match_ms,motion_ms,ba_ms,total_ms,x_m,y_m,z_m,gt_distance_m,"
@@ -238,15 +265,13 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   for (size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
     const Eigen::Vector3d t = est[i].translation();
-    const double te = has_gt ? (est_rel[i].translation() - gt_rel[i].translation()).norm() : 0.0;
-    const double re = has_gt ? RotationAngle(est_rel[i].linear(), gt_rel[i].linear()) * 180.0 / M_PI : 0.0;
     csv << i << "," << FormatDouble(times[i]) << "," << vo::ToString(r.status) << "," << r.num_features << ","
         << r.num_features_with_depth << "," << r.num_matches << "," << r.num_inliers << "," << Fmt(r.rms_reprojection_px)
         << "," << (r.ba_ran ? 1 : 0) << "," << Fmt(r.times.disparity_ms, 3) << "," << Fmt(r.times.detect_ms, 3) << ","
         << Fmt(r.times.depth_ms, 3) << "," << Fmt(r.times.match_ms, 3) << "," << Fmt(r.times.motion_ms, 3) << ","
         << Fmt(r.times.ba_ms, 3) << "," << Fmt(r.times.total_ms, 3) << "," << FormatDouble(t.x()) << ","
-        << FormatDouble(t.y()) << "," << FormatDouble(t.z()) << "," << Fmt(has_gt ? dist[i] : 0.0) << ","
-        << Fmt(te, 6) << "," << Fmt(re, 5) << "\n";
+        << FormatDouble(t.y()) << "," << FormatDouble(t.z()) << "," << Fmt(dist[i]) << ","
+        << Fmt(te_m[i], 6) << "," << Fmt(re_deg[i], 5) << "\n";
   }
   const std::string options_yaml = VoConfigToYaml(odometry->options());
   if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(times, est), error) ||
@@ -257,8 +282,9 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     return false;
   if (!scenario_yaml.empty() && !WriteTextFile((p / "scenario.yaml").string(), scenario_yaml, error)) return false;
   if (has_gt) {
-    if (!WriteTum((p / "groundtruth_tum.txt").string(), Stamped(times, gt), error) ||
-        !WriteKittiPoses((p / "groundtruth_kitti.txt").string(), gt, error) ||
+    // groundtruth_kitti.txt has no stamps: written only when it lines up with the estimate.
+    if (!WriteTum((p / "groundtruth_tum.txt").string(), Stamped(times_at_gt, gt_at_gt), error) ||
+        (all_gt && !WriteKittiPoses((p / "groundtruth_kitti.txt").string(), gt, error)) ||
         !WriteTum((p / "estimate_in_gt_world_tum.txt").string(), Stamped(times, anchored), error))
       return false;
   }

@@ -38,7 +38,8 @@ struct RunSummary {
   double inliers_median = 0.0;
   bool initial_orientation_ok = false;
   double initial_orientation_error_deg = -1.0;  // vs ground truth; < 0 when not known
-  bool has_ground_truth = false;
+  bool has_ground_truth = false;  // at least 2 frames with ground truth: the metrics are set
+  int ground_truth_frames = 0;    // frames with a ground-truth pose; the metrics use these only
   VoMatchStats match_stats;  // the VO's matches against the ground truth (simulated runs and
                              // datasets with depth); matches == 0 when not available
 };
@@ -54,7 +55,10 @@ struct RunOptions {
 // A source of stereo frames: fills *frame, returns false at the end (error empty) or on error.
 using FrameSource = std::function<bool(DatasetFrame* frame, std::string* error)>;
 
-// Runs the VO over `source` and writes the run folder.
+// Runs the VO over `source` and writes the run folder. Frames without ground truth
+// (DatasetFrame::has_gt false: a real sequence whose ground truth does not cover every frame)
+// are run and logged, but the metrics compare only the frames with ground truth (at least 2,
+// otherwise there are none and metrics.json leaves them out).
 bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameSource source,
                  int expected_frames, const vo::OdometryOptions& vo_options,
                  const RunOptions& options, const std::string& scenario_yaml, RunSummary* summary,

@@ -321,7 +321,7 @@ TEST_F(DatasetTest, EurocGroundTruthAtAnotherRateIsAssociated) {
 // --- Determinism ------------------------------------------------------------------------------
 
 TEST_F(DatasetTest, IdenticalInputGivesByteIdenticalFiles) {
-  for (DatasetFormat format : {DatasetFormat::kKitti, DatasetFormat::kEuroc}) {
+  for (DatasetFormat format : {DatasetFormat::kKitti, DatasetFormat::kEuroc, DatasetFormat::kTum}) {
     DatasetWriter::Options options;
     options.format = format;
     const std::string name = DatasetFormatName(format);
@@ -431,7 +431,9 @@ TEST_F(DatasetTest, WriterRejectsBadFrames) {
   DatasetFormat format;
   EXPECT_TRUE(ParseDatasetFormat("euroc", &format));
   EXPECT_EQ(format, DatasetFormat::kEuroc);
-  EXPECT_FALSE(ParseDatasetFormat("tum", &format));
+  EXPECT_TRUE(ParseDatasetFormat("tum", &format));
+  EXPECT_EQ(format, DatasetFormat::kTum);
+  EXPECT_FALSE(ParseDatasetFormat("asl", &format));
 }
 
 // --- Malformed input: false and an error that names the file -------------------------------------
@@ -629,7 +631,7 @@ TEST_F(EurocMalformedTest, MalformedGroundTruth) {
                                                  "expected at least 8 fields"));
 }
 
-TEST_F(EurocMalformedTest, RealEurocSensorYamlNeedsRectification) {
+TEST_F(EurocMalformedTest, RealEurocSensorYamlReadsAndResolutionsMustAgree) {
   // The shape of EuRoC's cam0/sensor.yaml (V1_01_easy), with distortion.
   WriteAll(dir_ + "/mav0/cam0/sensor.yaml",
            "%YAML:1.0\n"
@@ -665,10 +667,98 @@ TEST_F(EurocMalformedTest, RealEurocSensorYamlNeedsRectification) {
   ASSERT_TRUE(reader.Open(dir_, &error)) << error;
   StereoRectification rect;
   EXPECT_FALSE(reader.Rectification(&rect, &error));
-  EXPECT_THAT(error, HasSubstr("not implemented yet"));
+  EXPECT_THAT(error,
+              HasSubstr(dir_ + "/mav0/cam0/sensor.yaml, " + dir_ + "/mav0/cam1/sensor.yaml"));
+  EXPECT_THAT(error, HasSubstr("cam0 and cam1 resolutions differ (752x480 vs 64x48)"));
   DatasetFrame f;  // the images are 64x48, the yaml says 752x480
   EXPECT_FALSE(reader.ReadFrame(0, &f, &error));
   EXPECT_THAT(error, HasSubstr("differs from 752x480 (resolution in sensor.yaml)"));
+}
+
+TEST_F(EurocMalformedTest, LeftAndRightImagesOfDifferentSizes) {
+  cv::imwrite(dir_ + "/mav0/cam1/data/100033333333.png", cv::Mat::zeros(40, 64, CV_8UC1));
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/mav0/cam1/data/100033333333.png: image size "
+                                                 "64x40 differs from 64x48 (resolution in "
+                                                 "sensor.yaml)"));
+}
+
+TEST_F(EurocMalformedTest, UndecodableImage) {
+  WriteAll(dir_ + "/mav0/cam0/data/100066666667.png", "not a png");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/mav0/cam0/data/100066666667.png: cannot decode the image"));
+}
+
+TEST_F(EurocMalformedTest, MissingCameraList) {
+  fs::remove(dir_ + "/mav0/cam1/data.csv");
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/mav0/cam1/data.csv: file not found"));
+}
+
+TEST_F(EurocMalformedTest, GroundTruthWithFewerPosesCoversSomeFrames) {
+  // Only the first frame's pose: the others have no ground truth (and say so).
+  WriteAll(dir_ + "/mav0/state_groundtruth_estimate0/data.csv",
+           "#t\n100000000000,1,2,3,1,0,0,0,0,0,0,0,0,0,0,0,0\n");
+  EurocReader reader;
+  std::string error;
+  ASSERT_TRUE(reader.Open(dir_, &error)) << error;
+  EXPECT_EQ(reader.ground_truth_frames(), 1u);
+  DatasetFrame f;
+  ASSERT_TRUE(reader.ReadFrame(0, &f, &error)) << error;
+  EXPECT_TRUE(f.has_gt);
+  ASSERT_TRUE(reader.ReadFrame(1, &f, &error)) << error;
+  EXPECT_FALSE(f.has_gt);
+  // A ground truth that no frame associates with (another clock) is an error naming the file.
+  WriteAll(dir_ + "/mav0/state_groundtruth_estimate0/data.csv",
+           "#t\n200000000000,1,2,3,1,0,0,0,0,0,0,0,0,0,0,0,0\n");
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/mav0/state_groundtruth_estimate0/data.csv: no "
+                                                 "ground-truth pose within 0.003 s of any of the "
+                                                 "3 frames"));
+}
+
+TEST_F(EurocMalformedTest, GroundTruthFromATumFile) {
+  // The clip's arrangement: no state_groundtruth_estimate0, the body trajectory in TUM format in
+  // the dataset folder, at 200 Hz with stamps between the frames'.
+  EurocReader reader;
+  std::string error;
+  ASSERT_TRUE(reader.Open(dir_, &error)) << error;
+  std::vector<DatasetFrame> written(3);
+  for (size_t i = 0; i < 3; ++i) ASSERT_TRUE(reader.ReadFrame(i, &written[i], &error)) << error;
+  fs::remove_all(dir_ + "/mav0/state_groundtruth_estimate0");
+  fs::remove(dir_ + "/groundtruth_tum.txt");  // the KITTI-side file: first-camera frame
+  std::vector<StampedPose> body;
+  const Eigen::Isometry3d T_body_cam0 = reader.cam0().T_body_cam;
+  for (int r = 0; r < 20; ++r) {
+    StampedPose p;
+    p.time_s = 100.0 - 0.001 + 0.005 * r;
+    p.T_world_cam.translation() = Eigen::Vector3d(r, 0, 0);
+    body.push_back(p);
+  }
+  ASSERT_TRUE(WriteTum(dir_ + "/groundtruth.txt", body, &error)) << error;
+  ASSERT_TRUE(reader.Open(dir_, &error)) << error;
+  EXPECT_EQ(reader.ground_truth_path(), dir_ + "/groundtruth.txt");
+  EXPECT_EQ(reader.ground_truth_frames(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    DatasetFrame f;
+    ASSERT_TRUE(reader.ReadFrame(k, &f, &error)) << error;
+    ASSERT_TRUE(f.has_gt);
+    // Frame k at 100 + k/30 s pairs with row round((k/30 + 0.001) / 0.005); the camera pose is
+    // body * T_BS(cam0).
+    Eigen::Isometry3d expected = Eigen::Isometry3d::Identity();
+    expected.translation().x() = std::round((k / 30.0 + 0.001) / 0.005);
+    EXPECT_THAT(f.T_world_cam0, IsNearTransform(expected * T_body_cam0, 1e-12)) << k;
+  }
+  // groundtruth_tum.txt is preferred over groundtruth.txt; an explicit file over both; EuRoC's
+  // own data.csv over the TUM files.
+  ASSERT_TRUE(WriteTum(dir_ + "/groundtruth_tum.txt", body, &error)) << error;
+  ASSERT_TRUE(reader.Open(dir_, &error)) << error;
+  EXPECT_EQ(reader.ground_truth_path(), dir_ + "/groundtruth_tum.txt");
+  ASSERT_TRUE(WriteTum(dir_ + "/other.txt", body, &error)) << error;
+  EurocReader::Options options;
+  options.gt_path = dir_ + "/other.txt";
+  ASSERT_TRUE(reader.Open(dir_, options, &error)) << error;
+  EXPECT_EQ(reader.ground_truth_path(), dir_ + "/other.txt");
+  options.gt_path = dir_ + "/missing.txt";
+  EXPECT_FALSE(reader.Open(dir_, options, &error));
+  EXPECT_THAT(error, HasSubstr(dir_ + "/missing.txt: file not found"));
 }
 
 }  // namespace

@@ -1,0 +1,469 @@
+// `vobench eval` (harness/eval.h) on the simulator's exports: in each layout (kitti, euroc, tum)
+// the same frames give the same trajectory and metrics as `vobench run` on the scenario; ground
+// truth at another rate covering part of the frames; no ground truth. And on small synthetic
+// datasets, bad input ends with a message naming the file, a non-zero exit and no run folder.
+#include "harness/eval.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "harness/metrics.h"
+#include "harness/render.h"
+#include "harness/trajectory_io.h"
+#include "sim/simulator.h"
+#include "tests/sim/sim_test_util.h"
+
+namespace harness {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::Not;
+using vobench_test::WriteText;
+
+// Ground truth read back from text (17 digits) and recomposed (EuRoC: body * T_BS) differs from
+// the simulator's in the last bits; metrics follow within this.
+constexpr double kMetricTolerance = 1e-9;
+
+struct CommandResult {
+  int exit_code;
+  std::string output;
+};
+
+CommandResult RunVobench(const std::string& args) {
+  const std::string cmd = std::string(VOBENCH_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (pipe && fgets(buf, sizeof(buf), pipe)) out += buf;
+  const int status = pipe ? pclose(pipe) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+RunOptions QuietRun(const std::string& out_dir) {
+  RunOptions o;
+  o.out_dir = out_dir;
+  o.progress = false;
+  o.plots = false;
+  return o;
+}
+
+// One short noisy scenario in the real hallway (0.5 m), simulated once per test process: its
+// frames written in the euroc and tum layouts (both also hold the kitti layout) with the writer
+// options of `vobench render`, and the VO run on the frames as `vobench run` runs it.
+class EvalTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ =
+        new fs::path(fs::temp_directory_path() / ("vobench_eval_" + std::to_string(::getpid())));
+    fs::remove_all(*root_);
+    fs::create_directories(*root_);
+    const std::string scenario_path = (*root_ / "short.yaml").string();
+    WriteText(scenario_path, "name: short\nscene: " + std::string(VOBENCH_SOURCE_DIR) +
+                                 "/scenes/hallway_l.xml\npath:\n  - [0, 0]\n  - [0.5, 0]\n"
+                                 "noise:\n  pixel_sigma: 1.5\n  gain_sigma: 0.02\n");
+    std::string error;
+    scenario_ = new sim::Scenario;
+    ASSERT_TRUE(ResolveScenario(scenario_path, scenario_, &error)) << error;
+    auto simulator = sim::Simulator::Create(*scenario_, &error);
+    ASSERT_TRUE(simulator) << error;
+    std::vector<DatasetFrame> frames;
+    sim::StereoFrame f;
+    while (simulator->Next(&f, &error)) frames.push_back(ToDatasetFrame(f));
+    ASSERT_EQ(error, "");
+    const vo::StereoCamera camera = ToStereoCamera(simulator->calibration());
+    for (DatasetFormat format : {DatasetFormat::kEuroc, DatasetFormat::kTum}) {
+      DatasetWriter::Options options;  // as RenderScenario sets them
+      options.format = format;
+      options.T_body_cam0 = simulator->calibration().T_body_cam0;
+      options.rate_hz = scenario_->rate_hz;
+      DatasetWriter writer(options);
+      ASSERT_TRUE(writer.Open(Export(format), camera, &error)) << error;
+      for (const DatasetFrame& frame : frames) ASSERT_TRUE(writer.Add(frame, &error)) << error;
+      ASSERT_TRUE(writer.Finish(&error)) << error;
+    }
+    run_ = new RunSummary;
+    size_t next = 0;
+    FrameSource source = [&](DatasetFrame* frame, std::string*) {
+      if (next >= frames.size()) return false;
+      *frame = frames[next++];
+      return true;
+    };
+    ASSERT_TRUE(RunOdometry(scenario_->name, camera, source, static_cast<int>(frames.size()),
+                            vo::OdometryOptions(), QuietRun(RunDir()), "", run_, &error))
+        << error;
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*root_);
+    delete root_;
+    delete scenario_;
+    delete run_;
+  }
+  void SetUp() override {
+    ASSERT_TRUE(fs::exists(RunDir() + "/metrics.json")) << "suite set-up failed";
+    dir_ = *root_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static std::string Export(DatasetFormat format) {
+    return (*root_ / (std::string("export_") + DatasetFormatName(format))).string();
+  }
+  static std::string RunDir() { return (*root_ / "run").string(); }
+  // A private copy of an export, to change.
+  std::string Copy(DatasetFormat format) const {
+    const std::string copy = (dir_ / "data").string();
+    fs::copy(Export(format), copy, fs::copy_options::recursive);
+    return copy;
+  }
+  std::string Out() const { return (dir_ / "out").string(); }
+
+  static fs::path* root_;
+  static sim::Scenario* scenario_;
+  static RunSummary* run_;
+  fs::path dir_;
+};
+
+fs::path* EvalTest::root_ = nullptr;
+sim::Scenario* EvalTest::scenario_ = nullptr;
+RunSummary* EvalTest::run_ = nullptr;
+
+void ExpectSameAccuracy(const nlohmann::json& a, const nlohmann::json& b, const std::string& what) {
+  for (const char* k :
+       {"path_length_m", "end_pose_error_m", "end_rotation_error_deg", "ate_rmse_m",
+        "ate_rmse_unaligned_m", "rpe_trans_rmse_m", "rpe_rot_rmse_deg", "drift_pct"}) {
+    ASSERT_TRUE(a.contains(k) && b.contains(k)) << what << ": " << k;
+    EXPECT_NEAR(a[k].get<double>(), b[k].get<double>(), kMetricTolerance) << what << ": " << k;
+  }
+  for (const char* k : {"frames", "lost_frames", "ground_truth_frames", "has_ground_truth"})
+    EXPECT_EQ(a[k], b[k]) << what << ": " << k;
+}
+
+TEST_F(EvalTest, SimulatorExportsInEachFormatGiveTheRunsTrajectoryAndMetrics) {
+  // `vobench run` on the scenario itself (simulating again) is the reference.
+  const std::string scenario_run = (dir_ / "scenario_run").string();
+  RunSummary s0;
+  std::string error0;
+  ASSERT_TRUE(RunScenario(*scenario_, vo::OdometryOptions(), QuietRun(scenario_run), &s0, &error0))
+      << error0;
+  const nlohmann::json run = ReadJson(scenario_run + "/metrics.json");
+  ASSERT_TRUE(s0.has_ground_truth);
+  EXPECT_GT(s0.metrics.frames, 12);
+  EXPECT_EQ(run["ground_truth_frames"], s0.metrics.frames);
+  const std::string run_trajectory = ReadAll(scenario_run + "/trajectory_kitti.txt");
+  EXPECT_EQ(ReadAll(RunDir() + "/trajectory_kitti.txt"), run_trajectory);  // the fixture's run
+  const struct {
+    DatasetFormat format;
+    std::string dir;
+  } cases[] = {{DatasetFormat::kKitti, Export(DatasetFormat::kEuroc)},
+               {DatasetFormat::kEuroc, Export(DatasetFormat::kEuroc)},
+               {DatasetFormat::kTum, Export(DatasetFormat::kTum)}};
+  for (const auto& c : cases) {
+    const std::string name = DatasetFormatName(c.format);
+    EvalOptions options;
+    options.format = c.format;
+    RunSummary s;
+    EvalInfo info;
+    std::string error;
+    const std::string out = (dir_ / name).string();
+    ASSERT_TRUE(
+        EvalDataset(c.dir, options, vo::OdometryOptions(), QuietRun(out), &s, &info, &error))
+        << name << ": " << error;
+    EXPECT_FALSE(info.rectified) << name;  // the simulator's pair is ideal: images untouched
+    EXPECT_EQ(info.ground_truth_frames, static_cast<size_t>(s0.metrics.frames)) << name;
+    // Same frames -> the same trajectory, bit for bit, and the same metrics.
+    EXPECT_EQ(ReadAll(out + "/trajectory_kitti.txt"), run_trajectory) << name;
+    ExpectSameAccuracy(ReadJson(out + "/metrics.json"), run, name);
+    for (const char* f : {"trajectory_tum.txt", "groundtruth_tum.txt", "per_frame.csv",
+                          "vo_options.yaml", "report.md", "estimate_in_gt_world_tum.txt"})
+      EXPECT_TRUE(fs::exists(out + "/" + f)) << name << ": " << f;
+  }
+  // The euroc export's ground truth came from its own data.csv, not the KITTI-side files.
+  EurocReader reader;
+  std::string error;
+  ASSERT_TRUE(reader.Open(Export(DatasetFormat::kEuroc), &error)) << error;
+  EXPECT_THAT(reader.ground_truth_path(), HasSubstr("mav0/state_groundtruth_estimate0/data.csv"));
+}
+
+TEST_F(EvalTest, CommandPrintsTheRunTableAndWritesTheDefaultFolder) {
+  const std::string data = Copy(DatasetFormat::kTum);
+  const std::string cwd = fs::current_path().string();
+  fs::current_path(dir_);
+  const CommandResult r = RunVobench("eval --dataset " + data + " --format tum -q --no-plots");
+  fs::current_path(cwd);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("(tum layout)"));
+  EXPECT_THAT(r.output, HasSubstr("ground truth    " + data + "/groundtruth.txt: " +
+                                  std::to_string(run_->metrics.frames) + " of " +
+                                  std::to_string(run_->metrics.frames) + " frames associated"));
+  EXPECT_THAT(r.output, HasSubstr("end-pose error"));
+  EXPECT_THAT(r.output, HasSubstr("ATE RMSE"));
+  EXPECT_TRUE(fs::exists(dir_ / "out/eval/data/metrics.json"));
+  ExpectSameAccuracy(ReadJson((dir_ / "out/eval/data/metrics.json").string()),
+                     ReadJson(RunDir() + "/metrics.json"), "cli");
+  // `vobench run --dataset` keeps reading the KITTI layout.
+  const std::string kitti_run = (dir_ / "kitti_run").string();
+  const CommandResult k =
+      RunVobench("run --dataset " + data + " --out " + kitti_run + " -q --no-plots --max-frames 4");
+  ASSERT_EQ(k.exit_code, 0) << k.output;
+  EXPECT_EQ(ReadJson(kitti_run + "/metrics.json")["frames"], 4);
+}
+
+TEST_F(EvalTest, GroundTruthAtAnotherRateCoveringPartOfTheFrames) {
+  // A TUM ground truth at 3x the frame rate: the true pose 4 ms after each of the first 60 % of
+  // the frames, poses far off in between (33 ms from every frame, so never associated), nothing
+  // after. Metrics must be those of the associated frames only.
+  const std::string data = Copy(DatasetFormat::kTum);
+  std::vector<StampedPose> gt, est;
+  std::string error;
+  ASSERT_TRUE(ReadTum(RunDir() + "/groundtruth_tum.txt", &gt, &error)) << error;
+  ASSERT_TRUE(ReadTum(RunDir() + "/trajectory_tum.txt", &est, &error)) << error;
+  const size_t n = gt.size(), covered = n * 6 / 10;
+  const double period_s = gt[1].time_s - gt[0].time_s;
+  std::vector<StampedPose> fast;
+  for (size_t i = 0; i < covered; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      StampedPose p = gt[i];
+      p.time_s = gt[i].time_s + 0.004 + k * period_s / 3.0;
+      if (k > 0) p.T_world_cam.translation() += Eigen::Vector3d(100.0, 0, 0);  // never used
+      fast.push_back(p);
+    }
+  }
+  ASSERT_TRUE(WriteTum(data + "/gt_fast.txt", fast, &error)) << error;
+  EvalOptions options;
+  options.format = DatasetFormat::kTum;
+  options.gt_path = data + "/gt_fast.txt";
+  RunSummary s;
+  EvalInfo info;
+  ASSERT_TRUE(EvalDataset(data, options, vo::OdometryOptions(), QuietRun(Out()), &s, &info, &error))
+      << error;
+  EXPECT_EQ(info.ground_truth_frames, covered);
+  EXPECT_EQ(s.ground_truth_frames, static_cast<int>(covered));
+  EXPECT_EQ(s.metrics.frames, static_cast<int>(n));  // every frame ran
+  // The known answer: the metrics of the first `covered` frames of the full run.
+  std::vector<Eigen::Isometry3d> e, g;
+  for (size_t i = 0; i < covered; ++i) {
+    e.push_back(est[i].T_world_cam);
+    g.push_back(gt[i].T_world_cam);
+  }
+  const TrajectoryMetrics expected = ComputeTrajectoryMetrics(e, g);
+  const nlohmann::json j = ReadJson(Out() + "/metrics.json");
+  EXPECT_EQ(j["ground_truth_frames"], covered);
+  EXPECT_NEAR(j["ate_rmse_m"].get<double>(), expected.ate_rmse_m, kMetricTolerance);
+  EXPECT_NEAR(j["end_pose_error_m"].get<double>(), expected.end_pose_error_m, kMetricTolerance);
+  EXPECT_NEAR(j["path_length_m"].get<double>(), expected.path_length_m, kMetricTolerance);
+  // The run folder's ground truth holds the associated frames only; the per-frame log all.
+  std::vector<StampedPose> written;
+  ASSERT_TRUE(ReadTum(Out() + "/groundtruth_tum.txt", &written, &error)) << error;
+  EXPECT_EQ(written.size(), covered);
+  EXPECT_FALSE(fs::exists(Out() + "/groundtruth_kitti.txt"));  // would not line up
+  const std::string csv = ReadAll(Out() + "/per_frame.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), static_cast<long>(n) + 1);
+  EXPECT_THAT(csv, HasSubstr(",nan,nan,nan\n"));  // frames without ground truth
+}
+
+TEST_F(EvalTest, KittiWithAGroundTruthFileInTumOrKittiFormat) {
+  const std::string data = Copy(DatasetFormat::kTum);
+  EvalOptions options;
+  options.format = DatasetFormat::kKitti;
+  options.gt_path = data + "/groundtruth.txt";  // the left camera in the world, TUM format
+  RunSummary s;
+  EvalInfo info;
+  std::string error;
+  ASSERT_TRUE(EvalDataset(data, options, vo::OdometryOptions(), QuietRun(Out()), &s, &info, &error))
+      << error;
+  EXPECT_EQ(info.ground_truth_path, data + "/groundtruth.txt");
+  ExpectSameAccuracy(ReadJson(Out() + "/metrics.json"), ReadJson(RunDir() + "/metrics.json"), "gt");
+  // The KITTI benchmark's way: poses in a file of their own (poses/NN.txt), told by 12 fields.
+  fs::create_directories(data + "/poses");
+  fs::rename(data + "/poses.txt", data + "/poses/00.txt");
+  options.gt_path = data + "/poses/00.txt";
+  ASSERT_TRUE(EvalDataset(data, options, vo::OdometryOptions(), QuietRun(Out()), &s, &info, &error))
+      << error;
+  EXPECT_EQ(info.ground_truth_path, data + "/poses/00.txt");
+  ExpectSameAccuracy(ReadJson(Out() + "/metrics.json"), ReadJson(RunDir() + "/metrics.json"),
+                     "kitti poses");
+}
+
+TEST_F(EvalTest, WithoutGroundTruthTheRunHasNoAccuracyMetrics) {
+  const std::string data = Copy(DatasetFormat::kTum);
+  fs::remove(data + "/groundtruth.txt");
+  const CommandResult r =
+      RunVobench("eval --dataset " + data + " --format tum --out " + Out() + " -q --no-plots");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("ground truth    none: trajectory and per-frame log only"));
+  EXPECT_THAT(r.output, Not(HasSubstr("ATE RMSE")));
+  const nlohmann::json j = ReadJson(Out() + "/metrics.json");
+  EXPECT_EQ(j["has_ground_truth"], false);
+  EXPECT_EQ(j["ground_truth_frames"], 0);
+  EXPECT_EQ(j["frames"], run_->metrics.frames);
+  for (const char* k : {"ate_rmse_m", "end_pose_error_m", "path_length_m", "drift_pct"})
+    EXPECT_FALSE(j.contains(k)) << k;
+  EXPECT_EQ(ReadAll(Out() + "/trajectory_kitti.txt"), ReadAll(RunDir() + "/trajectory_kitti.txt"));
+  EXPECT_TRUE(fs::exists(Out() + "/per_frame.csv"));
+  EXPECT_FALSE(fs::exists(Out() + "/groundtruth_tum.txt"));
+}
+
+// --- Bad input: a message naming the file, a non-zero exit, no run folder ----------------------
+
+// Small synthetic datasets (random images, a moving ground truth): no simulator needed.
+class EvalBadInputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("vobench_eval_bad_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    vo::StereoCamera camera;
+    camera.width = 160;
+    camera.height = 120;
+    camera.fx_px = camera.fy_px = 120.0;
+    camera.cx_px = 79.5;
+    camera.cy_px = 59.5;
+    camera.baseline_m = 0.1;
+    cv::RNG rng(3);
+    for (DatasetFormat format : {DatasetFormat::kEuroc, DatasetFormat::kTum}) {
+      DatasetWriter::Options options;
+      options.format = format;
+      DatasetWriter writer(options);
+      std::string error;
+      ASSERT_TRUE(writer.Open(Data(format), camera, &error)) << error;
+      for (int i = 0; i < 8; ++i) {
+        DatasetFrame f;
+        f.time_s = 0.1 * i;
+        f.left.create(120, 160, CV_8UC1);
+        rng.fill(f.left, cv::RNG::UNIFORM, 0, 256);
+        f.right = f.left.clone();
+        f.has_gt = true;
+        f.T_world_cam0.translation() = Eigen::Vector3d(0.0, 0.0, 0.05 * i);
+        ASSERT_TRUE(writer.Add(f, &error)) << error;
+      }
+      ASSERT_TRUE(writer.Finish(&error)) << error;
+    }
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Data(DatasetFormat format) const {
+    return (dir_ / (std::string("data_") + DatasetFormatName(format))).string();
+  }
+  std::string Out() const { return (dir_ / "out").string(); }
+
+  // Runs `vobench eval ARGS --out Out() -q --no-plots`; expects failure with a message holding
+  // `message` and no run folder (nor a partial one) left behind.
+  void ExpectCliFailure(const std::string& args, const std::string& message, int exit_code = 1) {
+    const CommandResult r = RunVobench("eval " + args + " --out " + Out() + " -q --no-plots");
+    EXPECT_EQ(r.exit_code, exit_code) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(message));
+    EXPECT_FALSE(fs::exists(Out())) << args;
+    EXPECT_FALSE(fs::exists(Out() + ".partial")) << args;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(EvalBadInputTest, WellFormedDatasetsRun) {
+  for (const char* format : {"kitti", "euroc", "tum"}) {
+    const std::string data =
+        Data(std::string(format) == "tum" ? DatasetFormat::kTum : DatasetFormat::kEuroc);
+    const CommandResult r = RunVobench("eval --dataset " + data + " --format " + format +
+                                       " --out " + Out() + " -q --no-plots");
+    EXPECT_EQ(r.exit_code, 0) << format << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr("8 of 8 frames associated")) << format;
+  }
+}
+
+TEST_F(EvalBadInputTest, KittiMissingCalibrationOrFewerPoses) {
+  const std::string data = Data(DatasetFormat::kTum);
+  std::vector<Eigen::Isometry3d> poses;
+  std::string error;
+  ASSERT_TRUE(ReadKittiPoses(data + "/poses.txt", &poses, &error)) << error;
+  poses.pop_back();
+  ASSERT_TRUE(WriteKittiPoses(data + "/poses.txt", poses, &error)) << error;
+  ExpectCliFailure("--dataset " + data + " --format kitti",
+                   data + "/poses.txt: has 7 poses but " + data + "/times.txt lists 8 frames");
+  fs::remove(data + "/calib.txt");
+  ExpectCliFailure("--dataset " + data + " --format kitti", data + "/calib.txt: file not found");
+}
+
+TEST_F(EvalBadInputTest, UnreadableImageInTheMiddleLeavesNoRunFolder) {
+  // Open() checks only that the files exist: the broken frame is met during the run.
+  const std::string data = Data(DatasetFormat::kTum);
+  WriteText(data + "/image_1/000005.png", "not a png");
+  ExpectCliFailure("--dataset " + data + " --format kitti",
+                   data + "/image_1/000005.png: cannot decode the image");
+}
+
+TEST_F(EvalBadInputTest, EurocMissingOrBadCalibration) {
+  const std::string data = Data(DatasetFormat::kEuroc);
+  std::string yaml = ReadAll(data + "/mav0/cam1/sensor.yaml");
+  const size_t at = yaml.find("intrinsics: [");
+  ASSERT_NE(at, std::string::npos);
+  const size_t start = at + std::string("intrinsics: [").size();
+  yaml.replace(start, yaml.find(',', start) - start, ".nan");  // fu = NaN
+  WriteText(data + "/mav0/cam1/sensor.yaml", yaml);
+  ExpectCliFailure("--dataset " + data + " --format euroc",
+                   data + "/mav0/cam1/sensor.yaml: 'intrinsics': value 1 is not finite");
+  fs::remove(data + "/mav0/cam0/sensor.yaml");
+  ExpectCliFailure("--dataset " + data + " --format euroc",
+                   data + "/mav0/cam0/sensor.yaml: file not found");
+}
+
+TEST_F(EvalBadInputTest, TumImagesOfDifferentSizesOrMissingList) {
+  const std::string data = Data(DatasetFormat::kTum);
+  const std::string right0 = data + "/right/0.000000000.png";
+  ASSERT_TRUE(fs::exists(right0));
+  cv::imwrite(right0, cv::Mat::zeros(100, 160, CV_8UC1));
+  ExpectCliFailure("--dataset " + data + " --format tum",
+                   right0 + ": size 160x100 differs from the left image's 160x120");
+  fs::remove(data + "/left.txt");
+  ExpectCliFailure("--dataset " + data + " --format tum", data + "/left.txt: file not found");
+}
+
+TEST_F(EvalBadInputTest, BadArguments) {
+  const std::string data = Data(DatasetFormat::kTum);
+  ExpectCliFailure("--dataset " + data + " --format asl", "--format: expected kitti, euroc or tum",
+                   2);
+  ExpectCliFailure("--dataset " + data + " --format tum --max-difference -1",
+                   "--max-difference: expected seconds > 0", 2);
+  ExpectCliFailure("--dataset " + data + " --format tum --gt " + (dir_ / "none.txt").string(),
+                   (dir_ / "none.txt").string() + ": file not found");
+  ExpectCliFailure("--dataset " + (dir_ / "nowhere").string() + " --format euroc",
+                   (dir_ / "nowhere").string() + ": dataset folder not found");
+  WriteText((dir_ / "vo.yaml").string(), "matcher:\n  typo: 1\n");
+  ExpectCliFailure("--dataset " + data + " --format tum --config " + (dir_ / "vo.yaml").string(),
+                   (dir_ / "vo.yaml").string() + ":2", 2);
+  // A ground truth on another clock: nothing associates.
+  std::vector<StampedPose> gt(2);
+  gt[1].time_s = 1.0;
+  for (StampedPose& p : gt) p.time_s += 1000.0;
+  std::string error;
+  ASSERT_TRUE(WriteTum((dir_ / "late.txt").string(), gt, &error)) << error;
+  ExpectCliFailure("--dataset " + data + " --format tum --gt " + (dir_ / "late.txt").string(),
+                   (dir_ / "late.txt").string() + ": no ground-truth pose within 0.02 s");
+}
+
+}  // namespace
+}  // namespace harness
