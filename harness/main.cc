@@ -16,6 +16,7 @@
 #include "harness/run.h"
 #include "harness/vo_config.h"
 #include "harness/trajectory_io.h"
+#include "harness/tune_command.h"
 
 namespace {
 
@@ -243,11 +244,15 @@ int main(int argc, char** argv) {
   run->add_flag("--no-plots", run_no_plots, "Skip the PNG plots");
   run->add_flag("-q,--quiet", quiet, "No progress display");
 
+  harness::TuneCommandArgs tune_args;
+  CLI::App* tune = harness::AddTuneCommand(app, &tune_args);
+
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   spdlog::set_pattern("[%l] %v");
   if (*render) return RunRender(scenario, out, format, overwrite, quiet);
   if (*run) return RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_no_plots, quiet);
+  if (*tune) return harness::RunTuneCommand(tune_args);
   if (*match_eval) return RunMatchEval(me_scenario, me_strides, me_matchers, me_out, me_max_frames, quiet);
   return 0;
 }
