@@ -136,8 +136,8 @@ bool RunNlopt(nlopt_algorithm algorithm, Search* search, std::string* error) {
     search->origin = options.algorithm + (run == 0 ? "" : " restart " + std::to_string(run));
     nlopt_opt opt = nlopt_create(algorithm, n);
     if (opt == nullptr) {
-      *error = "NLopt cannot create " + options.algorithm + " in " + std::to_string(n) +
-               " dimensions";
+      *error =
+          "NLopt cannot create " + options.algorithm + " in " + std::to_string(n) + " dimensions";
       return false;
     }
     search->opt = opt;
@@ -260,15 +260,16 @@ double UnitToValue(const Parameter& p, double u) {
   u = std::clamp(u, 0.0, 1.0);
   double v = p.log ? p.min * std::pow(p.max / p.min, u) : p.min + u * (p.max - p.min);
   if (p.type == ParameterType::kInt) {
-    const long k = std::clamp(static_cast<long>(std::round((v - p.min) / p.step)), 0L, GridSteps(p));
+    const long k =
+        std::clamp(static_cast<long>(std::round((v - p.min) / p.step)), 0L, GridSteps(p));
     return p.min + static_cast<double>(k) * p.step;
   }
   return std::clamp(v, p.min, p.max);
 }
 
 double ValueToUnit(const Parameter& p, double value) {
-  const double u = p.log ? std::log(value / p.min) / std::log(p.max / p.min)
-                         : (value - p.min) / (p.max - p.min);
+  const double u =
+      p.log ? std::log(value / p.min) / std::log(p.max / p.min) : (value - p.min) / (p.max - p.min);
   return std::isfinite(u) ? std::clamp(u, 0.0, 1.0) : 0.0;
 }
 

@@ -74,9 +74,9 @@ struct OptimizerOptions {
   std::string algorithm = "LN_SBPLX";  // "random" or a derivative-free NLopt name (see above)
   int max_evals = 50;                  // distinct objective evaluations, the start included, >= 1
   uint64_t seed = 1;                   // random points, restarts, NLopt's stochastic algorithms
-  double initial_step = 0.25;  // first step of local NLopt algorithms (unit box), in (0, 1]
-  double xtol_abs = 1e-3;      // an NLopt run stops when every unit coordinate moves less than
-                               // this (then a local one restarts), > 0
+  double initial_step = 0.25;          // first step of local NLopt algorithms (unit box), in (0, 1]
+  double xtol_abs = 1e-3;  // an NLopt run stops when every unit coordinate moves less than
+                           // this (then a local one restarts), > 0
 
   bool IsValid(std::string* error) const;
 };

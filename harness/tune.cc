@@ -1,6 +1,7 @@
 #include "harness/tune.h"
 
 #include <sys/wait.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <chrono>
@@ -8,11 +9,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include "harness/overrides.h"
 #include "harness/progress.h"
@@ -84,7 +83,8 @@ class Reader {
   }
 
   // `map` must be a mapping whose keys are all in `allowed`.
-  bool Keys(const YAML::Node& map, const std::string& what, const std::vector<std::string>& allowed) {
+  bool Keys(const YAML::Node& map, const std::string& what,
+            const std::vector<std::string>& allowed) {
     if (!map.IsMap()) return Fail(map, what + ": expected a mapping");
     for (const auto& kv : map) {
       const std::string key = kv.first.Scalar();
@@ -161,7 +161,8 @@ bool ReadScenarios(Reader& r, const YAML::Node& root, const std::string& what,
                                 : s.scenario_arg;
     sim::Scenario base;
     std::string why;
-    if (!ResolveScenario(arg, &base, &why)) return r.Fail(n["scenario"], where + ".scenario: " + why);
+    if (!ResolveScenario(arg, &base, &why))
+      return r.Fail(n["scenario"], where + ".scenario: " + why);
     const YAML::Node set = n["set"];
     if (set.IsDefined() && !set.IsNull() && !set.IsMap())
       return r.Fail(set, where + ".set: expected a mapping of scenario keys to values");
@@ -176,7 +177,8 @@ bool ReadScenarios(Reader& r, const YAML::Node& root, const std::string& what,
       long v = 0;
       if (!r.Int(n["max_frames"], where + ".max_frames", 0, 1000000, &v)) return false;
       s.max_frames = static_cast<int>(v);
-      if (s.max_frames == 1) return r.Fail(n["max_frames"], where + ".max_frames: needs >= 2 frames (or 0 = all)");
+      if (s.max_frames == 1)
+        return r.Fail(n["max_frames"], where + ".max_frames: needs >= 2 frames (or 0 = all)");
     }
     s.scenario.name = s.name;
     out->push_back(s);
@@ -231,7 +233,8 @@ bool ReadParameters(Reader& r, const YAML::Node& root, TuneSpec* spec) {
     for (const char* required : {"key", "min", "max"})
       if (!n[required].IsDefined()) return r.Fail(n, where + ": '" + required + "' is required");
     Parameter p;
-    if (!r.String(n["key"], where + ".key", &p.key) || !r.Double(n["min"], where + ".min", &p.min) ||
+    if (!r.String(n["key"], where + ".key", &p.key) ||
+        !r.Double(n["min"], where + ".min", &p.min) ||
         !r.Double(n["max"], where + ".max", &p.max)) {
       return false;
     }
@@ -255,27 +258,29 @@ bool ReadParameters(Reader& r, const YAML::Node& root, TuneSpec* spec) {
     // The key against the VO config reader: known, of the right kind, start value in range.
     const YAML::Node option = FindDotted(base_yaml, SplitDots(p.key), 0);
     if (!option.IsDefined())
-      return r.Fail(n["key"], who + ": not a VO option key (see a run folder's vo_options.yaml "
-                                    "for the keys)");
+      return r.Fail(n["key"], who +
+                                  ": not a VO option key (see a run folder's vo_options.yaml "
+                                  "for the keys)");
     double start = 1.0;
     if (p.type == ParameterType::kScale) {
       bool numeric_list = option.IsSequence() && option.size() > 0;
       for (const auto& x : option) numeric_list = numeric_list && ParseDouble(x.Scalar(), &start);
       if (!numeric_list)
-        return r.Fail(n["key"], who + ": type scale needs a list-valued option (such as "
-                                      "matcher.gabor.wavelengths_px), this one holds " +
-                                          FlowYaml(option));
+        return r.Fail(n["key"], who +
+                                    ": type scale needs a list-valued option (such as "
+                                    "matcher.gabor.wavelengths_px), this one holds " +
+                                    FlowYaml(option));
       start = 1.0;
     } else if (!option.IsScalar() || !ParseDouble(option.Scalar(), &start)) {
       return r.Fail(n["key"], who + ": not a numeric VO option (it holds " + FlowYaml(option) +
                                   ")" + (option.IsSequence() ? "; use type: scale" : ""));
     }
     if (!IsAttainable(p, start))
-      return r.Fail(n, who + ": the base configuration's value " + Short(start) +
-                           " is outside [" + Short(p.min) + ", " + Short(p.max) + "]" +
-                           (p.type == ParameterType::kInt ? " or off the grid of step " +
-                                                                std::to_string(p.step)
-                                                          : "") +
+      return r.Fail(n, who + ": the base configuration's value " + Short(start) + " is outside [" +
+                           Short(p.min) + ", " + Short(p.max) + "]" +
+                           (p.type == ParameterType::kInt
+                                ? " or off the grid of step " + std::to_string(p.step)
+                                : "") +
                            "; the search starts there, widen the range");
 
     // Values the search can take, each alone on the base options.
@@ -355,7 +360,8 @@ bool ReadOptimizer(Reader& r, const YAML::Node& root, OptimizerOptions* optimize
   if (n["initial_step"].IsDefined() &&
       !r.Double(n["initial_step"], "optimizer.initial_step", &optimizer->initial_step))
     return false;
-  if (n["xtol_abs"].IsDefined() && !r.Double(n["xtol_abs"], "optimizer.xtol_abs", &optimizer->xtol_abs))
+  if (n["xtol_abs"].IsDefined() &&
+      !r.Double(n["xtol_abs"], "optimizer.xtol_abs", &optimizer->xtol_abs))
     return false;
   std::string why;
   if (!optimizer->IsValid(&why)) return r.Fail(n, "optimizer: " + why);
@@ -382,7 +388,8 @@ std::string Quote(const std::string& s) {
 bool RunTunePlot(const std::string& dir, const std::string& png, std::string* error) {
   const std::string script = std::string(VOBENCH_SOURCE_DIR) + "/harness/tune_plot.py";
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string cmd = python + " " + Quote(script) + " " + Quote(dir) + " " + Quote(png) + " 2>&1";
+  const std::string cmd =
+      python + " " + Quote(script) + " " + Quote(dir) + " " + Quote(png) + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) {
     *error = "cannot start " + python;
@@ -415,8 +422,10 @@ std::string EvaluationsCsv(const TuneSpec& spec, const OptimizationResult& resul
   for (const Evaluation& e : result.evaluations) {
     best = e.index == 0 ? e.score : std::min(best, e.score);
     csv << e.index << "," << e.origin;
-    for (size_t i = 0; i < e.values.size(); ++i) csv << "," << ValueText(spec.parameters[i], e.values[i]);
-    for (const SequenceScore& s : scores[e.index]) csv << "," << FormatDouble(s.metric) << "," << s.lost_frames;
+    for (size_t i = 0; i < e.values.size(); ++i)
+      csv << "," << ValueText(spec.parameters[i], e.values[i]);
+    for (const SequenceScore& s : scores[e.index])
+      csv << "," << FormatDouble(s.metric) << "," << s.lost_frames;
     csv << "," << FormatDouble(e.score) << "," << FormatDouble(best) << "\n";
   }
   return csv.str();
@@ -429,9 +438,9 @@ std::string ScoresCsv(const TuneSpec& spec, const TuneSummary& summary) {
       << ",tuned_lost_frames,tuned_score\n";
   for (const TuneScenarioResult& r : summary.scenarios) {
     csv << r.name << "," << (r.train ? "train" : "validation") << "," << r.frames << ","
-        << FormatDouble(r.base.metric) << "," << r.base.lost_frames << "," << FormatDouble(r.base.score)
-        << "," << FormatDouble(r.tuned.metric) << "," << r.tuned.lost_frames << ","
-        << FormatDouble(r.tuned.score) << "\n";
+        << FormatDouble(r.base.metric) << "," << r.base.lost_frames << ","
+        << FormatDouble(r.base.score) << "," << FormatDouble(r.tuned.metric) << ","
+        << r.tuned.lost_frames << "," << FormatDouble(r.tuned.score) << "\n";
   }
   return csv.str();
 }
@@ -456,27 +465,41 @@ std::string SummaryJson(const TuneSpec& spec, const TuneSummary& s, const Optimi
   j["objective"] = {{"metric", spec.objective.metric},
                     {"lost_frame_penalty", spec.objective.lost_frame_penalty},
                     {"aggregate", spec.objective.aggregate}};
-  j["optimizer"] = {{"algorithm", opt.algorithm}, {"max_evals", opt.max_evals}, {"seed", opt.seed},
-                    {"evaluations", r.evaluations.size()}, {"optimizer_calls", r.optimizer_calls},
-                    {"restarts", r.restarts}, {"stop_reason", r.stop_reason},
-                    {"best_eval", r.best_index}, {"best_origin", r.best().origin}};
+  j["optimizer"] = {{"algorithm", opt.algorithm},
+                    {"max_evals", opt.max_evals},
+                    {"seed", opt.seed},
+                    {"evaluations", r.evaluations.size()},
+                    {"optimizer_calls", r.optimizer_calls},
+                    {"restarts", r.restarts},
+                    {"stop_reason", r.stop_reason},
+                    {"best_eval", r.best_index},
+                    {"best_origin", r.best().origin}};
   for (size_t i = 0; i < spec.parameters.size(); ++i) {
     const Parameter& p = spec.parameters[i];
-    j["parameters"].push_back({{"key", p.key}, {"type", ToString(p.type)}, {"min", p.min},
-                               {"max", p.max}, {"log", p.log}, {"step", p.step},
-                               {"default", spec.start_values[i]}, {"tuned", r.best().values[i]}});
+    j["parameters"].push_back({{"key", p.key},
+                               {"type", ToString(p.type)},
+                               {"min", p.min},
+                               {"max", p.max},
+                               {"log", p.log},
+                               {"step", p.step},
+                               {"default", spec.start_values[i]},
+                               {"tuned", r.best().values[i]}});
   }
   j["train"] = {{"default", s.train_base}, {"tuned", s.train_tuned}};
   j["validation"] = {{"default", s.validation_base}, {"tuned", s.validation_tuned}};
   for (const TuneScenarioResult& sc : s.scenarios) {
-    j["scenarios"].push_back({{"name", sc.name}, {"set", sc.train ? "train" : "validation"},
+    j["scenarios"].push_back({{"name", sc.name},
+                              {"set", sc.train ? "train" : "validation"},
                               {"frames", sc.frames},
                               {"default", ScoreJson(sc.base, spec.objective.metric)},
                               {"tuned", ScoreJson(sc.tuned, spec.objective.metric)}});
   }
-  j["timing_s"] = {{"simulate", s.simulate_s}, {"search", s.search_s},
-                   {"validation", s.validation_s}, {"total", s.wall_s},
-                   {"per_evaluation", r.evaluations.empty() ? 0.0 : s.search_s / r.evaluations.size()}};
+  j["timing_s"] = {
+      {"simulate", s.simulate_s},
+      {"search", s.search_s},
+      {"validation", s.validation_s},
+      {"total", s.wall_s},
+      {"per_evaluation", r.evaluations.empty() ? 0.0 : s.search_s / r.evaluations.size()}};
   return j.dump(2) + "\n";
 }
 
@@ -491,14 +514,14 @@ std::string ReportMarkdown(const TuneSpec& spec, const TuneSummary& s, const Opt
   const std::string& metric = spec.objective.metric;
   std::ostringstream md;
   md << "# vobench tune: " << spec.name << "\n\n";
-  md << "Tune file `" << (spec.source_path.empty() ? "(text)" : fs::path(spec.source_path).filename().string())
+  md << "Tune file `" << (spec.source_path.empty() ? "(text)" : spec.source_path)
      << "` (copied as `tune.yaml`); default = "
      << (spec.base_config_path.empty() ? "the library defaults" : "`" + spec.base_config_path + "`")
      << ". Optimizer " << opt.algorithm << ", seed " << opt.seed << ": " << r.evaluations.size()
      << " evaluations (budget " << opt.max_evals << ", " << r.restarts << " restarts; "
      << r.stop_reason << "). Run time " << Fixed(s.wall_s, 0) << " s (simulation "
-     << Fixed(s.simulate_s, 0) << " s, search " << Fixed(s.search_s, 0) << " s = "
-     << Fixed(r.evaluations.empty() ? 0.0 : s.search_s / r.evaluations.size(), 1)
+     << Fixed(s.simulate_s, 0) << " s, search " << Fixed(s.search_s, 0)
+     << " s = " << Fixed(r.evaluations.empty() ? 0.0 : s.search_s / r.evaluations.size(), 1)
      << " s per evaluation, validation " << Fixed(s.validation_s, 0) << " s).\n\n";
   md << "Score of a scenario = " << metric << " + " << Short(spec.objective.lost_frame_penalty)
      << " × lost frames (smaller is better); objective = " << spec.objective.aggregate
@@ -508,13 +531,15 @@ std::string ReportMarkdown(const TuneSpec& spec, const TuneSummary& s, const Opt
      << " | tuned lost | default score | tuned score | change |\n";
   md << "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const TuneScenarioResult& sc : s.scenarios) {
-    md << "| " << sc.name << " | " << (sc.train ? "train" : "validation") << " | " << sc.frames << " | "
-       << Fixed(sc.base.metric, 5) << " | " << sc.base.lost_frames << " | " << Fixed(sc.tuned.metric, 5)
-       << " | " << sc.tuned.lost_frames << " | " << Fixed(sc.base.score, 5) << " | "
-       << Fixed(sc.tuned.score, 5) << " | " << Change(sc.base.score, sc.tuned.score) << " |\n";
+    md << "| " << sc.name << " | " << (sc.train ? "train" : "validation") << " | " << sc.frames
+       << " | " << Fixed(sc.base.metric, 5) << " | " << sc.base.lost_frames << " | "
+       << Fixed(sc.tuned.metric, 5) << " | " << sc.tuned.lost_frames << " | "
+       << Fixed(sc.base.score, 5) << " | " << Fixed(sc.tuned.score, 5) << " | "
+       << Change(sc.base.score, sc.tuned.score) << " |\n";
   }
-  md << "| **training (" << spec.objective.aggregate << ")** | | | | | | | **" << Fixed(s.train_base, 5)
-     << "** | **" << Fixed(s.train_tuned, 5) << "** | " << Change(s.train_base, s.train_tuned) << " |\n";
+  md << "| **training (" << spec.objective.aggregate << ")** | | | | | | | **"
+     << Fixed(s.train_base, 5) << "** | **" << Fixed(s.train_tuned, 5) << "** | "
+     << Change(s.train_base, s.train_tuned) << " |\n";
   md << "| **validation (" << spec.objective.aggregate << ")** | | | | | | | **"
      << Fixed(s.validation_base, 5) << "** | **" << Fixed(s.validation_tuned, 5) << "** | "
      << Change(s.validation_base, s.validation_tuned) << " |\n\n";
@@ -525,10 +550,26 @@ std::string ReportMarkdown(const TuneSpec& spec, const TuneSummary& s, const Opt
     md << "On the validation set the tuned configuration is "
        << (s.validation_tuned < s.validation_base
                ? "**better** than the default"
-               : (s.validation_tuned == s.validation_base ? "**as good as** the default"
-                                                          : "**worse** than the default "
-                                                            "(the gain on training does not carry over)"))
-       << " (" << Fixed(s.validation_base, 5) << " -> " << Fixed(s.validation_tuned, 5) << ").\n\n";
+               : (s.validation_tuned == s.validation_base
+                      ? "**as good as** the default"
+                      : "**worse** than the default "
+                        "(the gain on training does not carry over)"))
+       << " (" << Fixed(s.validation_base, 5) << " -> " << Fixed(s.validation_tuned, 5) << ").";
+    // Per scenario, so a mean carried by one scenario is not mistaken for a general gain.
+    for (const bool train : {true, false}) {
+      std::vector<std::string> better, worse;
+      for (const TuneScenarioResult& sc : s.scenarios) {
+        if (sc.train != train) continue;
+        if (sc.tuned.score < sc.base.score) better.push_back(sc.name);
+        if (sc.tuned.score > sc.base.score)
+          worse.push_back(sc.name + " " + Change(sc.base.score, sc.tuned.score));
+      }
+      md << " " << (train ? "Training" : "Validation") << " scenarios: better on " << better.size()
+         << ", worse on " << worse.size();
+      for (size_t i = 0; i < worse.size(); ++i) md << (i == 0 ? " (" : ", ") << worse[i];
+      md << (worse.empty() ? "." : ").");
+    }
+    md << "\n\n";
   }
   md << "## Parameters\n\n";
   md << "| key | type | range | default | tuned |\n| --- | --- | --- | ---: | ---: |\n";
@@ -571,8 +612,9 @@ bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
     *error = source_name + ": expected a YAML mapping (name, train, validation, parameters, ...)";
     return false;
   }
-  if (!r.Keys(root, "the tune file",
-              {"name", "base_config", "train", "validation", "parameters", "objective", "optimizer"}))
+  if (!r.Keys(
+          root, "the tune file",
+          {"name", "base_config", "train", "validation", "parameters", "objective", "optimizer"}))
     return false;
   TuneSpec s;
   s.text = yaml_text;
@@ -666,7 +708,8 @@ bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSeque
                            : simulator->EstimatedFrames();
   Progress bar("simulate " + scenario.name, expected, progress);
   sim::StereoFrame f;
-  while ((scenario.max_frames <= 0 || static_cast<int>(sequence->frames.size()) < scenario.max_frames) &&
+  while ((scenario.max_frames <= 0 ||
+          static_cast<int>(sequence->frames.size()) < scenario.max_frames) &&
          simulator->Next(&f, error)) {
     DatasetFrame d = ToDatasetFrame(f);
     d.depth_m = cv::Mat();  // not needed: the score uses the poses only
@@ -756,7 +799,8 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
     return false;
   }
   if (fs::exists(dir) && !fs::exists(dir / "summary.json")) {
-    *error = dir.string() + ": exists and is not a vobench tune folder (no summary.json); choose another --out";
+    *error = dir.string() +
+             ": exists and is not a vobench tune folder (no summary.json); choose another --out";
     return false;
   }
   OptimizerOptions opt = spec.optimizer;
@@ -769,13 +813,15 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
   for (size_t i = 0; i < spec.train.size(); ++i)
     if (!SimulateTuneScenario(spec.train[i], options.progress, &train[i], error)) return false;
   for (size_t i = 0; i < spec.validation.size(); ++i)
-    if (!SimulateTuneScenario(spec.validation[i], options.progress, &validation[i], error)) return false;
+    if (!SimulateTuneScenario(spec.validation[i], options.progress, &validation[i], error))
+      return false;
   s.simulate_s = Seconds(start);
 
   // 2. Search on the training set.
   const auto search_start = Clock::now();
   std::vector<std::vector<SequenceScore>> eval_scores;  // per evaluation, per training scenario
-  const Objective objective = [&](const std::vector<double>& values, double* score, std::string* why) {
+  const Objective objective = [&](const std::vector<double>& values, double* score,
+                                  std::string* why) {
     vo::OdometryOptions o;
     if (!ApplyParameters(spec, values, &o, why)) return false;
     std::vector<SequenceScore> scores(train.size());
@@ -786,14 +832,16 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
     return true;
   };
   auto last = Clock::now();
-  const EvaluationCallback progress = [&](const Evaluation& e, const Evaluation& best, int max_evals) {
+  const EvaluationCallback progress = [&](const Evaluation& e, const Evaluation& best,
+                                          int max_evals) {
     if (!options.progress) return;
-    std::fprintf(stderr, "tune %s  eval %d/%d  score %.6f  best %.6f (eval %d)  %s  %.1f s\n",
-                 spec.name.c_str(), e.index + 1, max_evals, e.score, best.score, best.index + 1,
-                 e.origin.c_str(), Seconds(last));
+    std::fprintf(stderr, "tune %s  [%d/%d] eval %d  score %.6f  best %.6f (eval %d)  %s  %.1f s\n",
+                 spec.name.c_str(), e.index + 1, max_evals, e.index, e.score, best.score,
+                 best.index, e.origin.c_str(), Seconds(last));
     last = Clock::now();
   };
-  if (!Minimize(spec.parameters, spec.start_values, opt, objective, &s.optimization, error, progress))
+  if (!Minimize(spec.parameters, spec.start_values, opt, objective, &s.optimization, error,
+                progress))
     return false;
   s.search_s = Seconds(search_start);
   const Evaluation& best = s.optimization.best();
@@ -850,7 +898,8 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
   const fs::path p = guard.path;
   if (!WriteTextFile((p / "best_vo.yaml").string(), VoConfigToYaml(s.best_options), error) ||
       !WriteTextFile((p / "base_vo.yaml").string(), VoConfigToYaml(base_options), error) ||
-      !WriteTextFile((p / "evaluations.csv").string(), EvaluationsCsv(spec, s.optimization, eval_scores), error) ||
+      !WriteTextFile((p / "evaluations.csv").string(),
+                     EvaluationsCsv(spec, s.optimization, eval_scores), error) ||
       !WriteTextFile((p / "scores.csv").string(), ScoresCsv(spec, s), error) ||
       !WriteTextFile((p / "tune.yaml").string(), spec.text, error)) {
     return false;
@@ -863,7 +912,8 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
     has_plot = RunTunePlot(p.string(), (p / "objective.png").string(), &why);
     if (!has_plot) std::fprintf(stderr, "warning: no plot: %s\n", why.c_str());
   }
-  if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(spec, s, opt, has_plot), error)) return false;
+  if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(spec, s, opt, has_plot), error))
+    return false;
   if (fs::exists(dir)) fs::remove_all(dir, ec);
   fs::rename(p, dir, ec);
   if (ec) {
@@ -879,14 +929,15 @@ std::string TuneSummaryTable(const TuneSpec& spec, const TuneSummary& s) {
   const std::string m = spec.objective.metric.substr(0, 22);
   std::ostringstream out;
   char line[512];
-  std::snprintf(line, sizeof(line), "%-18s %-10s %6s | %22s %5s %9s | %22s %5s %9s | %8s\n", "scenario",
-                "set", "frames", ("default " + m).c_str(), "lost", "score", ("tuned " + m).c_str(), "lost",
-                "score", "change");
+  std::snprintf(line, sizeof(line), "%-18s %-10s %6s | %22s %5s %9s | %22s %5s %9s | %8s\n",
+                "scenario", "set", "frames", ("default " + m).c_str(), "lost", "score",
+                ("tuned " + m).c_str(), "lost", "score", "change");
   out << line;
   for (const TuneScenarioResult& r : s.scenarios) {
-    std::snprintf(line, sizeof(line), "%-18s %-10s %6d | %22.5f %5d %9.5f | %22.5f %5d %9.5f | %8s\n",
-                  r.name.c_str(), r.train ? "train" : "validation", r.frames, r.base.metric,
-                  r.base.lost_frames, r.base.score, r.tuned.metric, r.tuned.lost_frames, r.tuned.score,
+    std::snprintf(line, sizeof(line),
+                  "%-18s %-10s %6d | %22.5f %5d %9.5f | %22.5f %5d %9.5f | %8s\n", r.name.c_str(),
+                  r.train ? "train" : "validation", r.frames, r.base.metric, r.base.lost_frames,
+                  r.base.score, r.tuned.metric, r.tuned.lost_frames, r.tuned.score,
                   Change(r.base.score, r.tuned.score).c_str());
     out << line;
   }
@@ -895,14 +946,15 @@ std::string TuneSummaryTable(const TuneSpec& spec, const TuneSummary& s) {
     const double base = train ? s.train_base : s.validation_base;
     const double tuned = train ? s.train_tuned : s.validation_tuned;
     std::snprintf(line, sizeof(line), "%-18s %-10s %6s | %22s %5s %9.5f | %22s %5s %9.5f | %8s\n",
-                  objective.c_str(), train ? "train" : "validation", "", "", "", base, "", "", tuned,
-                  Change(base, tuned).c_str());
+                  objective.c_str(), train ? "train" : "validation", "", "", "", base, "", "",
+                  tuned, Change(base, tuned).c_str());
     out << line;
   }
   out << "parameters (default -> tuned):\n";
   for (size_t i = 0; i < spec.parameters.size(); ++i) {
-    std::snprintf(line, sizeof(line), "  %-36s %10s -> %s\n", ColumnName(spec.parameters[i]).c_str(),
-                  Short(spec.start_values[i]).c_str(), Short(s.optimization.best().values[i]).c_str());
+    std::snprintf(line, sizeof(line), "  %-36s %10s -> %s\n",
+                  ColumnName(spec.parameters[i]).c_str(), Short(spec.start_values[i]).c_str(),
+                  Short(s.optimization.best().values[i]).c_str());
     out << line;
   }
   return out.str();

@@ -50,8 +50,9 @@
 // if it holds an earlier tune result, i.e. summary.json):
 //   best_vo.yaml      the best options found, every key (vobench run --config accepts it)
 //   base_vo.yaml      the start (default) options, every key
-//   evaluations.csv   one row per evaluation: eval, origin, parameter values, per training
-//                     scenario `<name>:<metric>` and `<name>:lost_frames`, objective,
+//   evaluations.csv   one row per evaluation: eval (0-based; 0 = the start, i.e. the default),
+//                     origin ("start", the algorithm, "... restart N"), parameter values, per
+//                     training scenario `<name>:<metric>` and `<name>:lost_frames`, objective,
 //                     best_objective (best so far)
 //   scores.csv        scenario, set (train|validation), frames, and for config default|tuned
 //                     the metric, lost frames and score
@@ -136,7 +137,7 @@ bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& opti
 double AggregateScores(const std::vector<SequenceScore>& scores, const TuneObjective& objective);
 
 struct TuneOptions {
-  std::string out_dir;  // output folder (see above)
+  std::string out_dir;   // output folder (see above)
   bool progress = true;  // rendering progress and one line per evaluation on stderr
   bool plots = true;     // objective.png (python3-matplotlib)
   int max_evals = 0;     // > 0: replaces the file's optimizer.max_evals
@@ -152,8 +153,8 @@ struct TuneScenarioResult {
 
 struct TuneSummary {
   OptimizationResult optimization;
-  std::vector<TuneScenarioResult> scenarios;  // training first, then validation, file order
-  double train_base = 0.0, train_tuned = 0.0;            // objective on the training set
+  std::vector<TuneScenarioResult> scenarios;   // training first, then validation, file order
+  double train_base = 0.0, train_tuned = 0.0;  // objective on the training set
   double validation_base = 0.0, validation_tuned = 0.0;  // the same aggregate on validation
   vo::OdometryOptions best_options;
   double simulate_s = 0.0;    // simulating the scenarios (s)

@@ -2,16 +2,15 @@
 //   vobench tune FILE [--out DIR] [--max-evals N] [--no-plots] [-q]
 #pragma once
 
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace harness {
 
 struct TuneCommandArgs {
-  std::string file;    // the tune file (YAML, see tune.h)
-  std::string out;     // output folder; "" = out/tune/<name>
-  int max_evals = 0;   // > 0: replaces the file's optimizer.max_evals
+  std::string file;   // the tune file (YAML, see tune.h)
+  std::string out;    // output folder; "" = out/tune/<name>
+  int max_evals = 0;  // > 0: replaces the file's optimizer.max_evals
   bool no_plots = false;
   bool quiet = false;
 };

@@ -4,15 +4,14 @@
 // same as `vobench run`, bad files refused with nothing written.
 #include "harness/tune.h"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "harness/optimizer.h"
 #include "harness/render.h"
@@ -92,18 +91,19 @@ TEST(OptimizerTest, ParametersAndOptionsAreChecked) {
   o.algorithm = "LD_LBFGS";  // needs gradients
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_NE(error.find("LN_SBPLX"), std::string::npos) << error;  // lists the accepted ones
-  o.algorithm = "LN_AUGLAG";  // needs a subsidiary optimiser
+  o.algorithm = "LN_AUGLAG";                                      // needs a subsidiary optimiser
   EXPECT_FALSE(o.IsValid(&error));
   o.algorithm = "no_such";
   EXPECT_FALSE(o.IsValid(&error));
-  for (const char* name : {"random", "LN_SBPLX", "LN_BOBYQA", "LN_COBYLA", "GN_DIRECT_L", "GN_CRS2_LM"})
+  for (const char* name :
+       {"random", "LN_SBPLX", "LN_BOBYQA", "LN_COBYLA", "GN_DIRECT_L", "GN_CRS2_LM"})
     EXPECT_TRUE(harness::IsSupportedAlgorithm(name)) << name;
   // A start outside the box is refused.
   OptimizationResult r;
   int calls = 0;
   o = OptimizerOptions();
-  EXPECT_FALSE(harness::Minimize(QuadraticParameters(), {1.0, 0.0, 5.5}, o, CountingQuadratic(&calls),
-                                 &r, &error));
+  EXPECT_FALSE(harness::Minimize(QuadraticParameters(), {1.0, 0.0, 5.5}, o,
+                                 CountingQuadratic(&calls), &r, &error));
   EXPECT_NE(error.find("'n'"), std::string::npos) << error;
   EXPECT_EQ(calls, 0);
 }
@@ -119,7 +119,8 @@ TEST_P(NloptAlgorithmTest, FindsTheMinimumOfAShiftedQuadratic) {
   int calls = 0;
   OptimizationResult r;
   std::string error;
-  ASSERT_TRUE(harness::Minimize(QuadraticParameters(), kStart, o, CountingQuadratic(&calls), &r, &error))
+  ASSERT_TRUE(
+      harness::Minimize(QuadraticParameters(), kStart, o, CountingQuadratic(&calls), &r, &error))
       << error;
   const Evaluation& best = r.best();
   EXPECT_NEAR(best.values[0], kOptA, 0.02 * kOptA) << r.stop_reason;
@@ -146,7 +147,8 @@ TEST(OptimizerTest, RandomSearchFindsTheMinimumAndIsSeeded) {
   int calls = 0;
   OptimizationResult r, again, other;
   std::string error;
-  ASSERT_TRUE(harness::Minimize(QuadraticParameters(), kStart, o, CountingQuadratic(&calls), &r, &error))
+  ASSERT_TRUE(
+      harness::Minimize(QuadraticParameters(), kStart, o, CountingQuadratic(&calls), &r, &error))
       << error;
   EXPECT_EQ(static_cast<int>(r.evaluations.size()), o.max_evals);
   EXPECT_EQ(calls, o.max_evals);
@@ -176,8 +178,10 @@ TEST(OptimizerTest, StochasticNloptAlgorithmIsRepeatableForASeed) {
   int calls = 0;
   OptimizationResult a, b;
   std::string error;
-  ASSERT_TRUE(harness::Minimize(QuadraticParameters(), kStart, o, CountingQuadratic(&calls), &a, &error));
-  ASSERT_TRUE(harness::Minimize(QuadraticParameters(), kStart, o, CountingQuadratic(&calls), &b, &error));
+  ASSERT_TRUE(
+      harness::Minimize(QuadraticParameters(), kStart, o, CountingQuadratic(&calls), &a, &error));
+  ASSERT_TRUE(
+      harness::Minimize(QuadraticParameters(), kStart, o, CountingQuadratic(&calls), &b, &error));
   ASSERT_EQ(a.evaluations.size(), b.evaluations.size());
   for (size_t i = 0; i < a.evaluations.size(); ++i)
     EXPECT_EQ(a.evaluations[i].values, b.evaluations[i].values) << i;
@@ -191,8 +195,8 @@ TEST(OptimizerTest, NeverWorseThanTheStartAndCachesRepeatedPoints) {
   int calls = 0;
   OptimizationResult r;
   std::string error;
-  ASSERT_TRUE(harness::Minimize(QuadraticParameters(), {kOptA, kOptB, kOptN}, o, CountingQuadratic(&calls),
-                                &r, &error));
+  ASSERT_TRUE(harness::Minimize(QuadraticParameters(), {kOptA, kOptB, kOptN}, o,
+                                CountingQuadratic(&calls), &r, &error));
   EXPECT_EQ(r.best_index, 0);
   EXPECT_EQ(r.best().score, 0.0);
   // One integer parameter with three values and a budget of ten: three evaluations, no repeats.
@@ -246,15 +250,21 @@ TEST(OptimizerTest, AFailingObjectiveAbortsWithItsError) {
 // Tiny scenarios: the real hallway at 160×120, a few frames.
 const char* kScenarioSet = "camera.width: 160, camera.height: 120, path: [[0, 0], [0.6, 0]]";
 
-std::string TuneFileText(const std::string& max_frames = "6", const std::string& extra_parameters = "",
-                         const std::string& optimizer = "{algorithm: random, max_evals: 4, seed: 9}") {
+std::string TuneFileText(
+    const std::string& max_frames = "6", const std::string& extra_parameters = "",
+    const std::string& optimizer = "{algorithm: random, max_evals: 4, seed: 9}") {
   return std::string("name: tiny\n") +
          "train:\n"
-         "  - {name: tr_a, scenario: l_hallway, set: {" + kScenarioSet + ", textures.seed: 3}, max_frames: " +
-         max_frames + "}\n"
+         "  - {name: tr_a, scenario: l_hallway, set: {" +
+         kScenarioSet + ", textures.seed: 3}, max_frames: " + max_frames +
+         "}\n"
          "validation:\n"
-         "  - {name: va_a, scenario: l_hallway, set: {" + kScenarioSet + ", textures.seed: 4, seed: 2}, "
-         "max_frames: " + max_frames + "}\n"
+         "  - {name: va_a, scenario: l_hallway, set: {" +
+         kScenarioSet +
+         ", textures.seed: 4, seed: 2}, "
+         "max_frames: " +
+         max_frames +
+         "}\n"
          "parameters:\n"
          "  - {key: matcher.svd.sigma_px, min: 4, max: 30, log: true}\n"
          "  - {key: matcher.ncc.window_px, type: int, min: 5, max: 21, step: 2}\n"
@@ -262,14 +272,16 @@ std::string TuneFileText(const std::string& max_frames = "6", const std::string&
          "  - {key: ransac.inlier_threshold_px, min: 0.5, max: 5, log: true}\n" +
          extra_parameters +
          "objective: {metric: ate_rmse_m, lost_frame_penalty: 0.05, aggregate: mean}\n"
-         "optimizer: " + optimizer + "\n";
+         "optimizer: " +
+         optimizer + "\n";
 }
 
 TEST(TuneSpecTest, ReadsAValidFile) {
   harness::TuneSpec spec;
   std::string error;
-  ASSERT_TRUE(harness::ParseTuneSpec(TuneFileText("6", "  - {key: ba_window_frames, type: int, min: 3, max: 10}\n"),
-                                     "t.yaml", ".", &spec, &error))
+  ASSERT_TRUE(harness::ParseTuneSpec(
+      TuneFileText("6", "  - {key: ba_window_frames, type: int, min: 3, max: 10}\n"), "t.yaml", ".",
+      &spec, &error))
       << error;
   EXPECT_EQ(spec.name, "tiny");
   ASSERT_EQ(spec.train.size(), 1u);
@@ -282,9 +294,8 @@ TEST(TuneSpecTest, ReadsAValidFile) {
   EXPECT_EQ(spec.parameters[1].step, 2);
   EXPECT_EQ(spec.parameters[2].type, ParameterType::kScale);
   const vo::OdometryOptions defaults;
-  EXPECT_EQ(spec.start_values,
-            (std::vector<double>{defaults.matcher.svd.sigma_px, 11.0, 1.0,
-                                 defaults.ransac.inlier_threshold_px, 5.0}));
+  EXPECT_EQ(spec.start_values, (std::vector<double>{defaults.matcher.svd.sigma_px, 11.0, 1.0,
+                                                    defaults.ransac.inlier_threshold_px, 5.0}));
   EXPECT_EQ(spec.optimizer.algorithm, "random");
   EXPECT_EQ(spec.optimizer.max_evals, 4);
   // Applying values: scale multiplies the default wavelengths; the start gives the defaults.
@@ -317,33 +328,49 @@ std::vector<BadFile> BadFiles() {
   };
   return {
       {"unknown top-level key", good + "paramters: []\n", {":13:", "'paramters'"}},
-      {"unknown scenario key", replace("max_frames: 6}", "max_frame: 6}"), {":3:", "'max_frame'", "train[0]"}},
-      {"unknown VO key", replace("matcher.svd.sigma_px", "matcher.svd.sigmaa"),
+      {"unknown scenario key",
+       replace("max_frames: 6}", "max_frame: 6}"),
+       {":3:", "'max_frame'", "train[0]"}},
+      {"unknown VO key",
+       replace("matcher.svd.sigma_px", "matcher.svd.sigmaa"),
        {":7:", "'matcher.svd.sigmaa'", "not a VO option"}},
-      {"min >= max", replace("min: 4, max: 30", "min: 30, max: 4"), {":7:", "matcher.svd.sigma_px", "min < max"}},
-      {"empty training set", "name: x\ntrain: []\nvalidation: []\nparameters: []\n",
+      {"min >= max",
+       replace("min: 4, max: 30", "min: 30, max: 4"),
+       {":7:", "matcher.svd.sigma_px", "min < max"}},
+      {"empty training set",
+       "name: x\ntrain: []\nvalidation: []\nparameters: []\n",
        {":2:", "'train'", "empty"}},
-      {"validation equals training", replace("textures.seed: 4, seed: 2", "textures.seed: 3"),
+      {"validation equals training",
+       replace("textures.seed: 4, seed: 2", "textures.seed: 3"),
        {":5:", "'va_a'", "'tr_a'"}},
-      {"even NCC window", replace("min: 5, max: 21, step: 2", "min: 5, max: 21"),
+      {"even NCC window",
+       replace("min: 5, max: 21, step: 2", "min: 5, max: 21"),
        {":8:", "matcher.ncc.window_px", "value 6", "odd"}},
-      {"real on an integer key", replace("type: int, min: 5, max: 21, step: 2", "min: 5, max: 21"),
+      {"real on an integer key",
+       replace("type: int, min: 5, max: 21, step: 2", "min: 5, max: 21"),
        {":8:", "matcher.ncc.window_px"}},
-      {"scale on a scalar key", replace("matcher.gabor.wavelengths_px", "ransac.confidence"),
+      {"scale on a scalar key",
+       replace("matcher.gabor.wavelengths_px", "ransac.confidence"),
        {":9:", "ransac.confidence", "list-valued"}},
-      {"non-numeric key", replace("key: matcher.svd.sigma_px, min: 4, max: 30, log: true",
-                                  "key: matcher.type, min: 0, max: 1"),
+      {"non-numeric key",
+       replace("key: matcher.svd.sigma_px, min: 4, max: 30, log: true",
+               "key: matcher.type, min: 0, max: 1"),
        {":7:", "matcher.type", "not a numeric"}},
-      {"start outside the range", replace("min: 0.5, max: 5", "min: 2.5, max: 5"),
+      {"start outside the range",
+       replace("min: 0.5, max: 5", "min: 2.5, max: 5"),
        {":10:", "ransac.inlier_threshold_px", "outside"}},
-      {"key given twice", good.substr(0, good.find("objective")) +
-                              "  - {key: matcher.svd.sigma_px, min: 5, max: 20}\n" +
-                              good.substr(good.find("objective")),
+      {"key given twice",
+       good.substr(0, good.find("objective")) +
+           "  - {key: matcher.svd.sigma_px, min: 5, max: 20}\n" +
+           good.substr(good.find("objective")),
        {":11:", "matcher.svd.sigma_px", "twice"}},
       {"unknown metric", replace("metric: ate_rmse_m", "metric: ate"), {":11:", "'ate'"}},
       {"unknown algorithm", replace("algorithm: random", "algorithm: LN_FOO"), {":12:", "LN_FOO"}},
-      {"bad scenario override", replace("textures.seed: 3}", "textures.seeed: 3}"), {":3:", "seeed"}},
-      {"unknown scenario", replace("scenario: l_hallway", "scenario: no_such_hallway"),
+      {"bad scenario override",
+       replace("textures.seed: 3}", "textures.seeed: 3}"),
+       {":3:", "seeed"}},
+      {"unknown scenario",
+       replace("scenario: l_hallway", "scenario: no_such_hallway"),
        {":3:", "no_such_hallway"}},
   };
 }
@@ -355,7 +382,8 @@ TEST(TuneSpecTest, BadFilesAreRefusedWithFileLineAndKey) {
     EXPECT_FALSE(harness::ParseTuneSpec(bad.text, "bad_tune.yaml", ".", &spec, &error)) << bad.what;
     EXPECT_EQ(error.rfind("bad_tune.yaml", 0), 0u) << bad.what << ": " << error;
     for (const std::string& e : bad.expected)
-      EXPECT_NE(error.find(e), std::string::npos) << bad.what << ": '" << e << "' not in: " << error;
+      EXPECT_NE(error.find(e), std::string::npos)
+          << bad.what << ": '" << e << "' not in: " << error;
   }
 }
 
@@ -394,11 +422,13 @@ TEST(TuneCommandTest, BadTuneFilesFailWithTheirMessageAndWriteNothing) {
     EXPECT_EQ(r.exit_code, 2) << bad.what << ": " << r.output;
     EXPECT_NE(r.output.find(file), std::string::npos) << bad.what << ": " << r.output;
     for (const std::string& e : bad.expected)
-      EXPECT_NE(r.output.find(e), std::string::npos) << bad.what << ": '" << e << "' not in: " << r.output;
+      EXPECT_NE(r.output.find(e), std::string::npos)
+          << bad.what << ": '" << e << "' not in: " << r.output;
     EXPECT_FALSE(fs::exists(out)) << bad.what;
     EXPECT_FALSE(fs::exists(out + ".partial")) << bad.what;
   }
-  const CommandResult missing = RunVobench("tune " + (dir / "none.yaml") + " -q --out " + (dir / "out"));
+  const CommandResult missing =
+      RunVobench("tune " + (dir / "none.yaml") + " -q --out " + (dir / "out"));
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.output.find("none.yaml"), std::string::npos) << missing.output;
   // An existing folder that is not a tune result is not replaced (refused before simulating).
@@ -426,8 +456,8 @@ TEST(TuneCommandTest, TunesDeterministicallyAndWritesALoadableBestConfig) {
   const CommandResult r1 = RunVobench("tune " + file + " -q --no-plots --out " + out1);
   ASSERT_EQ(r1.exit_code, 0) << r1.output;
   EXPECT_NE(r1.output.find("validation"), std::string::npos) << r1.output;  // the summary table
-  for (const char* f : {"best_vo.yaml", "base_vo.yaml", "evaluations.csv", "scores.csv", "summary.json",
-                        "report.md", "tune.yaml"})
+  for (const char* f : {"best_vo.yaml", "base_vo.yaml", "evaluations.csv", "scores.csv",
+                        "summary.json", "report.md", "tune.yaml"})
     EXPECT_TRUE(fs::exists(fs::path(out1) / f)) << f;
   EXPECT_FALSE(fs::exists(out1 + ".partial"));
 
@@ -444,9 +474,10 @@ TEST(TuneCommandTest, TunesDeterministicallyAndWritesALoadableBestConfig) {
     for (std::string l; std::getline(csv, l);) lines.push_back(l);
   }
   ASSERT_EQ(lines.size(), 5u);
-  EXPECT_EQ(lines[0],
-            "eval,origin,matcher.svd.sigma_px,matcher.ncc.window_px,matcher.gabor.wavelengths_px:scale,"
-            "ransac.inlier_threshold_px,tr_a:ate_rmse_m,tr_a:lost_frames,objective,best_objective");
+  EXPECT_EQ(
+      lines[0],
+      "eval,origin,matcher.svd.sigma_px,matcher.ncc.window_px,matcher.gabor.wavelengths_px:scale,"
+      "ransac.inlier_threshold_px,tr_a:ate_rmse_m,tr_a:lost_frames,objective,best_objective");
   EXPECT_EQ(lines[1].rfind("0,start,10,11,1,2,", 0), 0u) << lines[1];
 
   // Never worse than the start on training; the tuned values are the best evaluation's.
@@ -482,7 +513,8 @@ TEST(TuneCommandTest, TunesDeterministicallyAndWritesALoadableBestConfig) {
   run.plots = false;
   run.max_frames = spec.train[0].max_frames;
   harness::RunSummary s;
-  ASSERT_TRUE(harness::RunScenario(spec.train[0].scenario, spec.base_options, run, &s, &error)) << error;
+  ASSERT_TRUE(harness::RunScenario(spec.train[0].scenario, spec.base_options, run, &s, &error))
+      << error;
   EXPECT_EQ(j["scenarios"][0]["default"]["ate_rmse_m"].get<double>(), s.metrics.ate_rmse_m);
   EXPECT_EQ(j["scenarios"][0]["default"]["lost_frames"].get<int>(), s.lost_frames);
   EXPECT_EQ(j["scenarios"][0]["frames"].get<int>(), s.metrics.frames);
