@@ -11,6 +11,7 @@ PACKAGES=(
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libspdlog-dev  # config, CLI, JSON, logging
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
   python3 python3-matplotlib python3-numpy    # plots in reports
+  libnlopt-cxx-dev                            # derivative-free optimisers (vobench tune)
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -19,6 +19,7 @@
 #include "harness/run.h"
 #include "harness/vo_config.h"
 #include "harness/trajectory_io.h"
+#include "harness/tune_command.h"
 
 namespace {
 
@@ -250,6 +251,8 @@ int main(int argc, char** argv) {
   run->add_flag("-q,--quiet", quiet, "No progress display");
 
   const auto eval = harness::AddEvalCommand(app);
+  harness::TuneCommandArgs tune_args;
+  CLI::App* tune = harness::AddTuneCommand(app, &tune_args);
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
@@ -257,6 +260,7 @@ int main(int argc, char** argv) {
   if (*render) return RunRender(scenario, out, format, overwrite, quiet);
   if (*run) return RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_no_plots, quiet);
   if (*eval->app) return eval->Run(PrintRunTable);
+  if (*tune) return harness::RunTuneCommand(tune_args);
   if (*match_eval) return RunMatchEval(me_scenario, me_strides, me_matchers, me_out, me_max_frames, quiet);
   return 0;
 }
