@@ -93,6 +93,7 @@ std::string MetricsJson(const RunSummary& s) {
   const TrajectoryMetrics& m = s.metrics;
   j["name"] = s.name;
   j["frames"] = m.frames;
+  j["frame_stride"] = s.frame_stride;
   j["has_ground_truth"] = s.has_ground_truth;
   j["path_length_m"] = m.path_length_m;
   j["end_pose_error_m"] = m.end_pose_error_m;
@@ -118,6 +119,10 @@ std::string MetricsJson(const RunSummary& s) {
 bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameSource source,
                  int expected_frames, const vo::OdometryOptions& vo_options, const RunOptions& options,
                  const std::string& scenario_yaml, RunSummary* summary, std::string* error) {
+  if (options.frame_stride < 1) {
+    *error = "frame stride must be >= 1, got " + std::to_string(options.frame_stride);
+    return false;
+  }
   auto odometry = vo::StereoOdometry::Create(camera, vo_options, error);
   if (!odometry) {
     *error = "invalid VO options or camera: " + *error;
@@ -142,9 +147,14 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   std::vector<Eigen::Isometry3d> est, gt;
   std::vector<vo::OdometryResult> results;
   bool has_gt = true;
-  Progress progress("vo " + name, expected_frames, options.progress);
+  const int stride = options.frame_stride;
+  if (options.max_frames > 0 && (expected_frames <= 0 || expected_frames > options.max_frames))
+    expected_frames = options.max_frames;
+  Progress progress("vo " + name, (expected_frames + stride - 1) / stride, options.progress);
   DatasetFrame frame;
-  while ((options.max_frames <= 0 || static_cast<int>(results.size()) < options.max_frames) && source(&frame, error)) {
+  int source_frames = 0;
+  while ((options.max_frames <= 0 || source_frames < options.max_frames) && source(&frame, error)) {
+    if (source_frames++ % stride != 0) continue;  // frame stride: skip to every k-th frame
     results.push_back(odometry->Process(frame.left, frame.right, frame.time_s));
     times.push_back(frame.time_s);
     est.push_back(results.back().T_world_cam0);
@@ -164,6 +174,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   s = RunSummary();
   s.name = name;
   s.has_ground_truth = has_gt;
+  s.frame_stride = stride;
   if (has_gt) s.metrics = ComputeTrajectoryMetrics(est, gt);
   s.metrics.frames = static_cast<int>(results.size());
   std::vector<double> total, feats, inl;
