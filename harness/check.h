@@ -6,7 +6,7 @@
 //   {
 //     "suite": "../suites/ci.yaml",          the suite, relative to the baseline file
 //     "tolerance_rule": "...",               how the tolerances were chosen (text)
-//     "relative_tolerance": 0.2,             --update: tolerance = max(relative * |value|,
+//     "relative_tolerance": 0.25,            --update: tolerance = max(relative * |value|,
 //     "absolute_tolerance": {"ate_rmse_m": 0.005, ...},        absolute[metric])
 //     "runs": {
 //       "<run id>": {

@@ -556,10 +556,19 @@ bool IsFinished(const fs::path& run_dir, const std::string& spec_hash, json* sta
   return true;
 }
 
-// Removes tmp/ and every *.partial* entry in runs/ (leftovers of interrupted runs).
-void RemoveLeftovers(const fs::path& out) {
+// The folder under tmp/ where this process's children write: one per shard, so shards that share
+// an output folder never remove each other's runs in progress.
+fs::path WorkDir(const fs::path& out, const std::string& tag) { return out / "tmp" / tag; }
+std::string ShardTag(const Shard& shard) {
+  return "shard" + std::to_string(shard.index) + "of" + std::to_string(shard.count);
+}
+
+// Removes `work` (this process's folder under tmp/, and tmp/ when it is then empty) and every
+// *.partial* entry in runs/: leftovers of interrupted runs.
+void RemoveLeftovers(const fs::path& out, const fs::path& work) {
   std::error_code ec;
-  fs::remove_all(out / "tmp", ec);
+  fs::remove_all(work, ec);
+  fs::remove(out / "tmp", ec);  // only if empty
   std::vector<fs::path> partial;
   for (fs::directory_iterator it(out / "runs", ec), end; !ec && it != end; it.increment(ec))
     if (it->path().filename().string().find(".partial") != std::string::npos)
@@ -569,7 +578,7 @@ void RemoveLeftovers(const fs::path& out) {
 
 bool MakeDirs(const fs::path& out, std::string* error) {
   std::error_code ec;
-  for (const char* sub : {"runs", "specs", "logs", "tmp"}) {
+  for (const char* sub : {"runs", "specs", "logs"}) {
     fs::create_directories(out / sub, ec);
     if (ec) {
       *error = (out / sub).string() + ": cannot create: " + ec.message();
@@ -666,6 +675,7 @@ std::string ExitText(int status) {
 struct Job {
   SuiteRun run;
   std::vector<std::string> argv;
+  fs::path tmp;  // the child's --out (moved to runs/<id> when finished)
   std::chrono::steady_clock::time_point start;
 };
 
@@ -673,7 +683,7 @@ struct Job {
 bool FinishJob(const fs::path& out, const Job& job, int status, double wall_s, bool* ok,
                std::string* error) {
   const SuiteRun& r = job.run;
-  const fs::path tmp = out / "tmp" / r.id, dst = out / "runs" / r.id;
+  const fs::path tmp = job.tmp, dst = out / "runs" / r.id;
   const fs::path failed = out / "runs" / (r.id + ".failed.txt");
   std::error_code ec;
   *ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::is_regular_file(tmp / "metrics.json");
@@ -712,15 +722,15 @@ bool FinishJob(const fs::path& out, const Job& job, int status, double wall_s, b
   return WriteFileAtomically(failed.string(), text, error);
 }
 
-std::vector<std::string> RunArgv(const std::string& binary, const fs::path& out, const SuiteRun& r,
-                                 bool plots) {
+std::vector<std::string> RunArgv(const std::string& binary, const fs::path& out,
+                                 const fs::path& tmp, const SuiteRun& r, bool plots) {
   std::vector<std::string> argv = {binary,
                                    "run",
                                    (out / "specs" / (r.id + ".scenario.yaml")).string(),
                                    "--config",
                                    (out / "specs" / (r.id + ".vo.yaml")).string(),
                                    "--out",
-                                   (out / "tmp" / r.id).string(),
+                                   tmp.string(),
                                    "--max-frames",
                                    std::to_string(r.max_frames),
                                    "--stride",
@@ -1085,8 +1095,13 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
       !WriteFileAtomically((out / "suite.yaml").string(), suite.source_text, error) ||
       !MakeDirs(out, error))
     return false;
-  RemoveLeftovers(out);
-  if (!MakeDirs(out, error)) return false;
+  const fs::path work = WorkDir(out, ShardTag(options.shard));
+  RemoveLeftovers(out, work);
+  fs::create_directories(work, ec);
+  if (ec) {
+    *error = work.string() + ": cannot create: " + ec.message();
+    return false;
+  }
 
   // What to run: this shard's runs that are not finished for their spec.
   std::deque<Job> queue;
@@ -1101,7 +1116,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
       ++result->kept;
       continue;
     }
-    queue.push_back({r, RunArgv(binary, out, r, options.run_plots), {}});
+    queue.push_back({r, RunArgv(binary, out, work / r.id, r, options.run_plots), work / r.id, {}});
   }
   const int total = static_cast<int>(queue.size());
   if (options.progress)
@@ -1125,8 +1140,8 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
       Job job = queue.front();
       queue.pop_front();
       std::error_code ec;
-      fs::remove_all(out / "tmp" / job.run.id, ec);
-      fs::remove_all(out / "tmp" / (job.run.id + ".partial"), ec);
+      fs::remove_all(job.tmp, ec);
+      fs::remove_all(job.tmp.string() + ".partial", ec);
       job.start = std::chrono::steady_clock::now();
       pid_t pid = 0;
       if (!Spawn(job.argv, (out / "logs" / (job.run.id + ".log")).string(), &pid, error)) {
@@ -1136,13 +1151,14 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
       running.emplace(pid, job);
     }
     int status = 0;
-    const pid_t pid = waitpid(-1, &status, WNOHANG);
-    if (pid <= 0) {
+    // Poll our own children only (a host program may have others).
+    auto it = running.begin();
+    for (; it != running.end(); ++it)
+      if (waitpid(it->first, &status, WNOHANG) == it->first) break;
+    if (it == running.end()) {
       std::this_thread::sleep_for(kWaitPoll);
       continue;
     }
-    auto it = running.find(pid);
-    if (it == running.end()) continue;  // not one of ours
     const Job job = it->second;
     running.erase(it);
     const double wall_s =
@@ -1173,7 +1189,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
       int status = 0;
       waitpid(pid, &status, 0);
     }
-    RemoveLeftovers(out);
+    RemoveLeftovers(out, work);
     if (!fatal)
       *error = std::string("interrupted by signal ") + std::to_string(g_interrupt_signal.load()) +
                " after " + std::to_string(done) + " of " + std::to_string(total) +
@@ -1181,7 +1197,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
     return false;
   }
   progress.Finish(done);
-  RemoveLeftovers(out);
+  RemoveLeftovers(out, work);
 
   result->rows = CollectRows(out, runs, options.shard);
   for (auto& row : result->rows) {
@@ -1242,8 +1258,8 @@ bool MergeSuiteShards(const std::vector<std::string>& shard_dirs, const std::str
   }
   const fs::path out = out_dir;
   if (!CheckOutDir(out, name, error) || !MakeDirs(out, error)) return false;
-  RemoveLeftovers(out);
-  if (!MakeDirs(out, error)) return false;
+  const fs::path work = WorkDir(out, "merge");
+  RemoveLeftovers(out, work);
   for (const auto& r : runs) {
     std::error_code ec;
     const fs::path dst = out / "runs" / r.id;
@@ -1252,9 +1268,10 @@ bool MergeSuiteShards(const std::vector<std::string>& shard_dirs, const std::str
       const fs::path src = fs::path(dir) / "runs" / r.id;
       if (!IsFinished(src, r.spec_hash)) continue;
       // Copy under tmp/ and rename, so a merged run also appears only when complete.
-      const fs::path tmp = out / "tmp" / r.id;
+      const fs::path tmp = work / r.id;
       fs::remove_all(tmp, ec);
-      fs::copy(src, tmp, fs::copy_options::recursive, ec);
+      fs::create_directories(work, ec);
+      if (!ec) fs::copy(src, tmp, fs::copy_options::recursive, ec);
       if (!ec) fs::remove_all(dst, ec);
       if (!ec) fs::rename(tmp, dst, ec);
       if (ec) {
@@ -1284,7 +1301,7 @@ bool MergeSuiteShards(const std::vector<std::string>& shard_dirs, const std::str
       break;
     }
   }
-  RemoveLeftovers(out);
+  RemoveLeftovers(out, work);
   json manifest;
   if (!ReadJsonFile(fs::path(shard_dirs[0]) / "suite.json", &manifest, error)) return false;
   manifest["shard"] = "1/1";

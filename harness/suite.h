@@ -3,39 +3,41 @@
 // a summary table across the runs.
 //
 // Suite file (YAML; unknown keys are refused with the file, line and key; see suites/*.yaml):
-//   name: hallway                 # suite name ([A-Za-z0-9_.-], no "__"); default out/suite/<name>
-//   max_frames: 0                 # optional default for every scenario (source frames, 0 = all)
-//   scenarios:                    # at least one
-//     - name: l_hallway           # optional (default: the scenario's name); unique
-//       scenario: l_hallway       # a built-in scenario (scenes/) or a YAML file relative to the
-//       suite set: {noise.pixel_sigma: 3}   # optional scenario overrides (dotted keys,
-//       harness/overrides.h) max_frames: 200           # optional: stop after this many source
-//       frames
-//   configs:                      # at least one
-//     - name: paper               # required, unique
-//       config: vo.yaml           # optional VO config file relative to the suite (default options)
+//   name: hallway               # suite name ([A-Za-z0-9_.-], no "__")
+//   max_frames: 0               # optional default for every scenario (source frames, 0 = all)
+//   scenarios:                  # at least one
+//     - name: l_hallway         # optional (default: the scenario's name); unique
+//       scenario: l_hallway     # a built-in scenario (scenes/) or a YAML file relative to
+//                               # the suite file
+//       set: {noise.pixel_sigma: 3}   # optional scenario overrides (dotted keys, overrides.h)
+//       max_frames: 200         # optional: stop after this many source frames
+//   configs:                    # at least one
+//     - name: paper             # required, unique
+//       config: vo.yaml         # optional VO config file relative to the suite file
 //       set: {matcher.type: ncc_mutual}   # optional VO overrides, applied after `config`
-//   seeds: [1, 2]                 # optional noise seeds (default: each scenario's own seed)
-//   strides: [1, 2]               # optional frame strides (default [1])
+//   seeds: [1, 2]               # optional noise seeds (default: each scenario's own seed)
+//   strides: [1, 2]             # optional frame strides (default [1])
 //
 // Runs are the product scenarios × configs × seeds × strides in that nesting order (the stride
 // varies fastest); run i (from 0) has the id `<scenario>__<config>__s<seed>__k<stride>`.
 //
 // Output folder (OUT):
-//   suite.json        manifest: suite name, the shard, every run of the suite (id, axes, spec hash)
-//   suite.yaml        copy of the suite file
-//   specs/<id>.scenario.yaml, specs/<id>.vo.yaml   effective inputs of each run (what the child
-//   reads) runs/<id>/        finished run folders (`vobench run` layout + suite_run.json: spec
-//   hash,
-//                     wall time). A run appears here only when finished: the child writes under
-//                     tmp/<id>, the suite adds suite_run.json and renames it into runs/.
+//   suite.json      manifest: suite name, the shard, every run of the suite (id, axes, spec hash)
+//   suite.yaml      copy of the suite file
+//   specs/<id>.scenario.yaml, specs/<id>.vo.yaml
+//                   effective inputs of each run (what the child reads)
+//   runs/<id>/      finished run folders (`vobench run` layout + suite_run.json: spec hash,
+//                   wall time). A run appears here only when finished: the child writes under
+//                   tmp/shard<i>of<N>/<id>, the suite adds suite_run.json and renames it into
+//                   runs/ (shards sharing one output folder keep out of each other's tmp/).
 //   runs/<id>.failed.txt   a failed run: command, exit status, the tail of its log
-//   logs/<id>.log     stdout and stderr of the child
+//   logs/<id>.log   stdout and stderr of the child
 //   summary.csv, summary.md, summary.png   the table across runs (written atomically)
 //
 // Resume: a run whose runs/<id>/suite_run.json records the same spec hash (effective scenario,
-// VO options, stride, max_frames) is kept; anything else is redone; tmp/ and *.partial leftovers
-// are removed. The hash does not cover the vobench binary: use --force after changing the code.
+// VO options, stride, max_frames) is kept; anything else is redone; the shard's tmp/ folder and
+// runs/*.partial leftovers are removed. The hash does not cover the vobench binary: use --force
+// after changing the code.
 #pragma once
 
 #include <cstdint>

@@ -315,7 +315,7 @@ TEST(SuiteRunTest, WritesEveryRunAndResumesOnlyUnfinishedRuns) {
   fs::remove_all(out / "runs" / gone);
   fs::create_directories(out / "runs" / (gone + ".partial"));
   WriteText((out / "runs" / (gone + ".partial") / "metrics.json").string(), "{}");
-  fs::create_directories(out / "tmp" / "l_hallway__paper__s1__k1.partial");
+  fs::create_directories(out / "tmp" / "shard1of1" / "l_hallway__paper__s1__k1.partial");
   std::string stamp = ReadAll(out / "runs" / stale / "suite_run.json");
   stamp.replace(stamp.find("\"spec_hash\": \"") + 14, 16, "0000000000000000");
   WriteText((out / "runs" / stale / "suite_run.json").string(), stamp);
@@ -404,6 +404,32 @@ TEST(SuiteRunTest, ShardsMergedEqualTheUnshardedSuite) {
   EXPECT_EQ(mixed.exit_code, 2) << mixed.output;
   EXPECT_NE(mixed.output.find("holds suite 'othr'"), std::string::npos) << mixed.output;
   EXPECT_FALSE(fs::exists(dir / "mixed"));
+}
+
+TEST(SuiteRunTest, ShardsCanShareOneOutputFolder) {
+  // As SLURM array tasks on a shared file system might: both shards at once, one --out.
+  TempDir dir("suite_shared");
+  WriteText(dir / "tiny.yaml", kTinySuite);
+  const std::string out = dir / "out";
+  std::vector<FILE*> pipes;
+  for (int i = 1; i <= 2; ++i)
+    pipes.push_back(popen((std::string(VOBENCH_BINARY) + " suite " + (dir / "tiny.yaml") +
+                           " -q -j 1 --shard " + std::to_string(i) + "/2 --out " + out + " 2>&1")
+                              .c_str(),
+                          "r"));
+  for (FILE* pipe : pipes) {
+    ASSERT_NE(pipe, nullptr);
+    std::string output;
+    char buf[4096];
+    while (fgets(buf, sizeof(buf), pipe)) output += buf;
+    const int status = pclose(pipe);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << output;
+  }
+  // Every run finished once; the unsharded suite there has nothing left to do.
+  const auto r = RunVobench("suite " + (dir / "tiny.yaml") + " -q --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("(0 run now, 8 kept)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(fs::path(out) / "tmp"));
 }
 
 TEST(SuiteFailureTest, AFailedRunIsRecordedAndTheOthersGoOn) {
