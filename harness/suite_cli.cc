@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -156,8 +157,11 @@ void RunCheckCommand(const CheckArgs& a) {
   for (auto& c : suite.configs) {
     if (!a.config.empty() && !LoadVoConfig(a.config, &c.options, &error))
       Fail("check", kExitBadInput, error);
-    if (!a.sets.empty() && !ApplyVoOverrides(sets, "--set", &c.options, &error))
-      Fail("check", kExitBadInput, error);
+    if (!a.sets.empty() && !ApplyVoOverrides(sets, "--set", &c.options, &error)) {
+      // The line number is one of the generated YAML text: meaningless here.
+      Fail("check", kExitBadInput,
+           std::regex_replace(error, std::regex(R"(\(VO overrides\):[0-9]+)"), "(VO overrides)"));
+    }
   }
   SuiteOptions options;
   options.out_dir = a.out;
