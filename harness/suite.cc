@@ -939,18 +939,12 @@ std::string SummaryMarkdown(const std::string& name, const SuiteResult& result, 
   return md.str();
 }
 
-std::string Quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 // harness/suite_plot.py SUMMARY_CSV PNG (Debian's python3 with matplotlib).
 bool RunSuitePlot(const std::string& csv, const std::string& png, std::string* error) {
   const std::string script = std::string(VOBENCH_SOURCE_DIR) + "/harness/suite_plot.py";
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   const std::string cmd =
-      python + " " + Quote(script) + " " + Quote(csv) + " " + Quote(png) + " 2>&1";
+      python + " " + ShellQuote(script) + " " + ShellQuote(csv) + " " + ShellQuote(png) + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) {
     *error = "cannot start " + python;
@@ -987,10 +981,11 @@ bool WriteSummary(const fs::path& out, const std::string& name, const SuiteResul
                              error);
 }
 
-void WriteSpecs(const fs::path& out, const SuiteRun& r, std::string* error, bool* ok) {
-  *ok = WriteFileAtomically((out / "specs" / (r.id + ".scenario.yaml")).string(), r.scenario_yaml,
-                            error) &&
-        WriteFileAtomically((out / "specs" / (r.id + ".vo.yaml")).string(), r.vo_yaml, error);
+// The run's effective inputs, as its child process reads them.
+bool WriteSpecs(const fs::path& out, const SuiteRun& r, std::string* error) {
+  return WriteFileAtomically((out / "specs" / (r.id + ".scenario.yaml")).string(), r.scenario_yaml,
+                             error) &&
+         WriteFileAtomically((out / "specs" / (r.id + ".vo.yaml")).string(), r.vo_yaml, error);
 }
 
 std::string SelfExecutable() {
@@ -1109,9 +1104,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
       options.vobench_binary.empty() ? SelfExecutable() : options.vobench_binary;
   for (const auto& r : runs) {
     if (!options.shard.Contains(r.index)) continue;
-    bool ok = false;
-    WriteSpecs(out, r, error, &ok);
-    if (!ok) return false;
+    if (!WriteSpecs(out, r, error)) return false;
     if (!options.force && IsFinished(out / "runs" / r.id, r.spec_hash)) {
       ++result->kept;
       continue;
