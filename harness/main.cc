@@ -17,6 +17,7 @@
 #include "harness/progress.h"
 #include "harness/render.h"
 #include "harness/run.h"
+#include "harness/suite_cli.h"
 #include "harness/vo_config.h"
 #include "harness/trajectory_io.h"
 #include "harness/tune_command.h"
@@ -172,7 +173,7 @@ void PrintRunTable(const harness::RunSummary& s, const std::string& out) {
 }
 
 int RunRun(const std::string& scenario_arg, const std::string& config, const std::string& dataset,
-           std::string out, int max_frames, bool no_plots, bool quiet) {
+           std::string out, int max_frames, int stride, bool no_plots, bool quiet) {
   std::string error;
   vo::OdometryOptions vo_options;
   if (!config.empty() && !harness::LoadVoConfig(config, &vo_options, &error)) {
@@ -183,6 +184,7 @@ int RunRun(const std::string& scenario_arg, const std::string& config, const std
   options.progress = !quiet;
   options.plots = !no_plots;
   options.max_frames = max_frames;
+  options.frame_stride = stride;
   harness::RunSummary summary;
   bool ok;
   if (!dataset.empty()) {
@@ -239,7 +241,7 @@ int main(int argc, char** argv) {
   match_eval->add_flag("-q,--quiet", quiet, "No progress display");
 
   std::string run_scenario = "l_hallway", run_config, run_dataset, run_out;
-  int run_max_frames = 0;
+  int run_max_frames = 0, run_stride = 1;
   bool run_no_plots = false;
   CLI::App* run = app.add_subcommand("run", "Run the VO on a simulated scenario (or a KITTI-layout dataset) and compare with ground truth");
   run->add_option("scenario", run_scenario, "Scenario YAML file or built-in name")->capture_default_str();
@@ -247,18 +249,21 @@ int main(int argc, char** argv) {
   run->add_option("--dataset", run_dataset, "Read a dataset folder in the KITTI layout instead of simulating");
   run->add_option("--out,-o", run_out, "Run folder (default out/run/<name>); an earlier run there is replaced");
   run->add_option("--max-frames", run_max_frames, "Stop after N frames (0 = all)");
+  run->add_option("--stride", run_stride, "The VO sees every k-th frame (less overlap); --max-frames counts all frames")
+      ->check(CLI::PositiveNumber);
   run->add_flag("--no-plots", run_no_plots, "Skip the PNG plots");
   run->add_flag("-q,--quiet", quiet, "No progress display");
 
   const auto eval = harness::AddEvalCommand(app);
   harness::TuneCommandArgs tune_args;
   CLI::App* tune = harness::AddTuneCommand(app, &tune_args);
+  harness::AddSuiteCommands(app);  // suite, suite merge, check
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   spdlog::set_pattern("[%l] %v");
   if (*render) return RunRender(scenario, out, format, overwrite, quiet);
-  if (*run) return RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_no_plots, quiet);
+  if (*run) return RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_stride, run_no_plots, quiet);
   if (*eval->app) return eval->Run(PrintRunTable);
   if (*tune) return harness::RunTuneCommand(tune_args);
   if (*match_eval) return RunMatchEval(me_scenario, me_strides, me_matchers, me_out, me_max_frames, quiet);

@@ -98,6 +98,7 @@ std::string MetricsJson(const RunSummary& s) {
   const TrajectoryMetrics& m = s.metrics;
   j["name"] = s.name;
   j["frames"] = m.frames;
+  j["frame_stride"] = s.frame_stride;
   j["has_ground_truth"] = s.has_ground_truth;
   j["ground_truth_frames"] = s.ground_truth_frames;
   if (s.has_ground_truth) {  // without ground truth there is nothing to compare with
@@ -134,6 +135,10 @@ std::string MetricsJson(const RunSummary& s) {
 bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameSource source,
                  int expected_frames, const vo::OdometryOptions& vo_options, const RunOptions& options,
                  const std::string& scenario_yaml, RunSummary* summary, std::string* error) {
+  if (options.frame_stride < 1) {
+    *error = "frame stride must be >= 1, got " + std::to_string(options.frame_stride);
+    return false;
+  }
   auto odometry = vo::StereoOdometry::Create(camera, vo_options, error);
   if (!odometry) {
     *error = "invalid VO options or camera: " + *error;
@@ -158,7 +163,10 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   std::vector<Eigen::Isometry3d> est, gt;
   std::vector<vo::OdometryResult> results;
   std::vector<size_t> gt_frames;  // indices of the frames with ground truth
-  Progress progress("vo " + name, expected_frames, options.progress);
+  const int stride = options.frame_stride;
+  if (options.max_frames > 0 && (expected_frames <= 0 || expected_frames > options.max_frames))
+    expected_frames = options.max_frames;
+  Progress progress("vo " + name, (expected_frames + stride - 1) / stride, options.progress);
   DatasetFrame frame;
   // Matcher statistics where the ground truth allows (frames with depth and pose): the VO's
   // matches to its reference frame (the last frame that was not lost) checked against them.
@@ -166,7 +174,9 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   const MatchEvalOptions match_eval_options;
   GroundTruthFrame reference_gt;
   bool have_reference_gt = false;
-  while ((options.max_frames <= 0 || static_cast<int>(results.size()) < options.max_frames) && source(&frame, error)) {
+  int source_frames = 0;
+  while ((options.max_frames <= 0 || source_frames < options.max_frames) && source(&frame, error)) {
+    if (source_frames++ % stride != 0) continue;  // frame stride: skip to every k-th frame
     results.push_back(odometry->Process(frame.left, frame.right, frame.time_s));
     if (frame.has_gt && !frame.depth_m.empty()) {
       GroundTruthFrame current;
@@ -213,6 +223,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     times_at_gt.push_back(times[i]);
   }
   if (has_gt) s.metrics = ComputeTrajectoryMetrics(est_at_gt, gt_at_gt);
+  s.frame_stride = stride;
   s.metrics.frames = static_cast<int>(results.size());
   std::vector<double> total, feats, inl;
   std::map<std::string, std::vector<double>> stages;

@@ -42,6 +42,7 @@ struct RunSummary {
   int ground_truth_frames = 0;    // frames with a ground-truth pose; the metrics use these only
   VoMatchStats match_stats;  // the VO's matches against the ground truth (simulated runs and
                              // datasets with depth); matches == 0 when not available
+  int frame_stride = 1;  // RunOptions::frame_stride of the run
 };
 
 struct RunOptions {
@@ -49,7 +50,9 @@ struct RunOptions {
   bool progress = true;       // progress display on stderr
   bool plots = true;          // PNG plots (python3-matplotlib)
   std::string outline;        // hallway outline name for the trajectory plot ("" = none)
-  int max_frames = 0;         // stop after this many frames (0 = all)
+  int max_frames = 0;         // stop after this many frames of the source (0 = all)
+  int frame_stride = 1;       // the VO sees every k-th source frame (0, k, 2k, ...; less overlap
+                              // between its frames), >= 1; metrics are on those frames
 };
 
 // A source of stereo frames: fills *frame, returns false at the end (error empty) or on error.

@@ -1,0 +1,458 @@
+// `vobench suite`: suite files (strict), the run matrix and its ids, shards, resume after an
+// interruption, shard-and-merge equal to the unsharded suite, failed runs.
+#include "harness/suite.h"
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "tests/sim/sim_test_util.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using vobench_test::TempDir;
+using vobench_test::WriteText;
+
+struct CommandResult {
+  int exit_code;
+  std::string output;
+};
+
+CommandResult RunVobench(const std::string& args) {
+  const std::string cmd = std::string(VOBENCH_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (pipe && fgets(buf, sizeof(buf), pipe)) out += buf;
+  const int status = pipe ? pclose(pipe) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string ReadAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// summary.csv without the timing columns (the last three), which vary between identical runs.
+std::string WithoutTimingColumns(const std::string& csv) {
+  std::istringstream in(csv);
+  std::string out, line;
+  while (std::getline(in, line)) {
+    for (int k = 0; k < 3; ++k) line = line.substr(0, line.rfind(','));
+    out += line + "\n";
+  }
+  return out;
+}
+
+fs::file_time_type MTime(const fs::path& p) { return fs::last_write_time(p); }
+
+// A small suite: both scenes, two configs, strides 1 and 2, 6 source frames per run (8 runs).
+// The corridor runs get a scenario override.
+constexpr char kTinySuite[] = R"(name: tiny
+max_frames: 6
+scenarios:
+  - scenario: l_hallway
+  - name: corridor
+    scenario: plain_corridor
+    set: {noise.pixel_sigma: 3.0}
+configs:
+  - name: paper
+  - name: ncc
+    set: {matcher.type: ncc_mutual}
+strides: [1, 2]
+)";
+
+// --------------------------------------------------------------------------------------------
+// Suite files.
+
+TEST(SuiteFileTest, ExpandsTheMatrixInAFixedOrderWithStableIds) {
+  harness::Suite suite;
+  std::string error;
+  const std::string text = std::string(kTinySuite) + "seeds: [3, 4]\n";
+  ASSERT_TRUE(harness::ParseSuite(text, "tiny.yaml", VOBENCH_SOURCE_DIR, &suite, &error)) << error;
+  EXPECT_EQ(suite.name, "tiny");
+  ASSERT_EQ(suite.scenarios.size(), 2u);
+  EXPECT_EQ(suite.scenarios[0].name, "l_hallway");  // default: the scenario's own name
+  EXPECT_EQ(suite.scenarios[1].scenario.noise.pixel_sigma, 3.0);
+  EXPECT_EQ(suite.scenarios[1].max_frames, 6);
+  EXPECT_EQ(suite.configs[1].options.matcher.type, vo::MatcherType::kNccMutual);
+
+  const std::vector<harness::SuiteRun> runs = harness::ExpandSuite(suite);
+  ASSERT_EQ(runs.size(), 2u * 2u * 2u * 2u);
+  EXPECT_EQ(runs[0].id, "l_hallway__paper__s3__k1");
+  EXPECT_EQ(runs[1].id, "l_hallway__paper__s3__k2");  // stride varies fastest
+  EXPECT_EQ(runs[2].id, "l_hallway__paper__s4__k1");
+  EXPECT_EQ(runs[4].id, "l_hallway__ncc__s3__k1");
+  EXPECT_EQ(runs[15].id, "corridor__ncc__s4__k2");
+  std::set<std::string> ids, hashes;
+  for (size_t i = 0; i < runs.size(); ++i) {
+    EXPECT_EQ(runs[i].index, static_cast<int>(i));
+    ids.insert(runs[i].id);
+    hashes.insert(runs[i].spec_hash);
+    EXPECT_EQ(runs[i].spec_hash.size(), 16u);
+  }
+  EXPECT_EQ(ids.size(), runs.size());
+  EXPECT_EQ(hashes.size(), runs.size());
+  // The effective inputs carry the seed, the id as name, and the config's overrides.
+  EXPECT_NE(runs[2].scenario_yaml.find("seed: 4"), std::string::npos);
+  EXPECT_NE(runs[2].scenario_yaml.find("name: l_hallway__paper__s4__k1"), std::string::npos);
+  EXPECT_NE(runs[4].vo_yaml.find("ncc_mutual"), std::string::npos);
+
+  // The same text gives the same hashes; another override value gives another hash.
+  harness::Suite again, other;
+  ASSERT_TRUE(harness::ParseSuite(text, "tiny.yaml", VOBENCH_SOURCE_DIR, &again, &error)) << error;
+  std::string changed = text;
+  changed.replace(changed.find("pixel_sigma: 3.0"), 16, "pixel_sigma: 3.5");
+  ASSERT_TRUE(harness::ParseSuite(changed, "tiny.yaml", VOBENCH_SOURCE_DIR, &other, &error))
+      << error;
+  const auto runs_again = harness::ExpandSuite(again), runs_other = harness::ExpandSuite(other);
+  for (size_t i = 0; i < runs.size(); ++i) {
+    EXPECT_EQ(runs_again[i].spec_hash, runs[i].spec_hash);
+    EXPECT_EQ(runs_other[i].spec_hash == runs[i].spec_hash, runs[i].scenario != "corridor")
+        << runs[i].id;
+  }
+}
+
+TEST(SuiteFileTest, SeedsDefaultToTheScenariosOwnAndStridesToOne) {
+  harness::Suite suite;
+  std::string error;
+  ASSERT_TRUE(
+      harness::ParseSuite("name: s\nscenarios:\n  - scenario: l_hallway\n    set: {seed: 9}\n"
+                          "configs:\n  - name: a\n",
+                          "s.yaml", VOBENCH_SOURCE_DIR, &suite, &error))
+      << error;
+  const auto runs = harness::ExpandSuite(suite);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].id, "l_hallway__a__s9__k1");
+  EXPECT_EQ(runs[0].max_frames, 0);
+}
+
+TEST(SuiteFileTest, ScenarioAndConfigFilesAreRelativeToTheSuite) {
+  TempDir dir("suite_rel");
+  fs::create_directories(dir / "sub");
+  WriteText(dir / "sub/short.yaml", "name: short\nscene: " + std::string(VOBENCH_SOURCE_DIR) +
+                                        "/scenes/hallway_l.xml\npath:\n  - [0, 0]\n  - [0.5, 0]\n");
+  WriteText(dir / "sub/vo.yaml", "ba_window_frames: 7\n");
+  WriteText(dir / "suite.yaml",
+            "name: rel\nscenarios:\n  - scenario: sub/short.yaml\nconfigs:\n"
+            "  - name: w7\n    config: sub/vo.yaml\n    set: {matcher.type: lucas_kanade}\n");
+  harness::Suite suite;
+  std::string error;
+  ASSERT_TRUE(harness::LoadSuite(dir / "suite.yaml", &suite, &error)) << error;
+  EXPECT_EQ(suite.scenarios[0].name, "short");
+  EXPECT_EQ(suite.configs[0].options.ba_window_frames, 7);
+  EXPECT_EQ(suite.configs[0].options.matcher.type, vo::MatcherType::kLucasKanade);
+}
+
+TEST(SuiteFileTest, BadSuiteFilesNameTheFileLineAndKey) {
+  struct Case {
+    const char* text;
+    std::vector<std::string> expected;  // substrings of the message
+  };
+  const std::vector<Case> cases = {
+      {"name: b\nscenarios:\n  - scenario: l_hallway\n    sett: {}\nconfigs:\n  - name: a\n",
+       {"bad.yaml:4", "scenarios[0].sett", "unknown key"}},
+      {"name: b\nscenario:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n",
+       {"bad.yaml:2", "'scenario'", "unknown key"}},
+      {"name: b\nscenarios:\n  - scenario: nothere.yaml\nconfigs:\n  - name: a\n",
+       {"bad.yaml:3", "scenarios[0].scenario", "nothere.yaml"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\n    set:\n      noise.pixel_sigmaa: "
+       "2\nconfigs:\n  - name: a\n",
+       {"bad.yaml:5", "noise.pixel_sigmaa", "unknown scenario key"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\n    set: {rate_hz: -1}\nconfigs:\n  - name: "
+       "a\n",
+       {"bad.yaml:4", "rate_hz"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n    set:\n      "
+       "matcher: {typo: 1}\n",
+       {"bad.yaml:7", "configs[0].set.matcher.typo", "unknown VO option key"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n    set: "
+       "{matcher.type: magic}\n",
+       {"bad.yaml:6", "matcher.type", "magic"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n    config: "
+       "none.yaml\n",
+       {"bad.yaml:6", "configs[0].config", "none.yaml"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n  - name: a\n",
+       {"bad.yaml:6", "used twice"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\nstrides: [1, 0]\n",
+       {"bad.yaml:6", "strides[1]"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\nseeds: [-1]\n",
+       {"bad.yaml:6", "seeds[0]"}},
+      {"name: a__b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n",
+       {"bad.yaml:1", "'name'"}},
+      {"name: b\nscenarios: []\nconfigs:\n  - name: a\n", {"bad.yaml:2", "scenarios"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\n", {"bad.yaml", "configs", "required"}},
+      {"name: b\nscenarios: [\n", {"bad.yaml", "malformed YAML"}},
+  };
+  for (const auto& c : cases) {
+    harness::Suite suite;
+    std::string error;
+    EXPECT_FALSE(harness::ParseSuite(c.text, "bad.yaml", VOBENCH_SOURCE_DIR, &suite, &error))
+        << c.text;
+    for (const auto& e : c.expected)
+      EXPECT_NE(error.find(e), std::string::npos) << "'" << e << "' not in: " << error;
+  }
+}
+
+TEST(SuiteFileTest, CommandRefusesABadSuiteWithExitTwoAndWritesNothing) {
+  TempDir dir("suite_bad");
+  WriteText(dir / "bad.yaml",
+            "name: b\nscenarios:\n  - scenario: l_hallway\n    set: {noise.pixel_sigmaa: 2}\n"
+            "configs:\n  - name: a\n");
+  const auto r = RunVobench("suite " + (dir / "bad.yaml") + " --out " + (dir / "out") + " -q");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("bad.yaml:4"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("noise.pixel_sigmaa"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+
+  const auto missing =
+      RunVobench("suite " + (dir / "none.yaml") + " --out " + (dir / "out") + " -q");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.output.find("none.yaml"), std::string::npos) << missing.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+
+  WriteText(dir / "good.yaml", kTinySuite);
+  const auto shard =
+      RunVobench("suite " + (dir / "good.yaml") + " --shard 3/2 --out " + (dir / "out") + " -q");
+  EXPECT_EQ(shard.exit_code, 2);
+  EXPECT_NE(shard.output.find("--shard"), std::string::npos) << shard.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+
+  // A folder that is not a suite's is not used.
+  fs::create_directories(dir / "mine");
+  WriteText(dir / "mine/notes.txt", "keep");
+  const auto other =
+      RunVobench("suite " + (dir / "good.yaml") + " --out " + (dir / "mine") + " -q");
+  EXPECT_NE(other.exit_code, 0);
+  EXPECT_NE(other.output.find("not a vobench suite folder"), std::string::npos) << other.output;
+  EXPECT_EQ(fs::directory_iterator(dir / "mine")->path().filename(), "notes.txt");
+}
+
+TEST(ShardTest, ParsesAndPartitionsTheRuns) {
+  harness::Shard shard;
+  std::string error;
+  ASSERT_TRUE(harness::ParseShard("2/3", &shard, &error)) << error;
+  EXPECT_EQ(shard.index, 2);
+  EXPECT_EQ(shard.count, 3);
+  for (const char* bad : {"0/3", "4/3", "1/0", "a/3", "2", "2/3/4", "-1/3", ""})
+    EXPECT_FALSE(harness::ParseShard(bad, &shard, &error)) << bad;
+  // Every run index lands in exactly one shard.
+  for (int n = 1; n <= 5; ++n)
+    for (int run = 0; run < 17; ++run) {
+      int holders = 0;
+      for (int i = 1; i <= n; ++i) holders += harness::Shard{i, n}.Contains(run);
+      EXPECT_EQ(holders, 1) << run << " in " << n << " shards";
+    }
+}
+
+// --------------------------------------------------------------------------------------------
+// Running suites, through the vobench command as users and schedulers run them. Each test makes
+// its own unsharded run (ctest runs every test in a process of its own).
+
+// Runs kTinySuite unsharded into dir/full; returns the suite file's path.
+std::string RunFullSuite(const TempDir& dir) {
+  WriteText(dir / "tiny.yaml", kTinySuite);
+  const auto r = RunVobench("suite " + (dir / "tiny.yaml") + " -j 2 --out " + (dir / "full"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return dir / "tiny.yaml";
+}
+
+TEST(SuiteRunTest, WritesEveryRunAndResumesOnlyUnfinishedRuns) {
+  TempDir dir("suite_resume");
+  const std::string suite = RunFullSuite(dir);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const fs::path full = dir / "full";
+  for (const char* f : {"suite.json", "suite.yaml", "summary.csv", "summary.md"})
+    EXPECT_TRUE(fs::exists(full / f)) << f;
+  EXPECT_FALSE(fs::exists(full / "tmp"));
+  const std::string csv = ReadAll(full / "summary.csv");
+  std::istringstream lines(csv);
+  std::string header, line;
+  std::getline(lines, header);
+  EXPECT_EQ(header.rfind("id,scenario,config,seed,stride,max_frames,status,frames,", 0), 0u)
+      << header;
+  for (const char* col :
+       {"end_pose_error_m", "ate_rmse_m", "lost_frames", "drift_pct", "vo_ms_median"})
+    EXPECT_NE(header.find(col), std::string::npos) << col;
+  int rows = 0;
+  while (std::getline(lines, line)) {
+    ++rows;
+    EXPECT_NE(line.find(",ok,"), std::string::npos) << line;
+  }
+  EXPECT_EQ(rows, 8);
+  // Each run folder: the `vobench run` files, the suite's stamp, the stride and overrides honoured.
+  const fs::path k2 = full / "runs" / "l_hallway__paper__s1__k2";
+  for (const char* f :
+       {"metrics.json", "suite_run.json", "trajectory_tum.txt", "vo_options.yaml", "scenario.yaml"})
+    EXPECT_TRUE(fs::exists(k2 / f)) << f;
+  const std::string metrics = ReadAll(k2 / "metrics.json");
+  EXPECT_NE(metrics.find("\"frames\": 3,"), std::string::npos)
+      << metrics;  // 6 source frames, stride 2
+  EXPECT_NE(metrics.find("\"frame_stride\": 2"), std::string::npos) << metrics;
+  EXPECT_NE(ReadAll(full / "runs/corridor__ncc__s1__k1/vo_options.yaml").find("type: ncc_mutual"),
+            std::string::npos);
+  EXPECT_NE(ReadAll(full / "runs/corridor__ncc__s1__k1/scenario.yaml").find("pixel_sigma: 3"),
+            std::string::npos);
+  const std::string md = ReadAll(full / "summary.md");
+  EXPECT_NE(md.find("## Per configuration"), std::string::npos);
+  EXPECT_NE(md.find("| corridor__ncc__s1__k2 | ok |"), std::string::npos) << md;
+
+  // An interrupted suite: one run folder gone, a half-written one left as .partial (with a
+  // metrics.json, so only the name says it is unfinished), a leftover in tmp/, and one run
+  // whose folder exists but whose stamp records another spec.
+  const fs::path out = dir / "resume";
+  fs::copy(full, out, fs::copy_options::recursive);
+  const std::string gone = "corridor__paper__s1__k1", stale = "l_hallway__ncc__s1__k2";
+  fs::remove_all(out / "runs" / gone);
+  fs::create_directories(out / "runs" / (gone + ".partial"));
+  WriteText((out / "runs" / (gone + ".partial") / "metrics.json").string(), "{}");
+  fs::create_directories(out / "tmp" / "shard1of1" / "l_hallway__paper__s1__k1.partial");
+  std::string stamp = ReadAll(out / "runs" / stale / "suite_run.json");
+  stamp.replace(stamp.find("\"spec_hash\": \"") + 14, 16, "0000000000000000");
+  WriteText((out / "runs" / stale / "suite_run.json").string(), stamp);
+  std::map<std::string, fs::file_time_type> before;
+  for (const auto& e : fs::directory_iterator(out / "runs"))
+    if (fs::exists(e.path() / "metrics.json"))
+      before[e.path().filename().string()] = MTime(e.path() / "metrics.json");
+
+  const auto r = RunVobench("suite " + suite + " -j 2 --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("6 finished before (kept), 2 to run"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(2 run now, 6 kept)"), std::string::npos) << r.output;
+  // Only those two ran: every other metrics.json is untouched.
+  for (const auto& [id, mtime] : before) {
+    if (id == stale || id.find(".partial") != std::string::npos) continue;
+    EXPECT_EQ(MTime(out / "runs" / id / "metrics.json"), mtime) << id << " was redone";
+  }
+  EXPECT_NE(MTime(out / "runs" / stale / "metrics.json"), before[stale]);
+  EXPECT_TRUE(fs::exists(out / "runs" / gone / "suite_run.json"));
+  EXPECT_FALSE(fs::exists(out / "runs" / (gone + ".partial")));
+  EXPECT_FALSE(fs::exists(out / "tmp"));
+  EXPECT_EQ(WithoutTimingColumns(ReadAll(out / "summary.csv")), WithoutTimingColumns(csv));
+
+  // Nothing left to do: a third call runs nothing and writes the same summary; --force redoes
+  // (here: the one run of shard 1/8).
+  const auto again = RunVobench("suite " + suite + " -q --out " + out.string());
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_NE(again.output.find("(0 run now, 8 kept)"), std::string::npos) << again.output;
+  EXPECT_EQ(WithoutTimingColumns(ReadAll(out / "summary.csv")), WithoutTimingColumns(csv));
+  const auto first = MTime(out / "runs/l_hallway__paper__s1__k1/metrics.json");
+  const auto forced =
+      RunVobench("suite " + suite + " -q --force --shard 1/8 --out " + out.string());
+  ASSERT_EQ(forced.exit_code, 0) << forced.output;
+  EXPECT_NE(forced.output.find("(1 run now, 0 kept)"), std::string::npos) << forced.output;
+  EXPECT_NE(MTime(out / "runs/l_hallway__paper__s1__k1/metrics.json"), first);
+}
+
+TEST(SuiteRunTest, ShardsMergedEqualTheUnshardedSuite) {
+  TempDir dir("suite_shards");
+  const std::string suite = RunFullSuite(dir);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  std::vector<std::string> shard_dirs;
+  for (int i = 1; i <= 2; ++i) {
+    shard_dirs.push_back(dir / ("shard" + std::to_string(i)));
+    const auto r = RunVobench("suite " + suite + " -q -j 2 --shard " + std::to_string(i) +
+                              "/2 --out " + shard_dirs.back());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  // Shard i holds the runs with index % 2 == i - 1.
+  std::vector<int> counts;
+  for (const auto& d : shard_dirs) {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(fs::path(d) / "runs")) n += e.is_directory();
+    counts.push_back(n);
+  }
+  EXPECT_EQ(counts, (std::vector<int>{4, 4}));
+  EXPECT_TRUE(fs::exists(fs::path(shard_dirs[0]) / "runs/l_hallway__paper__s1__k1"));  // index 0
+  EXPECT_TRUE(fs::exists(fs::path(shard_dirs[1]) / "runs/l_hallway__paper__s1__k2"));  // index 1
+
+  // A merge of one shard reports the other's runs missing (exit 1) ...
+  const std::string merged = dir / "merged";
+  const auto partial = RunVobench("suite merge --out " + merged + " " + shard_dirs[0]);
+  EXPECT_EQ(partial.exit_code, 1) << partial.output;
+  EXPECT_NE(partial.output.find("4 missing"), std::string::npos) << partial.output;
+  // ... and with both it equals the unsharded summary in every non-timing column.
+  const auto r =
+      RunVobench("suite merge --out " + merged + " " + shard_dirs[0] + " " + shard_dirs[1]);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(WithoutTimingColumns(ReadAll(fs::path(merged) / "summary.csv")),
+            WithoutTimingColumns(ReadAll(dir / "full/summary.csv")));
+  EXPECT_TRUE(fs::exists(fs::path(merged) / "runs/corridor__ncc__s1__k2/metrics.json"));
+  EXPECT_TRUE(fs::exists(fs::path(merged) / "specs/corridor__ncc__s1__k2.vo.yaml"));
+  // The merged folder is a suite folder: running the suite there finds everything finished.
+  const auto resume = RunVobench("suite " + suite + " -q --out " + merged);
+  ASSERT_EQ(resume.exit_code, 0) << resume.output;
+  EXPECT_NE(resume.output.find("(0 run now, 8 kept)"), std::string::npos) << resume.output;
+
+  // Shards of another suite are refused, and nothing is written (the manifest tells).
+  const std::string other = dir / "other_shard";
+  fs::copy(shard_dirs[1], other, fs::copy_options::recursive);
+  std::string manifest = ReadAll(fs::path(other) / "suite.json");
+  manifest.replace(manifest.find("\"suite\": \"tiny\""), 15, "\"suite\": \"othr\"");
+  WriteText((fs::path(other) / "suite.json").string(), manifest);
+  const auto mixed =
+      RunVobench("suite merge --out " + (dir / "mixed") + " " + shard_dirs[0] + " " + other);
+  EXPECT_EQ(mixed.exit_code, 2) << mixed.output;
+  EXPECT_NE(mixed.output.find("holds suite 'othr'"), std::string::npos) << mixed.output;
+  EXPECT_FALSE(fs::exists(dir / "mixed"));
+}
+
+TEST(SuiteRunTest, ShardsCanShareOneOutputFolder) {
+  // As SLURM array tasks on a shared file system might: both shards at once, one --out.
+  TempDir dir("suite_shared");
+  WriteText(dir / "tiny.yaml", kTinySuite);
+  const std::string out = dir / "out";
+  std::vector<FILE*> pipes;
+  for (int i = 1; i <= 2; ++i)
+    pipes.push_back(popen((std::string(VOBENCH_BINARY) + " suite " + (dir / "tiny.yaml") +
+                           " -q -j 1 --shard " + std::to_string(i) + "/2 --out " + out + " 2>&1")
+                              .c_str(),
+                          "r"));
+  for (FILE* pipe : pipes) {
+    ASSERT_NE(pipe, nullptr);
+    std::string output;
+    char buf[4096];
+    while (fgets(buf, sizeof(buf), pipe)) output += buf;
+    const int status = pclose(pipe);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << output;
+  }
+  // Every run finished once; the unsharded suite there has nothing left to do.
+  const auto r = RunVobench("suite " + (dir / "tiny.yaml") + " -q --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("(0 run now, 8 kept)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(fs::path(out) / "tmp"));
+}
+
+TEST(SuiteFailureTest, AFailedRunIsRecordedAndTheOthersGoOn) {
+  TempDir dir("suite_fail");
+  WriteText(dir / "broken.xml",
+            "<mujoco><worldbody><geom type='nonsense'/></worldbody></mujoco>\n");
+  WriteText(dir / "broken.yaml",
+            "name: broken\nscene: broken.xml\npath:\n  - [0, 0]\n  - [1, 0]\n");
+  WriteText(dir / "suite.yaml",
+            "name: fail\nmax_frames: 4\nscenarios:\n  - scenario: broken.yaml\n"
+            "  - scenario: l_hallway\nconfigs:\n  - name: paper\n");
+  const auto r = RunVobench("suite " + (dir / "suite.yaml") + " -q -j 2 --out " + (dir / "out"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("1 failed"), std::string::npos) << r.output;
+  const std::string failed = ReadAll(dir / "out/runs/broken__paper__s1__k1.failed.txt");
+  EXPECT_NE(failed.find("exit status 1"), std::string::npos) << failed;
+  EXPECT_NE(failed.find("nonsense"), std::string::npos) << failed;  // the child's message
+  EXPECT_FALSE(fs::exists(dir / "out/runs/broken__paper__s1__k1"));
+  EXPECT_TRUE(fs::exists(dir / "out/runs/l_hallway__paper__s1__k1/metrics.json"));
+  const std::string csv = ReadAll(dir / "out/summary.csv");
+  EXPECT_NE(csv.find("broken__paper__s1__k1,broken,paper,1,1,4,failed"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("l_hallway__paper__s1__k1,l_hallway,paper,1,1,4,ok,4,"), std::string::npos)
+      << csv;
+}
+
+}  // namespace
