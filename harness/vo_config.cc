@@ -159,6 +159,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"use_bundle_adjustment", Bool(&o->use_bundle_adjustment)},
       {"ba_window_frames", Number(&o->ba_window_frames, 3, 10)},
       {"ba.max_num_iterations", Number(&o->ba.max_num_iterations, 1, 1000)},
+      {"ba_max_points", Number(&o->ba_max_points, 0, 100000)},
       {"ba.loss_scale_px", Number(&o->ba.loss_scale_px, 0.01, 100.0)},
       {"prior_weight", Number(&o->prior_weight, 0.0, 1.0)},
       {"estimate_initial_orientation", Bool(&o->estimate_initial_orientation)},

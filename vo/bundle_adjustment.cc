@@ -144,6 +144,109 @@ struct MonoCost {
   Eigen::Vector2d uv_l;
 };
 
+// The same residuals with analytic Jacobians (the default; autodiff is kept as the reference,
+// BundleAdjustmentOptions::analytic_jacobians = false). p = q* (P − t) with Eigen's formula for
+// a unit quaternion q = (w, u): p = v − 2w (u × v) + 2 u × (u × v), v = P − t, so
+//   ∂p/∂w = −2 (u × v),  ∂p/∂u = 2w [v]× + 2 ((u·v) I + u vᵀ − 2 v uᵀ),
+//   ∂p/∂v = I − 2w [u]× + 2 (u uᵀ − |u|² I)  (= Rᵀ for a unit q),  ∂p/∂P = ∂p/∂v = −∂p/∂t.
+// These are the derivatives of exactly what the autodiff functors compute (tests compare them).
+struct CameraPointJacobian {
+  Eigen::Vector3d p;           // point in cam0
+  Eigen::Matrix<double, 3, 7> dp_dpose;  // columns: qx qy qz qw tx ty tz
+  Eigen::Matrix3d dp_dpoint;
+};
+
+inline Eigen::Matrix3d Skew(const Eigen::Vector3d& a) {
+  Eigen::Matrix3d m;
+  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return m;
+}
+
+void WorldToCam0WithJacobian(const double* pose, const double* point, CameraPointJacobian* j) {
+  const Eigen::Vector3d u(pose[0], pose[1], pose[2]);
+  const double w = pose[3];
+  const Eigen::Vector3d v =
+      Eigen::Vector3d(point[0], point[1], point[2]) - Eigen::Vector3d(pose[4], pose[5], pose[6]);
+  const Eigen::Vector3d uxv = u.cross(v);
+  j->p = v - 2.0 * w * uxv + 2.0 * u.cross(uxv);
+  j->dp_dpose.block<3, 3>(0, 0) =
+      2.0 * w * Skew(v) + 2.0 * (u.dot(v) * Eigen::Matrix3d::Identity() + u * v.transpose() -
+                                 2.0 * v * u.transpose());
+  j->dp_dpose.col(3) = -2.0 * uxv;
+  j->dp_dpoint = Eigen::Matrix3d::Identity() - 2.0 * w * Skew(u) +
+                 2.0 * (u * u.transpose() - u.squaredNorm() * Eigen::Matrix3d::Identity());
+  j->dp_dpose.block<3, 3>(0, 4) = -j->dp_dpoint;
+}
+
+class StereoCostAnalytic : public ceres::SizedCostFunction<4, 7, 3> {
+ public:
+  StereoCostAnalytic(const Intrinsics& k, const Eigen::Vector2d& uv_l, const Eigen::Vector2d& uv_r)
+      : k_(k), uv_l_(uv_l), uv_r_(uv_r) {}
+  bool Evaluate(double const* const* parameters, double* r, double** jacobians) const override {
+    CameraPointJacobian j;
+    WorldToCam0WithJacobian(parameters[0], parameters[1], &j);
+    const Eigen::Vector3d& p = j.p;
+    if (!(p.z() > 1e-9)) return false;
+    const double inv_z = 1.0 / p.z();
+    r[0] = k_.fx * p.x() * inv_z + k_.cx - uv_l_.x();
+    r[1] = k_.fy * p.y() * inv_z + k_.cy - uv_l_.y();
+    r[2] = k_.fx * (p.x() - k_.b) * inv_z + k_.cx - uv_r_.x();
+    r[3] = k_.fy * p.y() * inv_z + k_.cy - uv_r_.y();
+    if (jacobians == nullptr) return true;
+    Eigen::Matrix<double, 4, 3> dr_dp;
+    const double inv_z2 = inv_z * inv_z;
+    dr_dp << k_.fx * inv_z, 0, -k_.fx * p.x() * inv_z2,  //
+        0, k_.fy * inv_z, -k_.fy * p.y() * inv_z2,       //
+        k_.fx * inv_z, 0, -k_.fx * (p.x() - k_.b) * inv_z2, //
+        0, k_.fy * inv_z, -k_.fy * p.y() * inv_z2;
+    if (jacobians[0]) {
+      Eigen::Map<Eigen::Matrix<double, 4, 7, Eigen::RowMajor>> J(jacobians[0]);
+      J = dr_dp * j.dp_dpose;
+    }
+    if (jacobians[1]) {
+      Eigen::Map<Eigen::Matrix<double, 4, 3, Eigen::RowMajor>> J(jacobians[1]);
+      J = dr_dp * j.dp_dpoint;
+    }
+    return true;
+  }
+
+ private:
+  Intrinsics k_;
+  Eigen::Vector2d uv_l_, uv_r_;
+};
+
+class MonoCostAnalytic : public ceres::SizedCostFunction<2, 7, 3> {
+ public:
+  MonoCostAnalytic(const Intrinsics& k, const Eigen::Vector2d& uv_l) : k_(k), uv_l_(uv_l) {}
+  bool Evaluate(double const* const* parameters, double* r, double** jacobians) const override {
+    CameraPointJacobian j;
+    WorldToCam0WithJacobian(parameters[0], parameters[1], &j);
+    const Eigen::Vector3d& p = j.p;
+    if (!(p.z() > 1e-9)) return false;
+    const double inv_z = 1.0 / p.z();
+    r[0] = k_.fx * p.x() * inv_z + k_.cx - uv_l_.x();
+    r[1] = k_.fy * p.y() * inv_z + k_.cy - uv_l_.y();
+    if (jacobians == nullptr) return true;
+    Eigen::Matrix<double, 2, 3> dr_dp;
+    const double inv_z2 = inv_z * inv_z;
+    dr_dp << k_.fx * inv_z, 0, -k_.fx * p.x() * inv_z2,  //
+        0, k_.fy * inv_z, -k_.fy * p.y() * inv_z2;
+    if (jacobians[0]) {
+      Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> J(jacobians[0]);
+      J = dr_dp * j.dp_dpose;
+    }
+    if (jacobians[1]) {
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J(jacobians[1]);
+      J = dr_dp * j.dp_dpoint;
+    }
+    return true;
+  }
+
+ private:
+  Intrinsics k_;
+  Eigen::Vector2d uv_l_;
+};
+
 // Plain reprojection errors of one observation (pixels); false when behind the camera.
 bool ObservationErrors(const StereoCamera& cam, const Eigen::Isometry3d& T_world_cam0,
                        const Eigen::Vector3d& p_world, const BaObservation& obs, double min_depth_m,
@@ -305,12 +408,18 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
   for (size_t k = 0; k < input.observations.size(); ++k) {
     if (!obs_used[k]) continue;
     const BaObservation& o = input.observations[k];
-    ceres::CostFunction* cost =
-        o.has_right ? static_cast<ceres::CostFunction*>(
-                          new ceres::AutoDiffCostFunction<StereoCost, 4, 7, 3>(
-                              new StereoCost(intrinsics, o.uv_left_px, o.uv_right_px)))
-                    : new ceres::AutoDiffCostFunction<MonoCost, 2, 7, 3>(
-                          new MonoCost(intrinsics, o.uv_left_px));
+    ceres::CostFunction* cost = nullptr;
+    if (options.analytic_jacobians) {
+      cost = o.has_right ? static_cast<ceres::CostFunction*>(
+                               new StereoCostAnalytic(intrinsics, o.uv_left_px, o.uv_right_px))
+                         : new MonoCostAnalytic(intrinsics, o.uv_left_px);
+    } else {
+      cost = o.has_right ? static_cast<ceres::CostFunction*>(
+                               new ceres::AutoDiffCostFunction<StereoCost, 4, 7, 3>(
+                                   new StereoCost(intrinsics, o.uv_left_px, o.uv_right_px)))
+                         : new ceres::AutoDiffCostFunction<MonoCost, 2, 7, 3>(
+                               new MonoCost(intrinsics, o.uv_left_px));
+    }
     problem.AddResidualBlock(cost, loss, poses[o.frame_index].data(), points[o.point_index].data());
     pose_in_problem[o.frame_index] = true;
     ++s.num_residual_blocks;

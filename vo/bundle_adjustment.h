@@ -15,7 +15,8 @@
 // Residuals. One residual block per observation (frame i, point j): 4 residuals
 // [u_l, v_l, u_r, v_r] − observed (pixels) for a stereo observation, 2 for a left-only one,
 // through a robust loss (Huber or Cauchy, scale loss_scale_px) applied to the whole block,
-// so a stereo observation is down-weighted as one. Derivatives by ceres::AutoDiffCostFunction.
+// so a stereo observation is down-weighted as one. Derivatives analytic (hand-derived, see
+// bundle_adjustment.cc), or by ceres::AutoDiffCostFunction (analytic_jacobians = false).
 //
 // Gauge. The num_fixed_poses oldest poses (default 1: the oldest of the window) are held
 // constant (Problem::SetParameterBlockConstant); the stereo baseline fixes the scale.
@@ -72,6 +73,8 @@ struct BundleAdjustmentOptions {
   int min_frames_per_point = 1;       // points observed in fewer frames are left out (returned
                                       // unchanged, not optimised), >= 1
   BaLinearSolver linear_solver = BaLinearSolver::kAuto;  // see BaLinearSolver
+  bool analytic_jacobians = true;  // hand-derived Jacobians of the residuals (faster); false =
+                                   // ceres::AutoDiffCostFunction (the reference; same values)
   double min_depth_m = 1e-3;  // observations whose initial depth (z in cam0) is below this
                               // (metres) are left out and flagged as outliers, > 0
 

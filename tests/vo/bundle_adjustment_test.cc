@@ -236,6 +236,28 @@ TEST(BundleAdjustmentTest, DenseAndSparseSchurAgree) {
     EXPECT_THAT(a.T_world_cam0[i], IsNearPose(b.T_world_cam0[i], 1e-6, 1e-6));
 }
 
+// The hand-derived Jacobians (default) against Ceres' automatic differentiation of the same
+// residuals: the same iterations, hence the same solution to rounding.
+TEST(BundleAdjustmentTest, AnalyticJacobiansAgreeWithAutomaticDifferentiation) {
+  Scene s = MakeScene(9, kPixelSigma);
+  for (size_t k = 0; k < s.start.observations.size(); k += 4)
+    s.start.observations[k].has_right = false;  // left-only blocks too
+  BundleAdjustmentOptions analytic;
+  analytic.analytic_jacobians = true;
+  BundleAdjustmentOptions automatic = analytic;
+  automatic.analytic_jacobians = false;
+  const BundleAdjustmentSummary a = RunBundleAdjustment(TestCamera(), s.start, analytic);
+  const BundleAdjustmentSummary b = RunBundleAdjustment(TestCamera(), s.start, automatic);
+  ASSERT_TRUE(a.ok() && b.ok()) << a.message << b.message;
+  EXPECT_NEAR(a.initial_cost, b.initial_cost, 1e-12 * b.initial_cost);
+  EXPECT_NEAR(a.final_cost, b.final_cost, 1e-9 * b.final_cost);
+  EXPECT_GT(a.initial_cost, 10.0 * a.final_cost);
+  for (int i = 0; i < kNumFrames; ++i)
+    EXPECT_THAT(a.T_world_cam0[i], IsNearPose(b.T_world_cam0[i], 1e-9, 1e-9)) << "frame " << i;
+  for (int j = 0; j < kNumPoints; ++j)
+    EXPECT_LT((a.points_world[j] - b.points_world[j]).norm(), 1e-8) << "point " << j;
+}
+
 TEST(BundleAdjustmentTest, Deterministic) {
   const Scene s = MakeScene(6, kPixelSigma);
   const BundleAdjustmentSummary a = RunBundleAdjustment(TestCamera(), s.start);

@@ -156,6 +156,26 @@ TEST(SadBlockMatcherTest, RightViewMatchesTheRightImagesGroundTruth) {
   EXPECT_EQ(cv::norm(left_only, left_fixed, cv::NORM_INF), 0.0);
 }
 
+// The AVX2 kernels (chosen at run time) and the SSE2/scalar baseline give identical outputs.
+TEST(SadBlockMatcherTest, VectorWidthsGiveIdenticalResults) {
+  const Pair p = MakePair(7.7, 0.025, 13);
+  for (int nd : {16, 32, 48}) {
+    SadBlockMatcherOptions o;
+    o.num_disparities = nd;
+    o.min_disparity_px = nd == 48 ? 3 : 0;
+    SadBlockMatcher fast(o);
+    o.allow_avx2 = false;
+    SadBlockMatcher baseline(o);
+    cv::Mat la, ra, lb, rb;
+    cv::Mat discard(p.left.size(), CV_8UC1, cv::Scalar(0));
+    discard(cv::Rect(0, 0, kWidth, 40)).setTo(1);
+    fast.Compute(p.left, p.right, &la, &ra, &discard);
+    baseline.Compute(p.left, p.right, &lb, &rb, &discard);
+    EXPECT_EQ(cv::norm(la, lb, cv::NORM_INF), 0.0) << nd;
+    EXPECT_EQ(cv::norm(ra, rb, cv::NORM_INF), 0.0) << nd;
+  }
+}
+
 TEST(SadBlockMatcherTest, DiscardedPixelsSkipOnlyTheUniquenessTest) {
   // A flat image: every disparity costs the same, so uniqueness fails everywhere; pixels
   // marked as discarded keep an estimate (the caller removes them), the others are invalid.
