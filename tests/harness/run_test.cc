@@ -117,10 +117,27 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   EXPECT_DOUBLE_EQ(o.matcher.svd.sigma_px, 14);
   EXPECT_FALSE(o.use_bundle_adjustment);
   EXPECT_EQ(o.ba_window_frames, 7);
-  // The effective file reads back to the same options.
+  // The effective file reads back to the same options, every key away from its default (a key
+  // written twice, e.g. a nested map split in two, would lose one of them).
+  o.ba.max_num_iterations = 7;
+  o.ba.loss_scale_px = 2.5;
+  o.ba_max_points = 55;
+  o.disparity.algorithm = vo::DisparityAlgorithm::kSemiGlobal;
+  o.disparity.block_size = 7;
+  o.disparity_min_depth_m = 0.6;
+  const std::string effective = harness::VoConfigToYaml(o);
+  for (const char* top : {"\nba:", "\ndisparity:", "\nmatcher:", "\ndetector:", "\nransac:"}) {
+    const size_t first = effective.find(top);
+    EXPECT_EQ(effective.find(top, first + 1), std::string::npos) << top << " twice in\n" << effective;
+  }
   vo::OdometryOptions again;
   ASSERT_TRUE(harness::ParseVoConfig(harness::VoConfigToYaml(o), "effective.yaml", &again, &error)) << error;
   EXPECT_EQ(harness::VoConfigToYaml(again), harness::VoConfigToYaml(o));
+  EXPECT_EQ(again.ba.max_num_iterations, 7);
+  EXPECT_EQ(again.ba.loss_scale_px, 2.5);
+  EXPECT_EQ(again.ba_max_points, 55);
+  EXPECT_EQ(again.disparity.algorithm, vo::DisparityAlgorithm::kSemiGlobal);
+  EXPECT_EQ(again.disparity_min_depth_m, 0.6);
 
   vo::OdometryOptions bad;
   EXPECT_FALSE(harness::ParseVoConfig("matcher:\n  typo: 1\n", "cfg.yaml", &bad, &error));
