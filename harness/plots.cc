@@ -7,20 +7,21 @@
 
 namespace harness {
 
-namespace {
-std::string Quote(const std::string& s) {
+std::string ShellQuoted(const std::string& s) {
+  const char* kSafe = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./=:";
+  if (!s.empty() && s.find_first_not_of(kSafe) == std::string::npos) return s;
   std::string q = "'";
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return q + "'";
 }
-}  // namespace
 
-bool RunPlot(const std::vector<std::string>& args, std::string* error) {
-  const std::string script = std::string(VOBENCH_SOURCE_DIR) + "/harness/plot.py";
-  // Debian's interpreter: python3-matplotlib is installed for it, not for other pythons on PATH.
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  std::string cmd = python + " " + Quote(script);
-  for (const auto& a : args) cmd += " " + Quote(a);
+bool RunPythonScript(const std::string& script, const std::vector<std::string>& args,
+                     std::string* error) {
+  const std::string path = std::string(VOBENCH_SOURCE_DIR) + "/harness/" + script;
+  const std::string python =
+      std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  std::string cmd = python + " " + ShellQuoted(path);
+  for (const auto& a : args) cmd += " " + ShellQuoted(a);
   cmd += " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) {
@@ -32,10 +33,15 @@ bool RunPlot(const std::vector<std::string>& args, std::string* error) {
   while (fgets(buf, sizeof(buf), pipe)) out += buf;
   const int status = pclose(pipe);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    *error = "plot.py " + (args.empty() ? std::string() : args[0]) + " failed: " + out;
+    *error = script + (args.empty() || script != "plot.py" ? std::string() : " " + args[0]) +
+             " failed: " + out;
     return false;
   }
   return true;
+}
+
+bool RunPlot(const std::vector<std::string>& args, std::string* error) {
+  return RunPythonScript("plot.py", args, error);
 }
 
 }  // namespace harness

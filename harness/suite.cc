@@ -1,5 +1,7 @@
 #include "harness/suite.h"
 
+#include "harness/plots.h"
+
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -614,19 +616,9 @@ class InterruptGuard {
   struct sigaction old_int_ = {}, old_term_ = {};
 };
 
-std::string ShellQuote(const std::string& s) {
-  if (!s.empty() &&
-      s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./=:") ==
-          std::string::npos)
-    return s;
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 std::string CommandLine(const std::vector<std::string>& argv) {
   std::string s;
-  for (const auto& a : argv) s += (s.empty() ? "" : " ") + ShellQuote(a);
+  for (const auto& a : argv) s += (s.empty() ? "" : " ") + ShellQuoted(a);
   return s;
 }
 
@@ -941,24 +933,7 @@ std::string SummaryMarkdown(const std::string& name, const SuiteResult& result, 
 
 // harness/suite_plot.py SUMMARY_CSV PNG (Debian's python3 with matplotlib).
 bool RunSuitePlot(const std::string& csv, const std::string& png, std::string* error) {
-  const std::string script = std::string(VOBENCH_SOURCE_DIR) + "/harness/suite_plot.py";
-  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string cmd =
-      python + " " + ShellQuote(script) + " " + ShellQuote(csv) + " " + ShellQuote(png) + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) {
-    *error = "cannot start " + python;
-    return false;
-  }
-  std::string out;
-  char buf[1024];
-  while (fgets(buf, sizeof(buf), pipe)) out += buf;
-  const int status = pclose(pipe);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    *error = "suite_plot.py failed: " + out;
-    return false;
-  }
-  return true;
+  return RunPythonScript("suite_plot.py", {csv, png}, error);
 }
 
 bool WriteSummary(const fs::path& out, const std::string& name, const SuiteResult& result,

@@ -1,5 +1,7 @@
 #include "harness/tune.h"
 
+#include "harness/plots.h"
+
 #include <sys/wait.h>
 #include <yaml-cpp/yaml.h>
 
@@ -378,32 +380,9 @@ struct PartialGuard {
   }
 };
 
-std::string Quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 // harness/tune_plot.py DIR PNG with Debian's python3 (python3-matplotlib is installed for it).
 bool RunTunePlot(const std::string& dir, const std::string& png, std::string* error) {
-  const std::string script = std::string(VOBENCH_SOURCE_DIR) + "/harness/tune_plot.py";
-  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string cmd =
-      python + " " + Quote(script) + " " + Quote(dir) + " " + Quote(png) + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) {
-    *error = "cannot start " + python;
-    return false;
-  }
-  std::string out;
-  char buf[1024];
-  while (fgets(buf, sizeof(buf), pipe)) out += buf;
-  const int status = pclose(pipe);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    *error = "tune_plot.py failed: " + out;
-    return false;
-  }
-  return true;
+  return RunPythonScript("tune_plot.py", {dir, png}, error);
 }
 
 std::string ColumnName(const Parameter& p) {

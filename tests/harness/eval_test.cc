@@ -24,8 +24,14 @@
 #include "sim/simulator.h"
 #include "tests/sim/sim_test_util.h"
 
+#include "tests/harness/cli_test_util.h"
+
 namespace harness {
 namespace {
+
+using vobench_test::RunVobench;
+using vobench_test::CommandResult;
+using vobench_test::ReadAll;
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
@@ -35,26 +41,6 @@ using vobench_test::WriteText;
 // Ground truth read back from text (17 digits) and recomposed (EuRoC: body * T_BS) differs from
 // the simulator's in the last bits; metrics follow within this.
 constexpr double kMetricTolerance = 1e-9;
-
-struct CommandResult {
-  int exit_code;
-  std::string output;
-};
-
-CommandResult RunVobench(const std::string& args) {
-  const std::string cmd = std::string(VOBENCH_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (pipe && fgets(buf, sizeof(buf), pipe)) out += buf;
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);

@@ -12,28 +12,18 @@
 #include "harness/dataset.h"
 #include "tests/sim/sim_test_util.h"
 
+#include "tests/harness/cli_test_util.h"
+
 namespace {
+
+using vobench_test::RunVobench;
+using vobench_test::ReadAll;
 
 namespace fs = std::filesystem;
 using vobench_test::TempDir;
 using vobench_test::WriteText;
 
 constexpr double kPoseTol = 1e-9;  // poses pass through text with 17 significant digits
-
-struct CommandResult {
-  int exit_code;
-  std::string output;
-};
-
-CommandResult RunVobench(const std::string& args) {
-  const std::string cmd = std::string(VOBENCH_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (pipe && fgets(buf, sizeof(buf), pipe)) out += buf;
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
 
 // A short scenario in the real hallway (0.8 m straight), noise on.
 std::string ShortScenario(const TempDir& dir, const std::string& extra = "") {
@@ -42,13 +32,6 @@ std::string ShortScenario(const TempDir& dir, const std::string& extra = "") {
                       "/scenes/hallway_l.xml\npath:\n  - [0, 0]\n  - [0.8, 0]\n"
                       "noise:\n  pixel_sigma: 1.5\n  gain_sigma: 0.02\n" + extra);
   return path;
-}
-
-std::string ReadAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 TEST(RenderTest, DatasetOnDiskEqualsTheSimulationAndIsDeterministic) {

@@ -15,33 +15,16 @@
 
 #include "tests/sim/sim_test_util.h"
 
+#include "tests/harness/cli_test_util.h"
+
 namespace {
+
+using vobench_test::RunVobench;
+using vobench_test::ReadAll;
 
 namespace fs = std::filesystem;
 using vobench_test::TempDir;
 using vobench_test::WriteText;
-
-struct CommandResult {
-  int exit_code;
-  std::string output;
-};
-
-CommandResult RunVobench(const std::string& args) {
-  const std::string cmd = std::string(VOBENCH_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (pipe && fgets(buf, sizeof(buf), pipe)) out += buf;
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
-std::string ReadAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // summary.csv without the timing columns (the last three), which vary between identical runs.
 std::string WithoutTimingColumns(const std::string& csv) {

@@ -15,8 +15,13 @@
 #include "harness/dataset.h"
 #include "harness/trajectory_io.h"
 
+#include "tests/harness/cli_test_util.h"
+
 namespace harness {
+
 namespace {
+
+using vobench_test::ReadAll;
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
@@ -61,11 +66,6 @@ std::vector<DatasetFrame> MakeFrames(int n, bool with_gt) {
     frames.push_back(f);
   }
   return frames;
-}
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 void WriteAll(const std::string& path, const std::string& text) {

@@ -19,7 +19,13 @@
 #include "harness/vo_config.h"
 #include "tests/sim/sim_test_util.h"
 
+#include "tests/harness/cli_test_util.h"
+
 namespace {
+
+using vobench_test::RunVobench;
+using vobench_test::CommandResult;
+using vobench_test::ReadAll;
 
 namespace fs = std::filesystem;
 using harness::Evaluation;
@@ -388,28 +394,6 @@ TEST(TuneSpecTest, BadFilesAreRefusedWithFileLineAndKey) {
 }
 
 // --- The command -----------------------------------------------------------------------------
-
-struct CommandResult {
-  int exit_code;
-  std::string output;
-};
-
-CommandResult RunVobench(const std::string& args) {
-  const std::string cmd = std::string(VOBENCH_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (pipe && fgets(buf, sizeof(buf), pipe)) out += buf;
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
-std::string ReadAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 TEST(TuneCommandTest, BadTuneFilesFailWithTheirMessageAndWriteNothing) {
   if (!fs::exists(VOBENCH_BINARY)) GTEST_SKIP() << "vobench not built: " << VOBENCH_BINARY;
