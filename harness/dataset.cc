@@ -194,6 +194,21 @@ std::string TumStampName(double time_s) {
   return name;
 }
 
+// Reads one grey image of a stereo frame and checks its size against `expected`; `origin` says
+// where the expected size comes from (e.g. "the size of frame 0"). Error names the file.
+bool ReadGreyImage(const std::string& path, const cv::Size& expected, const std::string& origin,
+                   cv::Mat* image, std::string* error) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return Fail(error, path + ": missing image file");
+  *image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image->empty()) return Fail(error, path + ": cannot decode the image");
+  if (image->size() != expected)
+    return Fail(error, path + ": image size " + SizeText(*image) + " differs from " +
+                           std::to_string(expected.width) + "x" +
+                           std::to_string(expected.height) + " (" + origin + ")");
+  return true;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -637,17 +652,11 @@ bool KittiReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* erro
                            std::to_string(size()) + " frames)");
   const cv::Size size(camera_.width, camera_.height);
   cv::Mat images[2];
-  std::error_code ec;
   for (int cam = 0; cam < 2; ++cam) {
-    const std::string path = ImagePath(cam, index);
-    if (!fs::is_regular_file(path, ec)) return Fail(error, path + ": missing image file");
-    images[cam] = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (images[cam].empty()) return Fail(error, path + ": cannot decode the image");
-    if (images[cam].size() != size)
-      return Fail(error, path + ": image size " + SizeText(images[cam]) + " differs from " +
-                             std::to_string(size.width) + "x" + std::to_string(size.height) +
-                             " (the size of frame 0)");
+    if (!ReadGreyImage(ImagePath(cam, index), size, "the size of frame 0", &images[cam], error))
+      return false;
   }
+  std::error_code ec;
   cv::Mat depth_m;
   if (has_depth_) {
     const std::string path = Join(dir_, "depth/" + FrameName(index, ".png"));
@@ -1143,16 +1152,10 @@ bool EurocReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* erro
     return Fail(error, dir_ + ": frame " + std::to_string(index) + " out of range (" +
                            std::to_string(size()) + " frames)");
   cv::Mat images[2];
-  std::error_code ec;
   for (int cam = 0; cam < 2; ++cam) {
-    const std::string& path = files_[cam][index];
-    if (!fs::is_regular_file(path, ec)) return Fail(error, path + ": missing image file");
-    images[cam] = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (images[cam].empty()) return Fail(error, path + ": cannot decode the image");
-    if (images[cam].cols != cam_[cam].width || images[cam].rows != cam_[cam].height)
-      return Fail(error, path + ": image size " + SizeText(images[cam]) + " differs from " +
-                             std::to_string(cam_[cam].width) + "x" +
-                             std::to_string(cam_[cam].height) + " (resolution in sensor.yaml)");
+    if (!ReadGreyImage(files_[cam][index], cv::Size(cam_[cam].width, cam_[cam].height),
+                       "resolution in sensor.yaml", &images[cam], error))
+      return false;
   }
   frame->time_s = NsToSeconds(t_ns_[index]);
   frame->left = images[0];
@@ -1276,16 +1279,9 @@ bool TumReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error)
                            std::to_string(size()) + " frames)");
   const cv::Size size(camera_.width, camera_.height);
   cv::Mat images[2];
-  std::error_code ec;
   for (int cam = 0; cam < 2; ++cam) {
-    const std::string& path = files_[cam][index];
-    if (!fs::is_regular_file(path, ec)) return Fail(error, path + ": missing image file");
-    images[cam] = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (images[cam].empty()) return Fail(error, path + ": cannot decode the image");
-    if (images[cam].size() != size)
-      return Fail(error, path + ": image size " + SizeText(images[cam]) + " differs from " +
-                             std::to_string(size.width) + "x" + std::to_string(size.height) +
-                             " (the size of the first pair)");
+    if (!ReadGreyImage(files_[cam][index], size, "the size of the first pair", &images[cam], error))
+      return false;
   }
   frame->time_s = times_s_[index];
   frame->left = images[0];

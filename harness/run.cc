@@ -24,35 +24,6 @@ std::vector<StampedPose> Stamped(const std::vector<double>& t, const std::vector
   return out;
 }
 
-// Replaces `dir` with the finished `partial` folder; refuses to delete a folder that does not
-// look like a run folder.
-bool Publish(const fs::path& partial, const fs::path& dir, std::string* error) {
-  std::error_code ec;
-  if (fs::exists(dir)) {
-    if (!fs::exists(dir / "metrics.json")) {
-      *error = dir.string() + ": exists and is not a vobench run folder (no metrics.json); not replacing it";
-      return false;
-    }
-    fs::remove_all(dir, ec);
-  }
-  fs::rename(partial, dir, ec);
-  if (ec) {
-    *error = dir.string() + ": cannot move the finished run into place: " + ec.message();
-    return false;
-  }
-  return true;
-}
-
-// Removes the partial folder unless released.
-struct PartialGuard {
-  fs::path path;
-  bool keep = false;
-  ~PartialGuard() {
-    std::error_code ec;
-    if (!keep && !path.empty()) fs::remove_all(path, ec);
-  }
-};
-
 std::string Fmt(double v, int prec = 4) {
   std::ostringstream s;
   s.setf(std::ios::fixed);
@@ -149,15 +120,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     *error = dir.string() + ": exists and is not a vobench run folder (no metrics.json); choose another --out";
     return false;
   }
-  PartialGuard guard;
-  guard.path = dir.string() + ".partial";
-  std::error_code ec;
-  fs::remove_all(guard.path, ec);
-  fs::create_directories(guard.path, ec);
-  if (ec) {
-    *error = guard.path.string() + ": cannot create: " + ec.message();
-    return false;
-  }
+  PartialFolder folder;  // the run folder is written as DIR.partial and moved into place
+  if (!folder.Create(dir.string(), error)) return false;
 
   std::vector<double> times;
   std::vector<Eigen::Isometry3d> est, gt;
@@ -251,7 +215,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     s.initial_orientation_error_deg = RotationAngle(est.front().linear(), gt.front().linear()) * 180.0 / M_PI;
 
   // Files.
-  const fs::path p = guard.path;
+  const fs::path p = folder.path();
   // Errors per frame relative to the first frame with ground truth; "nan" for frames without.
   const size_t g0 = gt_frames.empty() ? 0 : gt_frames.front();
   std::vector<Eigen::Isometry3d> anchored;
@@ -315,9 +279,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     if (!ok) std::fprintf(stderr, "warning: plots not made: %s\n", plot_error.c_str());
   }
   if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(s, options_yaml), error)) return false;
-  if (!Publish(guard.path, dir, error)) return false;
-  guard.keep = true;
-  return true;
+  return folder.Publish("metrics.json", "run", error);
 }
 
 bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_options,

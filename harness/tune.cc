@@ -370,16 +370,6 @@ bool ReadOptimizer(Reader& r, const YAML::Node& root, OptimizerOptions* optimize
   return true;
 }
 
-// Removes the partial folder unless released.
-struct PartialGuard {
-  fs::path path;
-  bool keep = false;
-  ~PartialGuard() {
-    std::error_code ec;
-    if (!keep && !path.empty()) fs::remove_all(path, ec);
-  }
-};
-
 // harness/tune_plot.py DIR PNG with Debian's python3 (python3-matplotlib is installed for it).
 bool RunTunePlot(const std::string& dir, const std::string& png, std::string* error) {
   return RunPythonScript("tune_plot.py", {dir, png}, error);
@@ -865,16 +855,9 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
   s.validation_s = Seconds(validation_start);
 
   // 4. The output folder, written beside DIR and moved into place.
-  PartialGuard guard;
-  guard.path = dir.string() + ".partial";
-  std::error_code ec;
-  fs::remove_all(guard.path, ec);
-  fs::create_directories(guard.path, ec);
-  if (ec) {
-    *error = guard.path.string() + ": cannot create: " + ec.message();
-    return false;
-  }
-  const fs::path p = guard.path;
+  PartialFolder folder;
+  if (!folder.Create(dir.string(), error)) return false;
+  const fs::path p = folder.path();
   if (!WriteTextFile((p / "best_vo.yaml").string(), VoConfigToYaml(s.best_options), error) ||
       !WriteTextFile((p / "base_vo.yaml").string(), VoConfigToYaml(base_options), error) ||
       !WriteTextFile((p / "evaluations.csv").string(),
@@ -893,13 +876,7 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
   }
   if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(spec, s, opt, has_plot), error))
     return false;
-  if (fs::exists(dir)) fs::remove_all(dir, ec);
-  fs::rename(p, dir, ec);
-  if (ec) {
-    *error = dir.string() + ": cannot move the finished tune result into place: " + ec.message();
-    return false;
-  }
-  guard.keep = true;
+  if (!folder.Publish("summary.json", "tune", error)) return false;
   *summary = s;
   return true;
 }

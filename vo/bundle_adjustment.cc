@@ -178,9 +178,14 @@ void WorldToCam0WithJacobian(const double* pose, const double* point, CameraPoin
   j->dp_dpose.block<3, 3>(0, 4) = -j->dp_dpoint;
 }
 
-class StereoCostAnalytic : public ceres::SizedCostFunction<4, 7, 3> {
+// kResiduals = 4: stereo observation [u_l, v_l, u_r, v_r]; 2: left-only [u_l, v_l].
+template <int kResiduals>
+class ReprojectionCostAnalytic : public ceres::SizedCostFunction<kResiduals, 7, 3> {
+  static_assert(kResiduals == 2 || kResiduals == 4, "left-only or stereo");
+
  public:
-  StereoCostAnalytic(const Intrinsics& k, const Eigen::Vector2d& uv_l, const Eigen::Vector2d& uv_r)
+  ReprojectionCostAnalytic(const Intrinsics& k, const Eigen::Vector2d& uv_l,
+                           const Eigen::Vector2d& uv_r = Eigen::Vector2d::Zero())
       : k_(k), uv_l_(uv_l), uv_r_(uv_r) {}
   bool Evaluate(double const* const* parameters, double* r, double** jacobians) const override {
     CameraPointJacobian j;
@@ -188,23 +193,26 @@ class StereoCostAnalytic : public ceres::SizedCostFunction<4, 7, 3> {
     const Eigen::Vector3d& p = j.p;
     if (!(p.z() > 1e-9)) return false;
     const double inv_z = 1.0 / p.z();
-    r[0] = k_.fx * p.x() * inv_z + k_.cx - uv_l_.x();
-    r[1] = k_.fy * p.y() * inv_z + k_.cy - uv_l_.y();
-    r[2] = k_.fx * (p.x() - k_.b) * inv_z + k_.cx - uv_r_.x();
-    r[3] = k_.fy * p.y() * inv_z + k_.cy - uv_r_.y();
-    if (jacobians == nullptr) return true;
-    Eigen::Matrix<double, 4, 3> dr_dp;
     const double inv_z2 = inv_z * inv_z;
-    dr_dp << k_.fx * inv_z, 0, -k_.fx * p.x() * inv_z2,  //
-        0, k_.fy * inv_z, -k_.fy * p.y() * inv_z2,       //
-        k_.fx * inv_z, 0, -k_.fx * (p.x() - k_.b) * inv_z2, //
+    const double v = k_.fy * p.y() * inv_z + k_.cy;
+    r[0] = k_.fx * p.x() * inv_z + k_.cx - uv_l_.x();
+    r[1] = v - uv_l_.y();
+    Eigen::Matrix<double, kResiduals, 3> dr_dp;
+    dr_dp.template topRows<2>() << k_.fx * inv_z, 0, -k_.fx * p.x() * inv_z2,  //
         0, k_.fy * inv_z, -k_.fy * p.y() * inv_z2;
+    if constexpr (kResiduals == 4) {
+      r[2] = k_.fx * (p.x() - k_.b) * inv_z + k_.cx - uv_r_.x();
+      r[3] = v - uv_r_.y();
+      dr_dp.template bottomRows<2>() << k_.fx * inv_z, 0, -k_.fx * (p.x() - k_.b) * inv_z2,  //
+          0, k_.fy * inv_z, -k_.fy * p.y() * inv_z2;
+    }
+    if (jacobians == nullptr) return true;
     if (jacobians[0]) {
-      Eigen::Map<Eigen::Matrix<double, 4, 7, Eigen::RowMajor>> J(jacobians[0]);
+      Eigen::Map<Eigen::Matrix<double, kResiduals, 7, Eigen::RowMajor>> J(jacobians[0]);
       J = dr_dp * j.dp_dpose;
     }
     if (jacobians[1]) {
-      Eigen::Map<Eigen::Matrix<double, 4, 3, Eigen::RowMajor>> J(jacobians[1]);
+      Eigen::Map<Eigen::Matrix<double, kResiduals, 3, Eigen::RowMajor>> J(jacobians[1]);
       J = dr_dp * j.dp_dpoint;
     }
     return true;
@@ -213,38 +221,6 @@ class StereoCostAnalytic : public ceres::SizedCostFunction<4, 7, 3> {
  private:
   Intrinsics k_;
   Eigen::Vector2d uv_l_, uv_r_;
-};
-
-class MonoCostAnalytic : public ceres::SizedCostFunction<2, 7, 3> {
- public:
-  MonoCostAnalytic(const Intrinsics& k, const Eigen::Vector2d& uv_l) : k_(k), uv_l_(uv_l) {}
-  bool Evaluate(double const* const* parameters, double* r, double** jacobians) const override {
-    CameraPointJacobian j;
-    WorldToCam0WithJacobian(parameters[0], parameters[1], &j);
-    const Eigen::Vector3d& p = j.p;
-    if (!(p.z() > 1e-9)) return false;
-    const double inv_z = 1.0 / p.z();
-    r[0] = k_.fx * p.x() * inv_z + k_.cx - uv_l_.x();
-    r[1] = k_.fy * p.y() * inv_z + k_.cy - uv_l_.y();
-    if (jacobians == nullptr) return true;
-    Eigen::Matrix<double, 2, 3> dr_dp;
-    const double inv_z2 = inv_z * inv_z;
-    dr_dp << k_.fx * inv_z, 0, -k_.fx * p.x() * inv_z2,  //
-        0, k_.fy * inv_z, -k_.fy * p.y() * inv_z2;
-    if (jacobians[0]) {
-      Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> J(jacobians[0]);
-      J = dr_dp * j.dp_dpose;
-    }
-    if (jacobians[1]) {
-      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J(jacobians[1]);
-      J = dr_dp * j.dp_dpoint;
-    }
-    return true;
-  }
-
- private:
-  Intrinsics k_;
-  Eigen::Vector2d uv_l_;
 };
 
 // Plain reprojection errors of one observation (pixels); false when behind the camera.
@@ -410,9 +386,9 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
     const BaObservation& o = input.observations[k];
     ceres::CostFunction* cost = nullptr;
     if (options.analytic_jacobians) {
-      cost = o.has_right ? static_cast<ceres::CostFunction*>(
-                               new StereoCostAnalytic(intrinsics, o.uv_left_px, o.uv_right_px))
-                         : new MonoCostAnalytic(intrinsics, o.uv_left_px);
+      cost = o.has_right ? static_cast<ceres::CostFunction*>(new ReprojectionCostAnalytic<4>(
+                               intrinsics, o.uv_left_px, o.uv_right_px))
+                         : new ReprojectionCostAnalytic<2>(intrinsics, o.uv_left_px);
     } else {
       cost = o.has_right ? static_cast<ceres::CostFunction*>(
                                new ceres::AutoDiffCostFunction<StereoCost, 4, 7, 3>(

@@ -498,10 +498,9 @@ void SadBlockMatcher::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat
   cv::copyMakeBorder(left, padded_, half, half, pad_left, half, cv::BORDER_REPLICATE);
   PrefilterXSobel(padded_, o.prefilter_cap, &left_pf_);
   cv::copyMakeBorder(right, padded_, half, half, pad_left, half, cv::BORDER_REPLICATE);
-  cv::Mat right_pf;
-  PrefilterXSobel(padded_, o.prefilter_cap, &right_pf);
+  PrefilterXSobel(padded_, o.prefilter_cap, &right_pf_);
   // Mirrored right rows: the right pixels X - d for d = dmin, dmin + 1, ... are then contiguous.
-  cv::flip(right_pf, right_pf_reversed_, 1);
+  cv::flip(right_pf_, right_pf_reversed_, 1);
 
   // Column j (0 .. w + 2 half - 1) is padded column X = pad_left - half + j; its right
   // candidates for disparity index k sit at reversed index base(j) + k.

@@ -68,7 +68,7 @@ class SadBlockMatcher {
  private:
   SadBlockMatcherOptions options_;
   // Scratch, reused between calls.
-  cv::Mat padded_, left_pf_, right_pf_reversed_;
+  cv::Mat padded_, left_pf_, right_pf_, right_pf_reversed_;
   std::vector<int16_t> column_sums_, costs_, right_min_, right_best_, right_thresh_,
       right_ambiguous_;
 };
