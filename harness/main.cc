@@ -74,7 +74,8 @@ bool ParseIntList(const std::string& text, std::vector<int>* out) {
 }
 
 int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg,
-                 const std::string& matchers_arg, std::string out, int max_frames, bool quiet) {
+                 const std::string& matchers_arg, const std::string& prediction_arg, std::string out,
+                 int max_frames, bool quiet) {
   std::string error;
   sim::Scenario scenario;
   if (!harness::ResolveScenario(scenario_arg, &scenario, &error)) {
@@ -98,6 +99,11 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
       }
       options.matchers.push_back(t);
     }
+  }
+  if (!vo::ParsePredictionMode(prediction_arg, &options.prediction)) {
+    std::fprintf(stderr, "vobench match-eval: --prediction: expected none or motion_prior, got '%s'\n",
+                 prediction_arg.c_str());
+    return 2;
   }
   if (!options.IsValid(&error)) {
     std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
@@ -157,7 +163,8 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
 void PrintRunTable(const harness::RunSummary& s, const std::string& out) {
   const harness::TrajectoryMetrics& m = s.metrics;
   std::printf("run             %s -> %s\n", s.name.c_str(), out.c_str());
-  std::printf("frames          %d (lost %d)\n", m.frames, s.lost_frames);
+  std::printf("frames          %d (lost %d, re-initialised %d)\n", m.frames, s.lost_frames,
+              s.reinitialisations);
   if (s.has_ground_truth) {
     std::printf("path length     %.3f m\n", m.path_length_m);
     std::printf("end-pose error  %.4f m (%.2f %% of the path), rotation %.3f deg\n", m.end_pose_error_m,
@@ -230,12 +237,17 @@ int main(int argc, char** argv) {
   render->add_flag("--overwrite", overwrite, "Replace an existing output folder");
   render->add_flag("-q,--quiet", quiet, "No progress display");
 
-  std::string me_scenario = "l_hallway", me_strides = "1,2,3,5,8", me_matchers, me_out;
+  std::string me_scenario = "l_hallway", me_strides = "1,2,3,5,8", me_matchers, me_out,
+              me_prediction = "motion_prior";
   int me_max_frames = 0;
   CLI::App* match_eval = app.add_subcommand("match-eval", "Matcher precision/recall/F1 per stride against the simulator's ground truth");
   match_eval->add_option("scenario", me_scenario, "Scenario YAML file or built-in name")->capture_default_str();
   match_eval->add_option("--strides", me_strides, "Frame strides, comma-separated")->capture_default_str();
   match_eval->add_option("--matchers", me_matchers, "Matchers, comma-separated (default: all seven)");
+  match_eval->add_option("--prediction", me_prediction,
+                         "Search centre of every matcher: motion_prior (constant velocity from the "
+                         "previous pair's ground truth, as the VO predicts) or none (the paper's form)")
+      ->capture_default_str();
   match_eval->add_option("--out,-o", me_out, "Output folder (default out/match_eval/<scenario>)");
   match_eval->add_option("--max-frames", me_max_frames, "Use only the first N frames (0 = all)");
   match_eval->add_flag("-q,--quiet", quiet, "No progress display");
@@ -266,6 +278,7 @@ int main(int argc, char** argv) {
   if (*run) return RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_stride, run_no_plots, quiet);
   if (*eval->app) return eval->Run(PrintRunTable);
   if (*tune) return harness::RunTuneCommand(tune_args);
-  if (*match_eval) return RunMatchEval(me_scenario, me_strides, me_matchers, me_out, me_max_frames, quiet);
+  if (*match_eval)
+    return RunMatchEval(me_scenario, me_strides, me_matchers, me_prediction, me_out, me_max_frames, quiet);
   return 0;
 }

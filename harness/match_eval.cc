@@ -131,8 +131,20 @@ bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::Ste
       for (size_t k = 0; k + s < frames.size(); k += s) {
         const FrameFeatures& a = feats[k];
         const FrameFeatures& b = feats[k + s];
+        // The same prediction for every matcher: constant velocity from the previous pair.
+        vo::MatchPrediction prediction;
+        if (o.prediction == vo::PredictionMode::kMotionPrior && k >= static_cast<size_t>(s)) {
+          const Eigen::Isometry3d T_curr_ref =
+              (frames[k - s].T_world_cam0.inverse() * frames[k].T_world_cam0).inverse();
+          for (const vo::Feature& f : a.frame.features) {
+            Eigen::Vector2d uv = Eigen::Vector2d::Constant(std::nan(""));
+            if (!f.p_cam0.allFinite() || !camera.ProjectLeft(T_curr_ref * f.p_cam0, &uv))
+              uv = Eigen::Vector2d::Constant(std::nan(""));
+            prediction.uv_px.push_back(uv);
+          }
+        }
         const auto t0 = std::chrono::steady_clock::now();
-        const std::vector<vo::Match> matches = matcher->MatchFrames(a.frame, b.frame);
+        const std::vector<vo::Match> matches = matcher->MatchFrames(a.frame, b.frame, prediction);
         ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         // Ground-truth position in frame k+s of each evaluated feature of frame k.
         std::vector<Eigen::Vector2d> gt(a.frame.features.size());

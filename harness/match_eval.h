@@ -45,6 +45,12 @@ struct MatchEvalOptions {
   vo::DisparityOptions disparity;      // for dropping features without depth
   vo::DepthSamplingOptions depth;
   vo::MatcherOptions matcher;          // per-matcher options (type is overridden)
+  vo::PredictionMode prediction = vo::PredictionMode::kMotionPrior;  // kMotionPrior: every
+                                       // matcher searches around the same predicted positions,
+                                       // the features' stereo 3D points moved by a
+                                       // constant-velocity prior (the ground-truth motion of the
+                                       // previous pair of the same stride; none for the first
+                                       // pair), as the VO predicts; kNone: previous positions
   double correct_px = 2.0;             // a match is correct within this of the GT position (px)
   double depth_agree_rel = 0.03;       // visibility: |z_gt - z_proj| <= this * z_proj + 0.01 m
   double ambiguous_depth_rel = 0.05;   // GT depth spread in 3x3 above this * z: feature left out

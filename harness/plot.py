@@ -90,7 +90,10 @@ def errors(run_dir, png):
     b.set_xlabel("distance travelled (m)")
     for ax in (a, b):
         ax.grid(True, alpha=0.3)
-    lost = [float(r["gt_distance_m"]) for r in rows if r["status"] == "lost"]
+    # Frames without a measured motion (lost or re-initialised); older files lack the column.
+    lost = [float(r["gt_distance_m"]) for r in rows
+            if r.get("motion_measured", "1" if r["status"] != "lost" else "0") == "0"
+            and r["status"] != "initializing"]
     for x in lost:
         a.axvline(x, color="r", alpha=0.2)
     fig.suptitle("Error along the path (estimate vs ground truth, from the first frame)")

@@ -54,7 +54,8 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
     if (s.initial_orientation_error_deg >= 0)
       r << "| initial orientation from planes (error vs GT) | " << (s.initial_orientation_ok ? "found" : "not found") << ", " << Fmt(s.initial_orientation_error_deg, 2) << " deg |\n";
   }
-  r << "| lost frames | " << s.lost_frames << " |\n";
+  r << "| lost frames (no measured motion) / re-initialisations | " << s.lost_frames << " / "
+    << s.reinitialisations << " |\n";
   r << "| VO time per frame, median / p95 | " << Fmt(s.vo_ms_median, 2) << " / " << Fmt(s.vo_ms_p95, 2) << " ms |\n";
   for (const auto& [k, v] : s.stage_ms_median) r << "| stage median: " << k << " | " << Fmt(v, 2) << " ms |\n";
   r << "\n![trajectory](trajectory.png)\n\n![errors](errors.png)\n\n![timing](timing.png)\n\n";
@@ -93,6 +94,7 @@ std::string MetricsJson(const RunSummary& s) {
     j["inlier_match_precision"] = s.match_stats.inlier_precision();
   }
   j["lost_frames"] = s.lost_frames;
+  j["reinitialisations"] = s.reinitialisations;
   j["vo_ms_median"] = s.vo_ms_median;
   j["vo_ms_p95"] = s.vo_ms_p95;
   for (const auto& [k, v] : s.stage_ms_median) j["stage_ms_median"][k] = v;
@@ -192,7 +194,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   std::vector<double> total, feats, inl;
   std::map<std::string, std::vector<double>> stages;
   for (const auto& r : results) {
-    if (r.status == vo::TrackingStatus::kLost) ++s.lost_frames;
+    if (vo::IsLostFrame(r)) ++s.lost_frames;
+    if (r.reinitialised) ++s.reinitialisations;
     total.push_back(r.times.total_ms);
     feats.push_back(r.num_features_with_depth);
     inl.push_back(r.num_inliers);
@@ -202,6 +205,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     stages["match"].push_back(r.times.match_ms);
     stages["motion"].push_back(r.times.motion_ms);
     stages["ba"].push_back(r.times.ba_ms);
+    stages["predict"].push_back(r.times.predict_ms);
+    stages["guided"].push_back(r.times.guided_ms);
   }
   // Timing excludes the first frame (initialisation with the plane fit).
   s.vo_ms_median = Median({total.begin() + 1, total.end()});
@@ -236,7 +241,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   std::ostringstream csv;
   csv << "frame,time_s,status,features,features_with_depth,matches,inliers,rms_reprojection_px,ba_ran,"
          "disparity_ms,detect_ms,depth_ms,match_ms,motion_ms,ba_ms,total_ms,x_m,y_m,z_m,gt_distance_m,"
-         "translation_error_m,rotation_error_deg\n";
+         "translation_error_m,rotation_error_deg,motion_measured,reinitialised,prediction,"
+         "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms\n";
   for (size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
     const Eigen::Vector3d t = est[i].translation();
@@ -246,7 +252,10 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
         << Fmt(r.times.depth_ms, 3) << "," << Fmt(r.times.match_ms, 3) << "," << Fmt(r.times.motion_ms, 3) << ","
         << Fmt(r.times.ba_ms, 3) << "," << Fmt(r.times.total_ms, 3) << "," << FormatDouble(t.x()) << ","
         << FormatDouble(t.y()) << "," << FormatDouble(t.z()) << "," << Fmt(dist[i]) << ","
-        << Fmt(te_m[i], 6) << "," << Fmt(re_deg[i], 5) << "\n";
+        << Fmt(te_m[i], 6) << "," << Fmt(re_deg[i], 5) << "," << (r.motion_measured ? 1 : 0) << ","
+        << (r.reinitialised ? 1 : 0) << "," << vo::ToString(r.prediction) << "," << r.num_first_pass_inliers
+        << "," << Fmt(r.image_shift_px.x(), 2) << "," << Fmt(r.image_shift_px.y(), 2) << ","
+        << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << "\n";
   }
   const std::string options_yaml = VoConfigToYaml(odometry->options());
   if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(times, est), error) ||

@@ -30,7 +30,8 @@ namespace harness {
 struct RunSummary {
   std::string name;
   TrajectoryMetrics metrics;
-  int lost_frames = 0;
+  int lost_frames = 0;        // frames without a measured motion (vo::IsLostFrame)
+  int reinitialisations = 0;  // of those, frames the VO re-initialised on
   double vo_ms_median = 0.0;
   double vo_ms_p95 = 0.0;
   std::map<std::string, double> stage_ms_median;  // disparity, detect, depth, match, motion, ba

@@ -734,7 +734,7 @@ bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& opti
   SequenceScore s;
   for (const DatasetFrame& f : sequence.frames) {
     const vo::OdometryResult r = odometry->Process(f.left, f.right, f.time_s);
-    if (r.status == vo::TrackingStatus::kLost) ++s.lost_frames;
+    if (vo::IsLostFrame(r)) ++s.lost_frames;
     est.push_back(r.T_world_cam0);
     gt.push_back(f.T_world_cam0);
   }

@@ -123,7 +123,7 @@ bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSeque
 
 struct SequenceScore {
   TrajectoryMetrics metrics;  // as `vobench run` computes them
-  int lost_frames = 0;        // frames with TrackingStatus::kLost
+  int lost_frames = 0;        // frames without a measured motion (vo::IsLostFrame)
   double metric = 0.0;        // the objective's metric
   double score = 0.0;         // metric + lost_frame_penalty × lost_frames
 };

@@ -62,6 +62,15 @@ Entry Matcher(vo::MatcherType* field) {
           [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
 }
 
+Entry Prediction(vo::PredictionMode* field) {
+  return {[field](const YAML::Node& n, std::string* why) {
+            if (vo::ParsePredictionMode(n.Scalar(), field)) return true;
+            *why = "expected none or motion_prior, got '" + n.Scalar() + "'";
+            return false;
+          },
+          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
+}
+
 Entry DisparityAlgorithmEntry(vo::DisparityAlgorithm* field) {
   return {[field](const YAML::Node& n, std::string* why) {
             for (vo::DisparityAlgorithm a :
@@ -140,6 +149,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"disparity.left_right_max_diff_px", Number(&o->disparity.left_right_max_diff_px, -1.0, 1000.0)},
       {"disparity_min_depth_m", Number(&o->disparity_min_depth_m, 0.01, kInf)},
       {"matcher.type", Matcher(&o->matcher.type)},
+      {"matcher.prediction", Prediction(&o->matcher.prediction)},
       {"matcher.ncc.window_px", Number(&o->matcher.ncc.window_px, 3, 63)},
       {"matcher.gabor.wavelengths_px", Wavelengths(&o->matcher.gabor.wavelengths_px)},
       {"matcher.gabor.phase_exponent", Number(&o->matcher.gabor.phase_exponent, 0.0, 100.0)},
@@ -165,6 +175,21 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"estimate_initial_orientation", Bool(&o->estimate_initial_orientation)},
       {"min_features", Number(&o->min_features, 0, 100000)},
       {"min_inliers", Number(&o->min_inliers, 3, 100000)},
+      {"reinit_after_lost_frames", Number(&o->reinit_after_lost_frames, 1, 100000)},
+      {"tracking.coarse_to_fine", Bool(&o->tracking.coarse_to_fine)},
+      {"tracking.image_shift.min_score", Number(&o->tracking.image_shift.min_score, -1.0, 1.0)},
+      {"tracking.image_shift.max_shift_fraction_x",
+       Number(&o->tracking.image_shift.max_shift_fraction_x, 0.01, 0.9)},
+      {"tracking.shift_radius_scale", Number(&o->tracking.shift_radius_scale, 0.05, 20.0)},
+      {"tracking.confident_min_inliers", Number(&o->tracking.confident_min_inliers, 0, 100000)},
+      {"tracking.confident_inlier_fraction",
+       Number(&o->tracking.confident_inlier_fraction, 0.0, 1.0)},
+      {"tracking.guided_rematch", Bool(&o->tracking.guided_rematch)},
+      {"tracking.guided_radius_scale", Number(&o->tracking.guided_radius_scale, 0.05, 20.0)},
+      {"tracking.rotation_from_shift", Bool(&o->tracking.rotation_from_shift)},
+      {"tracking.rotation_min_shift_score",
+       Number(&o->tracking.rotation_min_shift_score, -1.0, 1.0)},
+      {"tracking.reliable_min_inliers", Number(&o->tracking.reliable_min_inliers, 3, 100000)},
   };
 }
 

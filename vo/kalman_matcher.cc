@@ -98,8 +98,9 @@ const std::vector<Eigen::Vector2f>& KalmanMatcher::Gradients(const MatchFrame& f
   return *cues.gradients;
 }
 
-std::vector<Match> KalmanMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                              MatcherSummary* summary) {
+std::vector<Match> KalmanMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                                          const MatchPrediction& prediction,
+                                          MatcherSummary* summary) {
   MatcherSummary local;
   MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (prev.image.empty() || curr.image.empty() || prev.image.type() != CV_8UC1 ||
@@ -145,8 +146,11 @@ std::vector<Match> KalmanMatcher::MatchFrames(const MatchFrame& prev, const Matc
   }
 
   // Candidates and their costs.
-  const PointGrid grid(FeaturePositions(curr.features),
-                       std::min(options_.max_search_radius_px, 32.0));
+  // With a prediction (the ego-motion of the camera), the gate is centred on it instead of the
+  // filter's image-velocity prediction, and scaled like every matcher's position gate.
+  const double max_radius = options_.max_search_radius_px * prediction.radius_scale;
+  const double gate_chi2 = options_.gate_chi2 * prediction.radius_scale * prediction.radius_scale;
+  const PointGrid grid(FeaturePositions(curr.features), std::min(max_radius, 32.0));
   std::vector<CandidatePair> candidates;
   for (int i = 0; i < s.num_prev; ++i) {
     const Track& t = tracks_[i];
@@ -154,16 +158,17 @@ std::vector<Match> KalmanMatcher::MatchFrames(const MatchFrame& prev, const Matc
     const Eigen::Matrix2d S = t.P.topLeftCorner<2, 2>() + r2 * Eigen::Matrix2d::Identity();
     const Eigen::Matrix2d Si = S.inverse();
     const double max_eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(S).eigenvalues()(1);
-    const double radius =
-        std::min(options_.max_search_radius_px, std::sqrt(options_.gate_chi2 * max_eig));
-    const Eigen::Vector2d predicted = t.x.head<2>();
+    const double radius = std::min(max_radius, std::sqrt(gate_chi2 * max_eig));
+    const Eigen::Vector2d predicted = prediction.empty()
+                                          ? Eigen::Vector2d(t.x.head<2>())
+                                          : prediction.Centre(i, Eigen::Vector2d(t.x.head<2>()));
     const double grad_var = t.g_var + rg2;
     grid.ForEachWithin(predicted, radius, [&](int j, double) {
       ++s.num_candidates;
       // (ii) predicted-position difference, scaled by the innovation covariance.
       const Eigen::Vector2d nu = curr.features[j].uv_px - predicted;
       const double d2_pos = nu.dot(Si * nu);
-      if (d2_pos > options_.gate_chi2) return;
+      if (d2_pos > gate_chi2) return;
       // (iii) cross correlation, eq. (2).
       const double c = ncc_prev.Score(i, ncc_curr, j);
       if (c < options_.min_ncc) return;

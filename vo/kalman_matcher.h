@@ -39,8 +39,6 @@ class KalmanMatcher : public FrameMatcher {
   // Options must be valid (CreateFrameMatcher checks them).
   KalmanMatcher(const Options& options, const NccOptions& ncc = NccOptions());
 
-  std::vector<Match> MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                 MatcherSummary* summary = nullptr) override;
   void Reset() override;
   MatcherType type() const override { return MatcherType::kKalman; }
 
@@ -50,6 +48,10 @@ class KalmanMatcher : public FrameMatcher {
   int num_continued_tracks() const;
   // Velocity estimate (pixels/frame) of the track of feature i of the last current frame.
   Eigen::Vector2d velocity(int i) const { return tracks_[i].x.tail<2>(); }
+
+ protected:
+  std::vector<Match> DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                             const MatchPrediction& prediction, MatcherSummary* summary) override;
 
  private:
   struct Track {

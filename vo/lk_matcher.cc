@@ -37,8 +37,9 @@ const std::vector<cv::Mat>& LucasKanadeMatcher::Pyramid(const MatchFrame& frame)
   return cues.lk_pyramid;
 }
 
-std::vector<Match> LucasKanadeMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                                   MatcherSummary* summary) {
+std::vector<Match> LucasKanadeMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                                               const MatchPrediction& prediction,
+                                               MatcherSummary* summary) {
   MatcherSummary local;
   MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (s.num_prev == 0 || s.num_curr == 0) return {};
@@ -55,10 +56,20 @@ std::vector<Match> LucasKanadeMatcher::MatchFrames(const MatchFrame& prev, const
   t0 = std::chrono::steady_clock::now();
 
   // 1. Forward tracking of every previous feature.
+  //    With a prediction, the flow starts at the predicted position (OPTFLOW_USE_INITIAL_FLOW).
   std::vector<cv::Point2f> pts_prev, pts_fwd, pts_back;
   pts_prev.reserve(s.num_prev);
   for (const Feature& f : prev.features) {
     pts_prev.emplace_back(static_cast<float>(f.uv_px.x()), static_cast<float>(f.uv_px.y()));
+  }
+  int flow_flags = 0;
+  if (!prediction.empty()) {
+    pts_fwd.reserve(s.num_prev);
+    for (int i = 0; i < s.num_prev; ++i) {
+      const Eigen::Vector2d c = prediction.Centre(i, prev.features[i].uv_px);
+      pts_fwd.emplace_back(static_cast<float>(c.x()), static_cast<float>(c.y()));
+    }
+    flow_flags = cv::OPTFLOW_USE_INITIAL_FLOW;
   }
   const cv::Size window(options_.window_px, options_.window_px);
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
@@ -66,15 +77,17 @@ std::vector<Match> LucasKanadeMatcher::MatchFrames(const MatchFrame& prev, const
   std::vector<uchar> status_fwd, status_back;
   std::vector<float> err;
   cv::calcOpticalFlowPyrLK(pyr_prev, pyr_curr, pts_prev, pts_fwd, status_fwd, err, window,
-                           options_.max_level, criteria, 0, options_.min_eig_threshold);
+                           options_.max_level, criteria, flow_flags, options_.min_eig_threshold);
   // 2. Forward-backward check.
   const bool fb_check = options_.max_fb_error_px > 0.0;
   if (fb_check) {
+    // Backward from the tracked points, starting at the previous positions.
+    if (flow_flags != 0) pts_back = pts_prev;
     cv::calcOpticalFlowPyrLK(pyr_curr, pyr_prev, pts_fwd, pts_back, status_back, err, window,
-                             options_.max_level, criteria, 0, options_.min_eig_threshold);
+                             options_.max_level, criteria, flow_flags, options_.min_eig_threshold);
   }
   // 3. Association with the current features (greedy one-to-one by distance).
-  const double radius = options_.association_radius_px;
+  const double radius = options_.association_radius_px * prediction.radius_scale;
   const PointGrid grid(FeaturePositions(curr.features), radius);
   std::vector<CandidatePair> candidates;
   for (int i = 0; i < s.num_prev; ++i) {

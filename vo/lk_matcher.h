@@ -23,9 +23,11 @@ class LucasKanadeMatcher : public FrameMatcher {
   // Options must be valid (CreateFrameMatcher checks them).
   explicit LucasKanadeMatcher(const Options& options);
 
-  std::vector<Match> MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                 MatcherSummary* summary = nullptr) override;
   MatcherType type() const override { return MatcherType::kLucasKanade; }
+
+ protected:
+  std::vector<Match> DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                             const MatchPrediction& prediction, MatcherSummary* summary) override;
 
  private:
   const std::vector<cv::Mat>& Pyramid(const MatchFrame& frame) const;

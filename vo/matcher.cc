@@ -40,6 +40,21 @@ const char* ToString(MatcherType type) {
   return "unknown";
 }
 
+const char* ToString(PredictionMode mode) {
+  return mode == PredictionMode::kNone ? "none" : "motion_prior";
+}
+
+bool ParsePredictionMode(const std::string& name, PredictionMode* mode) {
+  if (name == "none") {
+    *mode = PredictionMode::kNone;
+  } else if (name == "motion_prior") {
+    *mode = PredictionMode::kMotionPrior;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 bool ParseMatcherType(const std::string& name, MatcherType* type) {
   for (const TypeName& t : kTypeNames) {
     if (name == t.name) {
@@ -302,6 +317,29 @@ MatcherSummary& StartSummary(const MatchFrame& prev, const MatchFrame& curr,
   s.num_prev = static_cast<int>(prev.features.size());
   s.num_curr = static_cast<int>(curr.features.size());
   return s;
+}
+
+std::vector<Match> FrameMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
+                                             const MatchPrediction& prediction,
+                                             MatcherSummary* summary) {
+  MatcherSummary local;
+  MatcherSummary* s = summary != nullptr ? summary : &local;
+  const bool size_ok = prediction.uv_px.empty() || prediction.uv_px.size() == prev.features.size();
+  const bool scale_ok = prediction.radius_scale >= 0.05 && prediction.radius_scale <= 20.0;
+  if (!size_ok || !scale_ok) {
+    StartSummary(prev, curr, s, &local);
+    s->ok = false;
+    std::ostringstream msg;
+    if (!size_ok) {
+      msg << "prediction has " << prediction.uv_px.size() << " positions for "
+          << prev.features.size() << " previous features";
+    } else {
+      msg << "prediction radius_scale must be in [0.05, 20], got " << prediction.radius_scale;
+    }
+    s->message = msg.str();
+    return {};
+  }
+  return DoMatch(prev, curr, prediction, s);
 }
 
 }  // namespace vo

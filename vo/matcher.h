@@ -49,6 +49,18 @@ const char* ToString(MatcherType type);
 // Inverse of ToString; false (and *type untouched) for an unknown name.
 bool ParseMatcherType(const std::string& name, MatcherType* type);
 
+// Where the pipeline (odometry.h) centres every matcher's position gate.
+enum class PredictionMode {
+  kNone,         // on the feature's previous position: the paper's form (Kwolek III-B)
+  kMotionPrior,  // on its predicted position: the previous 3D point moved by the motion prior
+                 // (constant velocity, or one given by the caller), with a coarse-to-fine
+                 // image-shift search when the prior is weak and a guided second pass
+};
+// "none", "motion_prior".
+const char* ToString(PredictionMode mode);
+// Inverse of ToString; false (and *mode untouched) for an unknown name.
+bool ParsePredictionMode(const std::string& name, PredictionMode* mode);
+
 // Per-frame similarity cues, computed lazily by the matchers and kept with the frame, so a
 // frame's cues are computed once and reused when it becomes the previous frame. Each entry
 // records what produced it and is recomputed when asked with other options. Not thread-safe:
@@ -103,6 +115,30 @@ struct MatcherSummary {
   double match_time_ms = 0.0;  // everything else
 };
 
+// Where each previous feature is expected in the current image, and how far to look around
+// it. Built by the pipeline from the motion prior (odometry.h) or a coarse-to-fine image-shift
+// estimate (image_motion.h); empty = no prediction (the paper's form: every position-gated cue
+// is centred on the feature's previous position).
+struct MatchPrediction {
+  std::vector<Eigen::Vector2d> uv_px;  // one per previous feature (pixels, current left image),
+                                       // or empty; non-finite entries fall back to the
+                                       // previous position
+  double radius_scale = 1.0;  // scales every position gate of the matcher (SVD σ and cutoff,
+                              // NCC search radius, Kalman gate, LK association radius): < 1
+                              // for a guided re-match around a known motion, > 1 for a weak
+                              // prior; in [0.05, 20]
+
+  bool empty() const { return uv_px.empty(); }
+  // Centre of the search for previous feature i: the prediction when given and finite, else
+  // `previous_uv_px`.
+  Eigen::Vector2d Centre(int i, const Eigen::Vector2d& previous_uv_px) const {
+    if (i < 0 || i >= static_cast<int>(uv_px.size()) || !uv_px[i].allFinite()) {
+      return previous_uv_px;
+    }
+    return uv_px[i];
+  }
+};
+
 // The plug-in point.
 class FrameMatcher {
  public:
@@ -111,15 +147,29 @@ class FrameMatcher {
   // One-to-one matches between prev.features and curr.features, sorted by `prev`; each
   // Match::score is matcher-specific (larger = better, documented per matcher). Expected
   // failures (missing descriptors, empty images where needed) give no matches and
-  // summary->ok = false. `summary` may be null.
-  virtual std::vector<Match> MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                         MatcherSummary* summary = nullptr) = 0;
+  // summary->ok = false; so does a prediction whose size differs from prev.features (or a
+  // radius_scale out of range). `summary` may be null. Without `prediction` the position
+  // gates are centred on the previous positions.
+  std::vector<Match> MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
+                                 MatcherSummary* summary = nullptr) {
+    return MatchFrames(prev, curr, MatchPrediction(), summary);
+  }
+  std::vector<Match> MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
+                                 const MatchPrediction& prediction,
+                                 MatcherSummary* summary = nullptr);
 
   // Forgets any state carried between calls (only kKalman has some). Call it when the
   // sequence restarts or frames are skipped.
   virtual void Reset() {}
 
   virtual MatcherType type() const = 0;
+
+ protected:
+  // The matcher itself; `prediction` is checked (empty or one finite-or-not entry per
+  // previous feature, radius_scale in range) and `summary` is never null.
+  virtual std::vector<Match> DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                                     const MatchPrediction& prediction,
+                                     MatcherSummary* summary) = 0;
 };
 
 // ---- Options of every matcher -------------------------------------------------------------
@@ -215,6 +265,9 @@ struct SiftRatioMatcherOptions {
 
 struct MatcherOptions {
   MatcherType type = MatcherType::kSvdNccGabor;  // which matcher CreateFrameMatcher builds
+  PredictionMode prediction = PredictionMode::kMotionPrior;  // where the pipeline centres the
+                                                             // position gates (read by
+                                                             // StereoOdometry, not the matchers)
   NccOptions ncc;      // NCC cue: kSvdNcc, kSvdNccGabor, kNccMutual, kKalman
   GaborOptions gabor;  // Gabor phase cue: kSvdNccGabor
   SvdMatcherOptions svd;

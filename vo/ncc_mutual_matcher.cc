@@ -22,8 +22,9 @@ NccMutualMatcher::NccMutualMatcher(const Options& options, const NccOptions& ncc
   }
 }
 
-std::vector<Match> NccMutualMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                                 MatcherSummary* summary) {
+std::vector<Match> NccMutualMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                                             const MatchPrediction& prediction,
+                                             MatcherSummary* summary) {
   MatcherSummary local;
   MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (s.num_prev == 0 || s.num_curr == 0) return {};
@@ -43,10 +44,12 @@ std::vector<Match> NccMutualMatcher::MatchFrames(const MatchFrame& prev, const M
   // (ties: the first one met, in the grid's deterministic order, then by index).
   std::vector<int> best_of_prev(s.num_prev, -1), best_of_curr(s.num_curr, -1);
   std::vector<double> score_of_prev(s.num_prev, -1.0), score_of_curr(s.num_curr, -1.0);
-  const PointGrid grid(FeaturePositions(curr.features), options_.search_radius_px);
+  // Candidates around the predicted position (the previous one without a prediction).
+  const double radius = options_.search_radius_px * prediction.radius_scale;
+  const PointGrid grid(FeaturePositions(curr.features), radius);
   for (int i = 0; i < s.num_prev; ++i) {
     if (!ncc_prev.valid(i)) continue;
-    grid.ForEachWithin(prev.features[i].uv_px, options_.search_radius_px, [&](int j, double) {
+    grid.ForEachWithin(prediction.Centre(i, prev.features[i].uv_px), radius, [&](int j, double) {
       ++s.num_candidates;
       const double c = ncc_prev.Score(i, ncc_curr, j);  // eq. (2)
       if (c > score_of_prev[i] || (c == score_of_prev[i] && j < best_of_prev[i])) {

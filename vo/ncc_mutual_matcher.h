@@ -19,9 +19,11 @@ class NccMutualMatcher : public FrameMatcher {
   // Options must be valid (CreateFrameMatcher checks them).
   NccMutualMatcher(const Options& options, const NccOptions& ncc = NccOptions());
 
-  std::vector<Match> MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                 MatcherSummary* summary = nullptr) override;
   MatcherType type() const override { return MatcherType::kNccMutual; }
+
+ protected:
+  std::vector<Match> DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                             const MatchPrediction& prediction, MatcherSummary* summary) override;
 
  private:
   Options options_;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -39,13 +40,6 @@ Eigen::Isometry3d Blend(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T
   T.linear() = q_a.slerp(w, q_b).normalized().toRotationMatrix();
   T.translation() = (1.0 - w) * T_a.translation() + w * T_b.translation();
   return T;
-}
-
-// T repeated n >= 1 times (the constant-velocity motion over n frames).
-Eigen::Isometry3d Power(const Eigen::Isometry3d& T, int64_t n) {
-  Eigen::Isometry3d P = T;
-  for (int64_t i = 1; i < n; ++i) P = P * T;
-  return P;
 }
 
 // The per-frame motion of a motion spanning n >= 1 frames: the rotation's n-th root (slerp from
@@ -129,6 +123,12 @@ BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions() {
   return options;
 }
 
+ImageShiftOptions DefaultTrackingImageShiftOptions() {
+  ImageShiftOptions options;
+  options.min_score = 0.1;
+  return options;
+}
+
 DisparityOptions DefaultOdometryDisparityOptions() {
   DisparityOptions options;
   // The same correlation as cv::StereoBM, with the left-right check's right view taken from
@@ -151,6 +151,29 @@ DetectorOptions DefaultOdometryDetectorOptions() {
   return options;
 }
 
+bool RobustTrackingOptions::IsValid(std::string* error) const {
+  std::string part_error;
+  if (coarse_to_fine && !image_shift.IsValid(&part_error)) {
+    return FailPart("image_shift", part_error, error);
+  }
+  std::ostringstream msg;
+  if (!(shift_radius_scale >= 0.05 && shift_radius_scale <= 20.0)) {
+    msg << "shift_radius_scale must be in [0.05, 20], got " << shift_radius_scale;
+  } else if (confident_min_inliers < 0) {
+    msg << "confident_min_inliers must be >= 0, got " << confident_min_inliers;
+  } else if (!(confident_inlier_fraction >= 0.0 && confident_inlier_fraction <= 1.0)) {
+    msg << "confident_inlier_fraction must be in [0, 1], got " << confident_inlier_fraction;
+  } else if (!(guided_radius_scale >= 0.05 && guided_radius_scale <= 20.0)) {
+    msg << "guided_radius_scale must be in [0.05, 20], got " << guided_radius_scale;
+  } else if (!(rotation_min_shift_score >= -1.0 && rotation_min_shift_score <= 1.0)) {
+    msg << "rotation_min_shift_score must be in [-1, 1], got " << rotation_min_shift_score;
+  } else if (reliable_min_inliers < 3) {
+    msg << "reliable_min_inliers must be >= 3, got " << reliable_min_inliers;
+  }
+  if (msg.tellp() != 0) return Fail(msg, error);
+  return true;
+}
+
 bool OdometryOptions::IsValid(std::string* error) const {
   std::string part_error;
   if (!detector.IsValid(&part_error)) return FailPart("detector", part_error, error);
@@ -161,6 +184,7 @@ bool OdometryOptions::IsValid(std::string* error) const {
   if (!matcher.IsValid(&part_error)) return FailPart("matcher", part_error, error);
   if (!ransac.IsValid(&part_error)) return FailPart("ransac", part_error, error);
   if (!ba.IsValid(&part_error)) return FailPart("ba", part_error, error);
+  if (!tracking.IsValid(&part_error)) return FailPart("tracking", part_error, error);
   if (estimate_initial_orientation && !orientation.IsValid(&part_error)) {
     return FailPart("orientation", part_error, error);
   }
@@ -194,6 +218,20 @@ bool OdometryOptions::IsValid(std::string* error) const {
   }
   if (msg.tellp() != 0) return Fail(msg, error);
   return true;
+}
+
+const char* ToString(PredictionSource source) {
+  switch (source) {
+    case PredictionSource::kNone:
+      return "none";
+    case PredictionSource::kMotionPrior:
+      return "motion_prior";
+    case PredictionSource::kImageShift:
+      return "image_shift";
+    case PredictionSource::kGuided:
+      return "guided";
+  }
+  return "unknown";
 }
 
 const char* ToString(TrackingStatus status) {
@@ -260,6 +298,7 @@ void StereoOdometry::Reset() {
   T_world_prev_ = Eigen::Isometry3d::Identity();
   velocity_ = Eigen::Isometry3d::Identity();
   has_velocity_ = false;
+  velocity_frame_index_ = -1;
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
@@ -267,6 +306,9 @@ void StereoOdometry::Reset() {
   last_inlier_mask_.clear();
   last_reference_features_.clear();
   prev_call_index_map_.clear();
+  current_left_ = cv::Mat();
+  previous_left_ = cv::Mat();
+  current_depth_m_ = -1.0;
 }
 
 OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
@@ -277,20 +319,77 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
   result.T_prev_curr = result.frame_index == 0 ? Eigen::Isometry3d::Identity()
                                                : Eigen::Isometry3d(T_world_prev_.inverse() * T);
   T_world_prev_ = T;
+  previous_left_ = current_left_;
+  current_left_ = cv::Mat();
+  current_depth_m_ = -1.0;
   result.times.total_ms = MsSince(start);
   return result;
 }
 
+Eigen::Isometry3d CorrectPriorWithImageShift(const StereoCamera& camera,
+                                             const Eigen::Isometry3d& T_prev_curr_prior,
+                                             const Eigen::Vector2d& shift_px, double depth_m) {
+  // Where the prior puts the point seen at the previous image centre (depth_m, or far away).
+  const bool near = std::isfinite(depth_m) && depth_m > 0.0;
+  const Eigen::Vector3d p_prev = Eigen::Vector3d(0.0, 0.0, near ? depth_m : 1.0);
+  const Eigen::Isometry3d T_curr_prev = T_prev_curr_prior.inverse();
+  const Eigen::Vector3d p_curr =
+      near ? Eigen::Vector3d(T_curr_prev * p_prev) : Eigen::Vector3d(T_curr_prev.linear() * p_prev);
+  if (!(p_curr.z() > 1e-9)) return T_prev_curr_prior;
+  const Eigen::Vector2d predicted(camera.fx_px * p_curr.x() / p_curr.z(),
+                                  camera.fy_px * p_curr.y() / p_curr.z());
+  // The residual shift r: the prior-predicted camera c' sees along a ray that the true camera c
+  // sees at (r_x / fx, r_y / fy, 1), i.e. R_c'c^T e_z ∝ d, and R_c'c = FromTwoVectors(d, e_z).
+  const Eigen::Vector2d r = shift_px - predicted;
+  const Eigen::Vector3d ray_c(p_curr.x() / p_curr.z() + r.x() / camera.fx_px,
+                              p_curr.y() / p_curr.z() + r.y() / camera.fy_px, 1.0);
+  const Eigen::Vector3d ray_c_prime(p_curr.x() / p_curr.z(), p_curr.y() / p_curr.z(), 1.0);
+  // R_c'c maps directions in c to directions in c': the ray seen in c must map to the ray the
+  // point has in c'.
+  const Eigen::Matrix3d R_cprime_c =
+      Eigen::Quaterniond::FromTwoVectors(ray_c, ray_c_prime).toRotationMatrix();
+  Eigen::Isometry3d T_cprime_c = Eigen::Isometry3d::Identity();
+  T_cprime_c.linear() = R_cprime_c;
+  return T_prev_curr_prior * T_cprime_c;
+}
+
+Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, OdometryResult* result) {
+  const Eigen::Isometry3d predicted = PredictedPose(prior);
+  const RobustTrackingOptions& o = options_.tracking;
+  if (options_.matcher.prediction == PredictionMode::kNone || !o.rotation_from_shift ||
+      previous_left_.empty() || current_left_.empty() ||
+      previous_left_.size() != current_left_.size()) {
+    return predicted;
+  }
+  const Clock::time_point t = Clock::now();
+  const ImageShiftResult shift = EstimateImageShift(previous_left_, current_left_, o.image_shift);
+  result->times.predict_ms += MsSince(t);
+  if (!shift.ok || !(shift.score >= o.rotation_min_shift_score)) return predicted;
+  const Eigen::Isometry3d T_prev_curr_prior = T_world_prev_.inverse() * predicted;
+  const Eigen::Isometry3d T_prev_curr =
+      CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, current_depth_m_);
+  if (!IsFinite(T_prev_curr)) return predicted;
+  result->rotation_from_shift = true;
+  result->image_shift_ok = true;
+  result->image_shift_px = shift.shift_px;
+  return T_world_prev_ * T_prev_curr;
+}
+
+Eigen::Isometry3d StereoOdometry::PredictedPose(const MotionPrior* prior) const {
+  if (prior != nullptr && IsFinite(prior->T_prev_curr)) return T_world_prev_ * prior->T_prev_curr;
+  return has_velocity_ ? Eigen::Isometry3d(T_world_prev_ * velocity_) : T_world_prev_;
+}
+
 OdometryResult StereoOdometry::Lost(OdometryResult result, const std::string& message,
-                                    TimePoint start) {
+                                    TimePoint start, const MotionPrior* prior) {
   result.status = TrackingStatus::kLost;
   result.message = message;
   ++consecutive_lost_;
   // Frames are skipped from the matcher's point of view (the Kalman tracker keeps state).
   matcher_->Reset();
-  const Eigen::Isometry3d predicted =
-      has_velocity_ ? Eigen::Isometry3d(T_world_prev_ * velocity_) : T_world_prev_;
-  return Finish(std::move(result), predicted, start);
+  const Eigen::Isometry3d T_world_cam0 = BridgedPose(prior, &result);
+  if (result.rotation_from_shift) result.message += "; pose: prior + rotation from the image shift";
+  return Finish(std::move(result), T_world_cam0, start);
 }
 
 bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0) {
@@ -303,7 +402,8 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
 }
 
 OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame frame,
-                                          const std::string& reason, TimePoint start) {
+                                          const std::string& reason, TimePoint start,
+                                          const MotionPrior* prior) {
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
   if (!initialised_) {
     // World = hallway frame with its origin at the first camera centre, or the first camera.
@@ -312,9 +412,10 @@ OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame fram
     result.message = reason;
   } else {
     // Re-initialisation after a loss: keep the predicted pose and the constant velocity.
-    T_world_cam0 = has_velocity_ ? Eigen::Isometry3d(T_world_prev_ * velocity_) : T_world_prev_;
+    T_world_cam0 = BridgedPose(prior, &result);
     if (!IsFinite(T_world_cam0)) T_world_cam0 = T_world_prev_;
     result.status = TrackingStatus::kRecovered;
+    result.reinitialised = true;
     result.message = reason.empty() ? "re-initialised at the predicted pose" : reason;
   }
   tracks_.Reset();
@@ -335,18 +436,139 @@ OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame fram
   return Finish(std::move(result), T_world_cam0, start);
 }
 
-OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
-                                     const std::vector<Match>& matches, TimePoint start) {
+std::vector<Eigen::Vector2d> PredictFeaturePositions(const StereoCamera& camera,
+                                                     const std::vector<Feature>& features,
+                                                     const Eigen::Isometry3d& T_ref_curr,
+                                                     double min_depth_m) {
+  const Eigen::Isometry3d T_curr_ref = T_ref_curr.inverse();
+  const Eigen::Vector2d none = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::vector<Eigen::Vector2d> uv(features.size(), none);
+  for (size_t i = 0; i < features.size(); ++i) {
+    const Feature& f = features[i];
+    if (!f.has_depth() || !f.p_cam0.allFinite()) continue;
+    Eigen::Vector2d p;
+    if (camera.ProjectLeft(T_curr_ref * f.p_cam0, &p, min_depth_m)) uv[i] = p;
+  }
+  return uv;
+}
+
+std::vector<Eigen::Vector2d> StereoOdometry::PredictPositions(
+    const Eigen::Isometry3d& T_ref_curr) const {
+  return PredictFeaturePositions(camera_, reference_.frame.features, T_ref_curr,
+                                 options_.ransac.min_depth_m);
+}
+
+StereoOdometry::MotionAttempt StereoOdometry::EstimateMotion(
+    const std::vector<Feature>& ref_features, const std::vector<Feature>& curr_features,
+    std::vector<Match> matches, PredictionSource source) const {
+  MotionAttempt a;
+  a.matches = std::move(matches);
+  a.source = source;
+  a.correspondences =
+      MakeStereoCorrespondences(ref_features, curr_features, a.matches, &a.match_index);
+  a.ransac = EstimateMotionRansac(camera_, a.correspondences, options_.ransac);
+  return a;
+}
+
+StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
+    const MatchFrame& frame, const Eigen::Isometry3d* T_ref_curr_prior, OdometryResult* result,
+    std::string* matcher_error) {
+  const MatchFrame& ref = reference_.frame;
+  const RobustTrackingOptions& o = options_.tracking;
+  // One pass: match around `prediction`, then RANSAC. Times go to `match_ms` / `motion_ms`.
+  auto pass = [&](const MatchPrediction& prediction, PredictionSource source, double* match_ms,
+                  double* motion_ms, MotionAttempt* attempt) {
+    Clock::time_point t = Clock::now();
+    MatcherSummary summary;
+    std::vector<Match> matches = matcher_->MatchFrames(ref, frame, prediction, &summary);
+    *match_ms += MsSince(t);
+    if (!summary.ok) {
+      *matcher_error = summary.message;
+      return false;
+    }
+    t = Clock::now();
+    *attempt = EstimateMotion(ref.features, frame.features, std::move(matches), source);
+    *motion_ms += MsSince(t);
+    return true;
+  };
+  MotionAttempt best;
+  StageTimes& times = result->times;
+  if (options_.matcher.prediction == PredictionMode::kNone) {  // the paper's form
+    pass(MatchPrediction(), PredictionSource::kNone, &times.match_ms, &times.motion_ms, &best);
+    result->num_first_pass_inliers = best.inliers();
+    return best;
+  }
+
+  // 1. Centred on the motion prior's prediction (previous positions without a prior).
+  Clock::time_point t = Clock::now();
+  MatchPrediction prediction;
+  PredictionSource source = PredictionSource::kNone;
+  if (T_ref_curr_prior != nullptr) {
+    prediction.uv_px = PredictPositions(*T_ref_curr_prior);
+    source = PredictionSource::kMotionPrior;
+  }
+  times.predict_ms += MsSince(t);
+  if (!pass(prediction, source, &times.match_ms, &times.motion_ms, &best)) return best;
+  result->num_first_pass_inliers = best.inliers();
+  // The stateful Kalman tracker sees each frame pair once.
+  if (matcher_->type() == MatcherType::kKalman) return best;
+
+  // 2. Weak (no reliable motion yet, or after a loss) or contradicted prior: the dominant image
+  //    shift, coarse-to-fine, and a wider search around it; the pass with more inliers wins.
+  const double smaller = static_cast<double>(std::min(ref.features.size(), frame.features.size()));
+  const bool weak = T_ref_curr_prior == nullptr || consecutive_lost_ > 0;
+  const bool confident =
+      best.inliers() >= std::max(options_.min_inliers, o.confident_min_inliers) &&
+      best.inliers() >= o.confident_inlier_fraction * smaller;
+  if (o.coarse_to_fine && (weak || !confident)) {
+    t = Clock::now();
+    const ImageShiftResult shift = EstimateImageShift(ref.image, frame.image, o.image_shift);
+    result->image_shift_ok = shift.ok;
+    if (shift.ok) result->image_shift_px = shift.shift_px;
+    times.predict_ms += MsSince(t);
+    if (shift.ok) {
+      MatchPrediction shifted;
+      shifted.radius_scale = o.shift_radius_scale;
+      shifted.uv_px.reserve(ref.features.size());
+      for (const Feature& f : ref.features) shifted.uv_px.push_back(f.uv_px + shift.shift_px);
+      MotionAttempt attempt;
+      if (!pass(shifted, PredictionSource::kImageShift, &times.match_ms, &times.motion_ms,
+                &attempt)) {
+        return best;
+      }
+      if (attempt.inliers() > best.inliers()) best = std::move(attempt);
+    }
+  }
+
+  // 3. Guided second pass: every reference feature predicted with the estimated motion, matched
+  //    in a tight window, so more correct matches reach the bundle adjustment.
+  if (o.guided_rematch && best.ransac.ok() && IsFinite(best.ransac.T_prev_curr)) {
+    t = Clock::now();
+    MatchPrediction guided;
+    guided.uv_px = PredictPositions(best.ransac.T_prev_curr);
+    guided.radius_scale = o.guided_radius_scale;
+    double match_ms = 0.0, motion_ms = 0.0;
+    MotionAttempt attempt;
+    const bool ok = pass(guided, PredictionSource::kGuided, &match_ms, &motion_ms, &attempt);
+    times.guided_ms += MsSince(t);
+    if (!ok) return best;
+    if (attempt.inliers() >= best.inliers()) best = std::move(attempt);
+  }
+  return best;
+}
+
+OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, MotionAttempt attempt,
+                                     const Eigen::Isometry3d* T_ref_curr_prior,
+                                     const MotionPrior* prior, TimePoint start) {
   const Clock::time_point motion_start = Clock::now();
   const std::vector<Feature>& ref_features = reference_.frame.features;
   result.reference_frame_index = static_cast<int>(reference_.frame_index);
+  const std::vector<Match>& matches = attempt.matches;
+  const std::vector<StereoCorrespondence>& correspondences = attempt.correspondences;
+  const std::vector<int>& match_index = attempt.match_index;
+  const RansacResult& ransac = attempt.ransac;
   result.num_matches = static_cast<int>(matches.size());
-
-  // RANSAC + Horn on the matches whose both features have depth; seeded by track ages.
-  std::vector<int> match_index;
-  const std::vector<StereoCorrespondence> correspondences =
-      MakeStereoCorrespondences(ref_features, frame.features, matches, &match_index);
-  const RansacResult ransac = EstimateMotionRansac(camera_, correspondences, options_.ransac);
+  result.prediction = attempt.source;
 
   last_matches_ = matches;
   last_inlier_mask_.assign(matches.size(), false);
@@ -367,29 +589,38 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
         << ransac.num_inliers << " inliers of " << correspondences.size() << " correspondences, "
         << matches.size() << " matches; need " << options_.min_inliers << ")";
     if (!ransac.message.empty()) why << ": " << ransac.message;
-    result.times.motion_ms = MsSince(motion_start);
-    if (consecutive_lost_ >= options_.reinit_after_lost_frames) {
+    result.times.motion_ms += MsSince(motion_start);
+    // A poor reference (a plain stretch) after a loss is not waited on when this frame has
+    // plenty of features.
+    const int rich = 2 * options_.min_features;
+    const bool reference_poor = consecutive_lost_ > 0 &&
+                                static_cast<int>(ref_features.size()) < rich &&
+                                static_cast<int>(frame.features.size()) >= rich;
+    if (consecutive_lost_ >= options_.reinit_after_lost_frames || reference_poor) {
       // The reference is stale: start again from this frame at its predicted pose.
       return Initialise(std::move(result), std::move(frame),
-                        why.str() + "; re-initialised at the predicted pose", start);
+                        why.str() + "; re-initialised at the predicted pose", start, prior);
     }
-    return Lost(std::move(result), why.str(), start);
+    return Lost(std::move(result), why.str(), start, prior);
   }
 
   // Initial pose: blend of the RANSAC/Horn motion and the constant-velocity prediction.
   const int64_t gap = result.frame_index - reference_.frame_index;
   const double inlier_ratio =
       static_cast<double>(ransac.num_inliers) / std::max<size_t>(1, matches.size());
-  const double w =
-      has_velocity_ ? options_.prior_weight * (1.0 - std::min(1.0, inlier_ratio)) : 0.0;
-  const Eigen::Isometry3d T_ref_curr_initial = Blend(ransac.T_prev_curr, Power(velocity_, gap), w);
+  const double w = T_ref_curr_prior != nullptr
+                       ? options_.prior_weight * (1.0 - std::min(1.0, inlier_ratio))
+                       : 0.0;
+  const Eigen::Isometry3d T_ref_curr_initial = T_ref_curr_prior != nullptr
+                                                   ? Blend(ransac.T_prev_curr, *T_ref_curr_prior, w)
+                                                   : ransac.T_prev_curr;
 
   // Tracks from the inlier matches (track ids and ages written into the features).
   const TrackUpdateResult update =
       tracks_.AddFrame(result.frame_index, &frame.features, inlier_matches);
   if (!update.ok()) {
-    result.times.motion_ms = MsSince(motion_start);
-    return Lost(std::move(result), "tracks: " + update.message, start);
+    result.times.motion_ms += MsSince(motion_start);
+    return Lost(std::move(result), "tracks: " + update.message, start, prior);
   }
   const Eigen::Isometry3d T_world_ref = T_world_cam0_by_frame_.at(reference_.frame_index);
   Eigen::Isometry3d T_world_curr = T_world_ref * T_ref_curr_initial;
@@ -403,10 +634,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
       ++it;
     }
   }
-  result.times.motion_ms = MsSince(motion_start);
+  result.times.motion_ms += MsSince(motion_start);
   result.rms_reprojection_px = ransac.rms_reprojection_px;
 
   // Windowed bundle adjustment, the oldest pose(s) fixed.
+  bool ba_rejected = false;
   if (options_.use_bundle_adjustment && T_world_cam0_by_frame_.size() >= 2) {
     const Clock::time_point ba_start = Clock::now();
     std::vector<int64_t> frame_ids;
@@ -435,6 +667,7 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
               << turned_deg << " deg";
           result.message = msg.str();
           usable = false;
+          ba_rejected = true;
         }
       }
       if (usable) {
@@ -451,17 +684,23 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
     result.times.ba_ms = MsSince(ba_start);
   }
 
-  // Constant-velocity model: the (refined) motion from the reference, per frame.
+  // Constant-velocity model: the (refined) motion from the reference, per frame, taken only
+  // from a reliable motion (enough inliers, bundle adjustment not rejected), so one weak
+  // estimate before a loss is not extrapolated over the gap.
   const Eigen::Isometry3d T_ref_curr =
       T_world_cam0_by_frame_.count(reference_.frame_index)
           ? Eigen::Isometry3d(T_world_cam0_by_frame_.at(reference_.frame_index).inverse() *
                               T_world_curr)
           : T_ref_curr_initial;
   const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
-  if (IsFinite(per_frame)) {
+  const bool reliable =
+      ransac.num_inliers >= options_.tracking.reliable_min_inliers && !ba_rejected;
+  if (IsFinite(per_frame) && (reliable || !has_velocity_)) {
     velocity_ = per_frame;
     has_velocity_ = true;
+    velocity_frame_index_ = result.frame_index;
   }
+  result.motion_measured = true;
 
   result.status = consecutive_lost_ > 0 ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
   if (consecutive_lost_ > 0) {
@@ -478,7 +717,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame,
   return Finish(std::move(result), T_world_curr, start);
 }
 
-OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right, double time_s) {
+OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right, double time_s,
+                                       const MotionPrior* prior) {
   const Clock::time_point start = Clock::now();
   OdometryResult result;
   result.frame_index = frame_index_++;
@@ -491,25 +731,28 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
 
   // Input checks: expected failures come back as kLost.
   const cv::Size camera_size(camera_.width, camera_.height);
-  if (left.empty() || right.empty()) return Lost(std::move(result), "empty image", start);
+  if (left.empty() || right.empty()) return Lost(std::move(result), "empty image", start, prior);
   if (left.type() != CV_8UC1 || right.type() != CV_8UC1) {
-    return Lost(std::move(result), "images must be 8-bit grayscale (CV_8UC1)", start);
+    return Lost(std::move(result), "images must be 8-bit grayscale (CV_8UC1)", start, prior);
   }
   if (left.size() != right.size()) {
-    return Lost(std::move(result), "left and right images differ in size", start);
+    return Lost(std::move(result), "left and right images differ in size", start, prior);
   }
   if (left.size() != camera_size) {
     std::ostringstream msg;
     msg << "image size " << left.cols << "x" << left.rows << " differs from the camera's "
         << camera_.width << "x" << camera_.height;
-    return Lost(std::move(result), msg.str(), start);
+    return Lost(std::move(result), msg.str(), start, prior);
   }
+
+  current_left_ = left.clone();  // the caller may reuse its buffer
 
   // Dense disparity.
   Clock::time_point t = Clock::now();
   const DisparityResult disparity = disparity_->Compute(left, right);
   result.times.disparity_ms = MsSince(t);
-  if (!disparity.ok) return Lost(std::move(result), "disparity: " + disparity.message, start);
+  if (!disparity.ok)
+    return Lost(std::move(result), "disparity: " + disparity.message, start, prior);
 
   // Features in the left image.
   t = Clock::now();
@@ -540,14 +783,20 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   result.times.depth_ms = MsSince(t);
   result.num_features_with_depth = static_cast<int>(frame.features.size());
   last_features_ = frame.features;
+  if (!frame.features.empty()) {  // median depth, for the image-shift bridge of a lost frame
+    std::vector<double> z;
+    for (const Feature& f : frame.features) z.push_back(f.p_cam0.z());
+    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+    current_depth_m_ = z[z.size() / 2];
+  }
   if (result.num_features_with_depth < options_.min_features) {
     std::ostringstream msg;
     msg << "too few features with depth (" << result.num_features_with_depth << " of "
         << result.num_features << " features; need " << options_.min_features
         << "): black, textureless or unmatched frame";
-    return Lost(std::move(result), msg.str(), start);
+    return Lost(std::move(result), msg.str(), start, prior);
   }
-  frame.image = left.clone();  // the caller may reuse its buffer
+  frame.image = current_left_;
 
   if (!reference_.valid) {
     std::string reason;
@@ -574,20 +823,26 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
       }
       result.times.orientation_ms = MsSince(t);
     }
-    return Initialise(std::move(result), std::move(frame), reason, start);
+    return Initialise(std::move(result), std::move(frame), reason, start, prior);
   }
 
-  // Match against the reference frame (its cues are cached in reference_.frame).
-  t = Clock::now();
-  MatcherSummary summary;
-  const std::vector<Match> matches = matcher_->MatchFrames(reference_.frame, frame, &summary);
-  result.times.match_ms = MsSince(t);
-  if (!summary.ok) {
+  // Match against the reference frame (its cues are cached in reference_.frame), with the
+  // search predicted from the motion prior (see the header comment).
+  const auto ref_pose = T_world_cam0_by_frame_.find(reference_.frame_index);
+  const Eigen::Isometry3d T_world_ref =
+      ref_pose != T_world_cam0_by_frame_.end() ? ref_pose->second : T_world_prev_;
+  const Eigen::Isometry3d T_ref_curr_prior = T_world_ref.inverse() * PredictedPose(prior);
+  const bool has_prior = (prior != nullptr || has_velocity_) && IsFinite(T_ref_curr_prior);
+  std::string matcher_error;
+  MotionAttempt attempt =
+      MatchAndEstimate(frame, has_prior ? &T_ref_curr_prior : nullptr, &result, &matcher_error);
+  if (!matcher_error.empty()) {
     last_reference_features_ = reference_.frame.features;
     result.reference_frame_index = static_cast<int>(reference_.frame_index);
-    return Lost(std::move(result), "matcher: " + summary.message, start);
+    return Lost(std::move(result), "matcher: " + matcher_error, start, prior);
   }
-  return Track(std::move(result), std::move(frame), matches, start);
+  return Track(std::move(result), std::move(frame), std::move(attempt),
+               has_prior ? &T_ref_curr_prior : nullptr, prior, start);
 }
 
 OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
@@ -673,7 +928,13 @@ OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
     }
     return Initialise(std::move(result), std::move(frame), reason, start);
   }
-  return Track(std::move(result), std::move(frame), matches, start);
+  // The constant-velocity prediction from the reference (the previous call) to this frame.
+  const Eigen::Isometry3d T_ref_curr_prior = velocity_;
+  MotionAttempt attempt =
+      EstimateMotion(reference_.frame.features, frame.features, matches, PredictionSource::kNone);
+  result.num_first_pass_inliers = attempt.inliers();
+  return Track(std::move(result), std::move(frame), std::move(attempt),
+               has_velocity_ ? &T_ref_curr_prior : nullptr, nullptr, start);
 }
 
 }  // namespace vo

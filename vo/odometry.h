@@ -31,17 +31,43 @@
 // the consensus weakens (w <= prior_weight). Without bundle adjustment this blend is the
 // output; with it, the blend is where the solver starts.
 //
+// Predicted matching (matcher.prediction = kMotionPrior, the default; kNone = the paper's
+// unpredicted form, every position gate centred on the previous position). Beyond the paper,
+// whose proximity term exp(−d²/2σ²) with σ = 10 px stops at ~28 px of image motion:
+//   1. prior pass: each reference feature's 3D point is moved by the motion prior (the
+//      constant-velocity motion from the last RELIABLE frame, or the caller's MotionPrior) and
+//      projected (PredictFeaturePositions); every matcher centres its position gate there
+//      (MatchPrediction), then RANSAC.
+//   2. coarse-to-fine pass, when the prior is weak (no motion known yet, after a lost frame)
+//      or contradicted (fewer inliers than tracking.confident_min_inliers or
+//      confident_inlier_fraction of the features): the dominant image shift from the reference
+//      to this frame on an image pyramid (image_motion.h, the paper's "multi-scale analysis"),
+//      matching around uv + shift with gates widened by shift_radius_scale, then RANSAC; the
+//      pass with more inliers is kept.
+//   3. guided pass: every reference feature predicted with the motion just estimated, matched
+//      in a tight window (guided_radius_scale), RANSAC; kept when it has at least as many
+//      inliers, so more correct matches reach the bundle adjustment.
+// The stateful Kalman tracker runs pass 1 only. OdometryResult::prediction says which pass
+// the used matches came from; StageTimes::predict_ms / guided_ms time the new steps.
+//
 // Lost tracking and recovery. A frame is "lost" (TrackingStatus::kLost, with a message) when
 // its input is invalid (empty, not CV_8UC1, sizes differ from each other or from the camera),
 // its disparity fails, it has fewer than min_features features with depth (black or
 // textureless frame), or the motion fails (RANSAC without consensus, fewer than min_inliers
-// inliers). Its pose is the constant-velocity prediction from the previous output, never NaN;
-// the reference frame, the tracks and the window are kept. The next frame is matched against
-// that reference (the last good frame), the motion being allowed to span the gap; success
-// gives kRecovered. When the motion fails again while already lost (the reference is stale),
-// the pipeline re-initialises on the current frame at its predicted pose (kRecovered, message
-// "re-initialised"): tracks and window restart, the constant velocity is kept. The frame after
-// a kRecovered frame is kTracking again.
+// inliers). Its pose is the prior's prediction from the previous output, never NaN — corrected,
+// when the image shift from the previous frame is found (tracking.rotation_from_shift), by the
+// rotation that explains that shift (CorrectPriorWithImageShift): a turn in front of a plain
+// wall is followed, not extrapolated. The reference frame, the tracks and the window are kept.
+// The next frames are matched against that reference (the last good frame) with the
+// coarse-to-fine pass, so the motion across the gap is measured; success gives kRecovered.
+// When the motion still fails after reinit_after_lost_frames lost frames, or the reference is
+// poor (fewer than 2 · min_features features) while the current frame is rich, the pipeline
+// re-initialises on the current frame at its bridged pose (kRecovered, reinitialised = true):
+// tracks and window restart, the constant velocity is kept. The prior is updated only from a
+// reliable motion (tracking.reliable_min_inliers, BA not rejected), so a weak estimate just
+// before a loss is not extrapolated over the gap. Frames without a measured motion (lost and
+// re-initialised ones) are what IsLostFrame() counts. The frame after a kRecovered frame is
+// kTracking again.
 //
 // Determinism: every random choice is seeded (RANSAC, plane extraction), the bundle
 // adjustment is single-threaded; the same inputs give bit-identical outputs. Global OpenCV
@@ -63,6 +89,7 @@
 #include "vo/camera.h"
 #include "vo/disparity.h"
 #include "vo/features.h"
+#include "vo/image_motion.h"
 #include "vo/matcher.h"
 #include "vo/plane_orientation.h"
 #include "vo/ransac.h"
@@ -84,12 +111,62 @@ DetectorOptions DefaultOdometryDetectorOptions();
 // twice, in about half the time).
 DisparityOptions DefaultOdometryDisparityOptions();
 
+// Image-shift defaults for the pipeline's coarse-to-fine pass: min_score 0.1 instead of 0.3. A
+// wrong shift only costs one matching pass that loses to the other on inliers, while a turn
+// past nearby walls (perspective, parallax) scores ZNCC ~0.3 at the right shift; the pose
+// bridge of a lost frame asks for more (RobustTrackingOptions::rotation_min_shift_score).
+ImageShiftOptions DefaultTrackingImageShiftOptions();
+
+// Robust tracking (beyond the paper's unpredicted matcher; used when matcher.prediction is
+// kMotionPrior). See the header comment, "Predicted matching".
+struct RobustTrackingOptions {
+  bool coarse_to_fine = true;  // when the prior is weak (no reliable motion yet, after a lost
+                               // frame) or contradicted (the first pass is not confident),
+                               // estimate the dominant image shift coarse-to-fine
+                               // (image_motion.h) and match again around it
+  ImageShiftOptions image_shift = DefaultTrackingImageShiftOptions();  // the coarse-to-fine
+                                                                       // estimate
+  double shift_radius_scale = 2.0;  // the matcher's position gates are widened by this around
+                                    // a shift estimate (a global shift ignores parallax),
+                                    // in [0.05, 20]
+  int confident_min_inliers = 30;   // a first pass with fewer RANSAC inliers than this ...
+  double confident_inlier_fraction = 0.2;  // ... or than this fraction of the smaller feature
+                                           // count of the two frames, in [0, 1], is not
+                                           // confident: the coarse-to-fine pass is tried too
+                                           // and the one with more inliers is kept
+  bool guided_rematch = true;              // after RANSAC, predict every reference feature with the
+                               // estimated motion and match again in a tight window; the
+                               // second pass is kept when it has at least as many inliers
+  double guided_radius_scale = 0.3;       // gate scale of that pass (σ 10 px → 3 px), [0.05, 20]
+  bool rotation_from_shift = true;        // a frame without a measured motion (too few features, no
+                                          // consensus) takes the prior's motion corrected by the
+                                          // image shift from the previous frame (the rotation that
+                                          // explains the shift left after the prior, see
+                                          // CorrectPriorWithImageShift), when that shift is found
+  double rotation_min_shift_score = 0.6;  // ... with at least this ZNCC, in [-1, 1]
+  int reliable_min_inliers = 30;          // only a motion with at least this many inliers (and an
+                                          // accepted bundle adjustment, when it runs) updates the
+                                          // constant-velocity prior, >= 3; = confident_min_inliers:
+                                          // a motion the matcher trusts is one the prior may repeat
+
+  bool IsValid(std::string* error) const;
+};
+
+// An external motion prior for one frame (wheel odometry, a gyro, an IMU preintegration): the
+// camera's motion since the previous Process call, p_prev = T_prev_curr * p_curr (cam0 frames).
+// It replaces the constant-velocity prediction for that frame: it centres the matcher's search,
+// it is the pose of a lost frame, and it is what the RANSAC motion is blended with.
+struct MotionPrior {
+  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
+};
+
 struct OdometryOptions {
   DetectorOptions detector = DefaultOdometryDetectorOptions();  // feature detection (left)
-  DisparityOptions disparity = DefaultOdometryDisparityOptions();  // dense disparity;
-                                       // num_disparities is replaced by the value
-                                       // derived from the camera when derive_num_disparities
-  bool derive_num_disparities = true;  // search range from the camera: the smallest multiple
+  DisparityOptions disparity =
+      DefaultOdometryDisparityOptions();  // dense disparity;
+                                          // num_disparities is replaced by the value
+                                          // derived from the camera when derive_num_disparities
+  bool derive_num_disparities = true;     // search range from the camera: the smallest multiple
                                        // of 16 >= fx · baseline / disparity_min_depth_m, clamped
                                        // to [16, max_num_disparities] (and < image width)
   double disparity_min_depth_m = 0.7;  // nearest depth the derived search range covers (metres),
@@ -138,9 +215,13 @@ struct OdometryOptions {
                           // overexposed frame), >= 3
   int min_inliers = 12;   // fewer RANSAC inliers than this → lost, >= 3 (RANSAC's own
                           // min_inliers is raised to this when lower)
-  int reinit_after_lost_frames = 1;  // while this many consecutive frames (or more) have been
-                                     // lost, a frame whose motion fails against the reference
-                                     // re-initialises the pipeline on itself, >= 1
+  int reinit_after_lost_frames = 10;  // while this many consecutive frames (or more) have been
+                                      // lost, a frame whose motion fails against the reference
+                                      // re-initialises the pipeline on itself, >= 1. Before
+                                      // that, each new frame is matched against the last good
+                                      // frame (wide, coarse-to-fine search), so the motion
+                                      // across the gap is measured, not extrapolated
+  RobustTrackingOptions tracking;     // predicted matching, coarse-to-fine search, guided pass
 
   bool IsValid(std::string* error) const;
 };
@@ -165,8 +246,20 @@ struct StageTimes {
   double motion_ms = 0.0;       // correspondences + RANSAC + tracks + initial-pose blend
   double ba_ms = 0.0;           // window problem + bundle adjustment
   double orientation_ms = 0.0;  // first frame only: plane-based initial orientation
+  double predict_ms = 0.0;      // predicted positions + coarse-to-fine image shift (when run)
+  double guided_ms = 0.0;       // guided second pass: re-match + RANSAC
   double total_ms = 0.0;        // the whole Process / ProcessFeatures call
 };
+
+// What centred the matcher's search for the matches that were used.
+enum class PredictionSource {
+  kNone,         // previous positions (matcher.prediction: none, or no motion known yet)
+  kMotionPrior,  // the motion prior (constant velocity or the caller's MotionPrior)
+  kImageShift,   // previous positions + the coarse-to-fine image shift
+  kGuided,       // the estimated motion of this frame (guided second pass)
+};
+// "none", "motion_prior", "image_shift", "guided".
+const char* ToString(PredictionSource source);
 
 struct OdometryResult {
   TrackingStatus status = TrackingStatus::kLost;
@@ -189,10 +282,47 @@ struct OdometryResult {
   int ba_num_frames = 0;             // poses in the BA window (when ba_ran)
   int ba_num_points = 0;             // points optimised (when ba_ran)
   int reference_frame_index = -1;    // frame_index of the frame matched against; -1 = none
+  bool motion_measured = false;      // T_prev_curr was measured by matching (kTracking or a
+                                     // kRecovered frame matched across the gap); false for the
+                                     // first frame, lost frames and re-initialisations (their
+                                     // pose is the prior's prediction)
+  bool reinitialised = false;        // the pipeline restarted on this frame after a loss
+  bool rotation_from_shift = false;  // lost or re-initialised, its pose is the prior corrected
+                                     // by the image shift from the previous frame
+  PredictionSource prediction = PredictionSource::kNone;  // centre of the used matches' search
+  bool image_shift_ok = false;  // the coarse-to-fine image shift ran and found a shift
+  Eigen::Vector2d image_shift_px = Eigen::Vector2d::Zero();  // that shift (pixels), when ok
+  int num_first_pass_inliers = 0;  // inliers of the first (prior-centred) pass, before the
+                                   // coarse-to-fine and guided passes
   StageTimes times;
   bool initial_orientation_ok = false;  // first frame only: the hallway orientation was found
                                         // and defines the world frame
 };
+
+// Where each reference feature's 3D point (p_cam0, from its disparity) appears in the current
+// left image when the camera moved by T_ref_curr (p_ref = T_ref_curr * p_curr): the predicted
+// centre of the matcher's search. NaN for features without depth or behind the camera
+// (z <= min_depth_m).
+std::vector<Eigen::Vector2d> PredictFeaturePositions(const StereoCamera& camera,
+                                                     const std::vector<Feature>& features,
+                                                     const Eigen::Isometry3d& T_ref_curr,
+                                                     double min_depth_m);
+
+// The prior's frame-to-frame motion T_prev_curr_prior corrected by a measured image shift
+// (image_motion.h: curr(x + shift) ≈ prev(x)): the shift the prior predicts for the image
+// centre at depth_m (metres; <= 0 or non-finite = infinitely far, rotation only) is subtracted,
+// and the rest is explained by a rotation of the current camera about its centre (pan/tilt, no
+// roll). Exact for the image centre; used to bridge frames whose features are too few for a
+// motion (a plain wall in front of a turning robot).
+Eigen::Isometry3d CorrectPriorWithImageShift(const StereoCamera& camera,
+                                             const Eigen::Isometry3d& T_prev_curr_prior,
+                                             const Eigen::Vector2d& shift_px, double depth_m);
+
+// A frame without a measured motion: lost, or re-initialised at the predicted pose (what
+// `lost_frames` counts). The first frame (kInitializing) has nothing to measure and is not.
+inline bool IsLostFrame(const OdometryResult& r) {
+  return !r.motion_measured && r.status != TrackingStatus::kInitializing;
+}
 
 class StereoOdometry {
  public:
@@ -210,7 +340,10 @@ class StereoOdometry {
 
   // One rectified stereo pair: left/right CV_8UC1 of the camera's size. time_s: the frame's
   // time stamp (seconds), recorded only. Never throws; bad input gives kLost.
-  OdometryResult Process(const cv::Mat& left, const cv::Mat& right, double time_s);
+  // `prior` (optional): the camera motion since the previous call from another sensor; null =
+  // the constant-velocity prediction.
+  OdometryResult Process(const cv::Mat& left, const cv::Mat& right, double time_s,
+                         const MotionPrior* prior = nullptr);
 
   // The seam (libviso2's process(matches)): runs the back end (RANSAC, tracks, blend, BA) on
   // externally supplied left-image features and matches, skipping disparity, detection and
@@ -253,14 +386,45 @@ class StereoOdometry {
 
   using TimePoint = std::chrono::steady_clock::time_point;
 
+  // One matching pass and its RANSAC motion.
+  struct MotionAttempt {
+    std::vector<Match> matches;
+    std::vector<int> match_index;  // correspondence → index into matches
+    std::vector<StereoCorrespondence> correspondences;
+    RansacResult ransac;
+    PredictionSource source = PredictionSource::kNone;
+    int inliers() const { return ransac.ok() ? ransac.num_inliers : 0; }
+  };
+  // RANSAC on the matches (both features with depth), seeded by track ages.
+  MotionAttempt EstimateMotion(const std::vector<Feature>& ref_features,
+                               const std::vector<Feature>& curr_features,
+                               std::vector<Match> matches, PredictionSource source) const;
+  // Matches `frame` against the reference with the prediction passes (see the header
+  // comment); fills the prediction fields and times of `result`.
+  // T_ref_curr_prior: the prior's motion from the reference to `frame` (null = none known).
+  MotionAttempt MatchAndEstimate(const MatchFrame& frame, const Eigen::Isometry3d* T_ref_curr_prior,
+                                 OdometryResult* result, std::string* matcher_error);
+  // Positions of the reference features in the current image under T_ref_curr (NaN where a
+  // point falls behind the camera or has no depth).
+  std::vector<Eigen::Vector2d> PredictPositions(const Eigen::Isometry3d& T_ref_curr) const;
+  // The predicted T_world_cam0 of the newest frame: the previous output moved by the prior.
+  Eigen::Isometry3d PredictedPose(const MotionPrior* prior) const;
+  // The pose of a frame without a measured motion: the predicted pose, corrected by the image
+  // shift from the previous frame where it is found (sets result->rotation_from_shift).
+  Eigen::Isometry3d BridgedPose(const MotionPrior* prior, OdometryResult* result);
+
   // A lost frame: pose = constant-velocity prediction, reference and tracks kept.
-  OdometryResult Lost(OdometryResult result, const std::string& message, TimePoint start);
+  OdometryResult Lost(OdometryResult result, const std::string& message, TimePoint start,
+                      const MotionPrior* prior = nullptr);
   // (Re-)initialises on `frame`: first time at the initial orientation, later at the predicted
   // pose (kRecovered). `reason` goes into the message.
   OdometryResult Initialise(OdometryResult result, MatchFrame frame, const std::string& reason,
-                            TimePoint start);
+                            TimePoint start, const MotionPrior* prior = nullptr);
   // Everything after matching: RANSAC, tracks, blend, BA. `result` carries the counts so far.
-  OdometryResult Track(OdometryResult result, MatchFrame frame, const std::vector<Match>& matches,
+  // T_ref_curr_prior: the prior's motion from the reference to this frame (null = none), the
+  // blend's partner; `prior`: the caller's prior (for the pose of a lost frame), may be null.
+  OdometryResult Track(OdometryResult result, MatchFrame frame, MotionAttempt attempt,
+                       const Eigen::Isometry3d* T_ref_curr_prior, const MotionPrior* prior,
                        TimePoint start);
   // Sets the output pose (finite), T_prev_curr and the total time.
   OdometryResult Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
@@ -284,6 +448,7 @@ class StereoOdometry {
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();      // constant-velocity model: last
                                                                 // estimated per-frame T_prev_curr
   bool has_velocity_ = false;
+  int64_t velocity_frame_index_ = -1;  // frame whose reliable motion set velocity_
 
   Eigen::Matrix3d R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   PlaneOrientationResult orientation_result_;
@@ -291,6 +456,9 @@ class StereoOdometry {
   std::vector<Match> last_matches_;
   std::vector<bool> last_inlier_mask_;
   std::vector<Feature> last_reference_features_;
+  cv::Mat current_left_;           // this call's left image (for the image shift of a lost frame)
+  double current_depth_m_ = -1.0;  // median depth of this call's features (metres), -1 = none
+  cv::Mat previous_left_;          // the previous call's left image (empty after ProcessFeatures)
   std::vector<int> prev_call_index_map_;  // ProcessFeatures: given index → kept index of the
                                           // previous call's features (empty when unusable)
 };

@@ -61,8 +61,9 @@ SiftRatioMatcher::SiftRatioMatcher(const Options& options) : options_(options) {
   }
 }
 
-std::vector<Match> SiftRatioMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                                 MatcherSummary* summary) {
+std::vector<Match> SiftRatioMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                                             const MatchPrediction& prediction,
+                                             MatcherSummary* summary) {
   MatcherSummary local;
   MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (s.num_prev == 0 || s.num_curr == 0) return {};
@@ -89,9 +90,11 @@ std::vector<Match> SiftRatioMatcher::MatchFrames(const MatchFrame& prev, const M
     of_curr[j].Offer(i, d);
   };
   if (options_.search_radius_px > 0.0) {
-    const PointGrid grid(FeaturePositions(curr.features), options_.search_radius_px);
+    // Around the predicted position (the previous one without a prediction).
+    const double radius = options_.search_radius_px * prediction.radius_scale;
+    const PointGrid grid(FeaturePositions(curr.features), radius);
     for (int i = 0; i < s.num_prev; ++i) {
-      grid.ForEachWithin(prev.features[i].uv_px, options_.search_radius_px,
+      grid.ForEachWithin(prediction.Centre(i, prev.features[i].uv_px), radius,
                          [&](int j, double) { offer(i, j); });
     }
   } else {

@@ -22,9 +22,11 @@ class SiftRatioMatcher : public FrameMatcher {
   // Options must be valid (CreateFrameMatcher checks them).
   explicit SiftRatioMatcher(const Options& options);
 
-  std::vector<Match> MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                 MatcherSummary* summary = nullptr) override;
   MatcherType type() const override { return MatcherType::kSiftRatio; }
+
+ protected:
+  std::vector<Match> DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                             const MatchPrediction& prediction, MatcherSummary* summary) override;
 
  private:
   Options options_;

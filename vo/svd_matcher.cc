@@ -267,8 +267,8 @@ MatcherType SvdMatcher::type() const {
   return MatcherType::kSvdNccGabor;
 }
 
-std::vector<Match> SvdMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                           MatcherSummary* summary) {
+std::vector<Match> SvdMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                                       const MatchPrediction& prediction, MatcherSummary* summary) {
   MatcherSummary local;
   MatcherSummary& s = StartSummary(prev, curr, summary, &local);
   if (s.num_prev == 0 || s.num_curr == 0) return {};
@@ -290,7 +290,10 @@ std::vector<Match> SvdMatcher::MatchFrames(const MatchFrame& prev, const MatchFr
   s.cue_time_ms = MsSince(t0);
   t0 = std::chrono::steady_clock::now();
 
-  const double inv_two_sigma2 = 1.0 / (2.0 * options_.sigma_px * options_.sigma_px);
+  // The proximity term and the candidate radius are centred on the predicted position of each
+  // previous feature (its previous position without a prediction), σ scaled with the gate.
+  const double sigma = options_.sigma_px * prediction.radius_scale;
+  const double inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
   const double min_phase_similarity =
       use_gabor ? std::exp(-bank_->options().phase_exponent * options_.max_phase_diff_rad) : 0.0;
   // G_ij of one pair: proximity × C_ij (eq. (1)) × S_ij (eq. (5)); stops early (returns 0)
@@ -322,8 +325,10 @@ std::vector<Match> SvdMatcher::MatchFrames(const MatchFrame& prev, const MatchFr
     for (int i = 0; i < s.num_prev; ++i) {
       for (int j = 0; j < s.num_curr; ++j) {
         bool ok = true;
-        G(i, j) =
-            weight(i, j, (prev.features[i].uv_px - curr.features[j].uv_px).squaredNorm(), 0.0, &ok);
+        G(i, j) = weight(
+            i, j,
+            (prediction.Centre(i, prev.features[i].uv_px) - curr.features[j].uv_px).squaredNorm(),
+            0.0, &ok);
         acceptable(i, j) = ok ? 1 : 0;
       }
     }
@@ -333,17 +338,19 @@ std::vector<Match> SvdMatcher::MatchFrames(const MatchFrame& prev, const MatchFr
     matches = SvdPairDense(G, options_, &acceptable);
   } else {
     // Step 1: candidates within the cutoff radius, from a grid over the current features.
-    const double radius = options_.cutoff_sigmas * options_.sigma_px;
+    const double radius = options_.cutoff_sigmas * sigma;
     const PointGrid grid(FeaturePositions(curr.features), radius);
     std::vector<SvdEntry> entries;
     entries.reserve(static_cast<size_t>(s.num_prev) * 8);
     for (int i = 0; i < s.num_prev; ++i) {
-      grid.ForEachWithin(prev.features[i].uv_px, radius, [&](int j, double d2) {
-        ++s.num_candidates;
-        bool ok = true;
-        const double g = weight(i, j, d2, options_.min_entry, &ok);
-        if (g > 0.0 && g >= options_.min_entry) entries.push_back(SvdEntry{i, j, g, ok});
-      });
+      grid.ForEachWithin(prediction.Centre(i, prev.features[i].uv_px), radius,
+                         [&](int j, double d2) {
+                           ++s.num_candidates;
+                           bool ok = true;
+                           const double g = weight(i, j, d2, options_.min_entry, &ok);
+                           if (g > 0.0 && g >= options_.min_entry)
+                             entries.push_back(SvdEntry{i, j, g, ok});
+                         });
     }
     matches = SvdPairSparse(s.num_prev, s.num_curr, std::move(entries), options_, &s);
   }

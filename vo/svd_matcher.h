@@ -72,12 +72,14 @@ class SvdMatcher : public FrameMatcher {
   SvdMatcher(const Options& options, Cues cues, const NccOptions& ncc = NccOptions(),
              const GaborOptions& gabor = GaborOptions());
 
-  std::vector<Match> MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
-                                 MatcherSummary* summary = nullptr) override;
   MatcherType type() const override;
 
   const Options& options() const { return options_; }
   Cues cues() const { return cues_; }
+
+ protected:
+  std::vector<Match> DoMatch(const MatchFrame& prev, const MatchFrame& curr,
+                             const MatchPrediction& prediction, MatcherSummary* summary) override;
 
  private:
   Options options_;

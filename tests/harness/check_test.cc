@@ -223,11 +223,13 @@ TEST(CheckCommandTest, PassesOnItsOwnBaselineAndCatchesADegradedConfiguration) {
   EXPECT_EQ(pass.output.find("WORSE"), std::string::npos) << pass.output;
   EXPECT_NE(pass.output.find("+0.0000"), std::string::npos) << pass.output;
 
-  // Deliberately degraded: no bundle adjustment and the plain NCC matcher. The end-pose error
-  // about doubles on both scenes (corner 0.028 -> 0.056 m, corridor 0.050 -> 0.096 m), far
-  // beyond the tolerances (0.010 and 0.012 m).
-  const auto degraded =
-      RunVobench("check --set use_bundle_adjustment=false --set matcher.type=ncc_mutual" + common);
+  // Deliberately degraded: no bundle adjustment, the plain NCC matcher and no prediction
+  // (the predicted, guided matching made plain NCC without BA almost as accurate in position
+  // on the corner, so the end-pose error alone no longer shows it): some metric of each run
+  // gets worse than its tolerance.
+  const auto degraded = RunVobench(
+      "check --set use_bundle_adjustment=false --set matcher.type=ncc_mutual"
+      " --set matcher.prediction=none" + common);
   EXPECT_EQ(degraded.exit_code, 1) << degraded.output;
   EXPECT_NE(degraded.output.find("FAILED"), std::string::npos) << degraded.output;
   const std::string moved = degraded.output.substr(degraded.output.find("what moved:"));
@@ -235,9 +237,7 @@ TEST(CheckCommandTest, PassesOnItsOwnBaselineAndCatchesADegradedConfiguration) {
     bool end_pose_worse = false;
     std::istringstream lines(moved);
     for (std::string line; std::getline(lines, line);)
-      end_pose_worse |= line.find(run) != std::string::npos &&
-                        line.find("end_pose_error_m") != std::string::npos &&
-                        line.find("WORSE") != std::string::npos;
+      end_pose_worse |= line.find(run) != std::string::npos && line.find("WORSE") != std::string::npos;
     EXPECT_TRUE(end_pose_worse) << run << "\n" << degraded.output;
   }
   EXPECT_NE(ReadAll(dir / "out/check.md").find("WORSE"), std::string::npos);

@@ -233,6 +233,51 @@ INSTANTIATE_TEST_SUITE_P(
       return std::string(ToString(info.param.type));
     });
 
+// A 60 px motion (beyond every position gate) with the exact prediction of each previous
+// feature's position: every position-gated matcher recovers the matches around it, and none
+// does without it. A prediction of the wrong size is refused.
+TEST(MatcherPredictionTest, PredictedCentreRecoversALargeMotion) {
+  Motion large;
+  large.tx_px = 60.0;
+  large.ty_px = 8.0;
+  large.rot_deg = 1.0;
+  Scene s = MakeScene(large, false);
+  ASSERT_GT(s.possible, 60);
+  MatchPrediction exact;
+  for (const Feature& f : s.prev.features) exact.uv_px.push_back(Apply(s.A, f.uv_px));
+  for (MatcherType type : {MatcherType::kSvdNcc, MatcherType::kSvdNccGabor, MatcherType::kNccMutual,
+                           MatcherType::kKalman, MatcherType::kLucasKanade}) {
+    MatcherOptions options;
+    options.type = type;
+    MatcherSummary summary;
+    const std::vector<Match> without = CreateFrameMatcher(options)->MatchFrames(s.prev, s.curr);
+    const std::vector<Match> with =
+        CreateFrameMatcher(options)->MatchFrames(s.prev, s.curr, exact, &summary);
+    ASSERT_TRUE(summary.ok) << ToString(type) << ": " << summary.message;
+    const int correct = CountCorrect(s, with);
+    EXPECT_GE(correct, 0.7 * s.possible) << ToString(type);
+    EXPECT_GE(correct, 0.95 * with.size()) << ToString(type);
+    // Pyramidal LK and the Kalman tracker (15 px/frame velocity prior) reach some of it alone.
+    if (type != MatcherType::kLucasKanade && type != MatcherType::kKalman) {
+      EXPECT_LT(CountCorrect(s, without), 0.2 * s.possible) << ToString(type);
+    }
+    EXPECT_TRUE(IsOneToOne(with)) << ToString(type);
+  }
+  MatchPrediction wrong;
+  wrong.uv_px.resize(3);
+  MatcherSummary summary;
+  EXPECT_TRUE(
+      CreateFrameMatcher(MatcherOptions())->MatchFrames(s.prev, s.curr, wrong, &summary).empty());
+  EXPECT_FALSE(summary.ok);
+  EXPECT_NE(summary.message.find("prediction"), std::string::npos);
+  MatchPrediction bad_scale = exact;
+  bad_scale.radius_scale = 0.0;
+  EXPECT_TRUE(CreateFrameMatcher(MatcherOptions())
+                  ->MatchFrames(s.prev, s.curr, bad_scale, &summary)
+                  .empty());
+  EXPECT_FALSE(summary.ok);
+}
+
 TEST(MatcherFactoryTest, NamesRoundTripAndInvalidOptionsGiveNull) {
   for (MatcherType t : {MatcherType::kSvdProximity, MatcherType::kSvdNcc, MatcherType::kSvdNccGabor,
                         MatcherType::kNccMutual, MatcherType::kLucasKanade, MatcherType::kKalman,

@@ -545,6 +545,187 @@ TEST(OdometryLostTest, SeveralBlackFramesAreBridged) {
               IsNearPose(TrueMotionFromFirst(11), 1.0 * kDeg, 0.03));
 }
 
+// ---- (3b) Predicted matching, coarse-to-fine search, counting --------------------------------
+
+// A turn in place with a stop: 1 cm per frame forward, no rotation for frames 1-2, then 7° per
+// frame (about 28 px of image motion, beyond the paper's σ = 10 px gate) for frames 3-7, then
+// none. Frames 7 and 8 are black in the test below, so the constant-velocity prior (7° per
+// frame) predicts 21° from frame 6 to frame 9 where the truth is 7°.
+Eigen::Isometry3d TurnPose(int i) {
+  double yaw = 0.0;
+  Eigen::Vector3d t(0.0, 0.2, 1.0);
+  for (int k = 1; k <= i; ++k) {
+    if (k >= 3 && k <= 7) yaw += 7.0 * kDeg;
+    t += 0.01 * Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0);
+  }
+  return MakePose(R_hall_cam(yaw), t);
+}
+
+std::vector<OdometryResult> RunTurn(const OdometryOptions& options, const std::vector<int>& black) {
+  static const std::vector<StereoFrame> frames = [] {
+    const CorridorRenderer renderer;
+    std::vector<StereoFrame> out(12);
+    for (int i = 0; i < 12; ++i) {
+      renderer.Render(HallwayCamera(), TurnPose(i), &out[i].left, &out[i].right);
+    }
+    return out;
+  }();
+  StereoOdometry vo(HallwayCamera(), options);
+  std::vector<OdometryResult> results;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const bool is_black = std::find(black.begin(), black.end(), static_cast<int>(i)) != black.end();
+    const cv::Mat zeros = cv::Mat::zeros(frames[i].left.size(), CV_8UC1);
+    results.push_back(is_black ? vo.Process(zeros, zeros, 0.1 * i)
+                               : vo.Process(frames[i].left, frames[i].right, 0.1 * i));
+  }
+  return results;
+}
+
+Eigen::Isometry3d TrueTurnMotion(int a, int b) { return TurnPose(a).inverse() * TurnPose(b); }
+Eigen::Isometry3d EstimatedMotion(const std::vector<OdometryResult>& r, int a, int b) {
+  return r[a].T_world_cam0.inverse() * r[b].T_world_cam0;
+}
+
+TEST(OdometryPredictionTest, FastTurnIsTrackedAndAGapIsMeasuredNotExtrapolated) {
+  const std::vector<OdometryResult> r = RunTurn(OdometryOptions(), {7, 8});
+  for (int i = 1; i <= 6; ++i) {
+    EXPECT_TRUE(r[i].motion_measured)
+        << i << ": " << r[i].message << " shift ok " << r[i].image_shift_ok << " "
+        << r[i].image_shift_px.transpose() << " feats " << r[i].num_features_with_depth << " first "
+        << r[i].num_first_pass_inliers;
+    EXPECT_THAT(EstimatedMotion(r, i - 1, i),
+                IsNearPose(TrueTurnMotion(i - 1, i), 0.3 * kDeg, 0.01))
+        << i;
+  }
+  for (int i : {7, 8}) {
+    EXPECT_EQ(r[i].status, TrackingStatus::kLost);
+    EXPECT_TRUE(IsLostFrame(r[i]));
+  }
+  // Frame 9 is matched against frame 6, the last good one: the motion across the gap (7°) is
+  // measured, although the prior said 21°.
+  EXPECT_EQ(r[9].status, TrackingStatus::kRecovered) << r[9].message;
+  EXPECT_TRUE(r[9].motion_measured);
+  EXPECT_FALSE(r[9].reinitialised);
+  EXPECT_EQ(r[9].reference_frame_index, 6);
+  EXPECT_THAT(EstimatedMotion(r, 6, 9), IsNearPose(TrueTurnMotion(6, 9), 0.3 * kDeg, 0.01));
+  EXPECT_THAT(EstimatedMotion(r, 0, 11), IsNearPose(TrueTurnMotion(0, 11), 0.5 * kDeg, 0.02));
+  int lost = 0, reinit = 0;
+  for (const OdometryResult& x : r) {
+    lost += IsLostFrame(x) ? 1 : 0;
+    reinit += x.reinitialised ? 1 : 0;
+  }
+  EXPECT_EQ(lost, 2);
+  EXPECT_EQ(reinit, 0);
+}
+
+TEST(OdometryPredictionTest, ThePapersUnpredictedFormLosesTheFastTurn) {
+  // The same frames without prediction (matcher.prediction: none): 28 px per frame is beyond
+  // the σ = 10 px proximity gate, so the turn is not measured (the failure the prediction fixes).
+  OdometryOptions options;
+  options.matcher.prediction = PredictionMode::kNone;
+  const std::vector<OdometryResult> r = RunTurn(options, {});
+  int lost = 0;
+  for (const OdometryResult& x : r) lost += IsLostFrame(x) ? 1 : 0;
+  EXPECT_GE(lost, 1);
+  EXPECT_THAT(EstimatedMotion(r, 0, 11),
+              ::testing::Not(IsNearPose(TrueTurnMotion(0, 11), 0.5 * kDeg, 0.02)));
+}
+
+TEST(OdometryPredictionTest, LostFramesAndReinitialisationsAreCountedExactly) {
+  // Black frames 4-6 in the corridor: three frames without a measured motion, frame 7 measured
+  // across the gap, no re-initialisation.
+  const std::vector<OdometryResult> r = RunCorridor(OdometryOptions(), {4, 5, 6});
+  std::vector<int> lost;
+  for (const OdometryResult& x : r) {
+    if (IsLostFrame(x)) lost.push_back(static_cast<int>(x.frame_index));
+    EXPECT_FALSE(x.reinitialised) << x.frame_index;
+  }
+  EXPECT_EQ(lost, (std::vector<int>{4, 5, 6}));
+  EXPECT_FALSE(IsLostFrame(r[0]));  // the first frame has nothing to measure
+  EXPECT_TRUE(r[7].motion_measured);
+
+  // The seam: a lost frame, then matches to it (unusable) re-initialise: two frames without a
+  // measured motion, one of them a re-initialisation.
+  const StereoCamera cam = HallwayCamera();
+  OdometryOptions options;
+  options.estimate_initial_orientation = false;
+  StereoOdometry vo(cam, options);
+  const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  std::vector<SeamFrame> frames;
+  for (int i = 0; i < 5; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
+  std::vector<OdometryResult> s;
+  s.push_back(vo.ProcessFeatures(frames[0].features, {}, 0.0));
+  s.push_back(vo.ProcessFeatures(frames[1].features, SeamMatches(frames[0], frames[1], 0), 0.1));
+  std::vector<Match> few = SeamMatches(frames[1], frames[2], 0);
+  few.resize(5);
+  s.push_back(vo.ProcessFeatures(frames[2].features, few, 0.2));
+  s.push_back(vo.ProcessFeatures(frames[3].features, SeamMatches(frames[2], frames[3], 0), 0.3));
+  s.push_back(vo.ProcessFeatures(frames[4].features, SeamMatches(frames[3], frames[4], 0), 0.4));
+  const std::vector<bool> expect_lost = {false, false, true, true, false};
+  const std::vector<bool> expect_reinit = {false, false, false, true, false};
+  for (size_t i = 0; i < s.size(); ++i) {
+    EXPECT_EQ(IsLostFrame(s[i]), expect_lost[i]) << i << ": " << s[i].message;
+    EXPECT_EQ(s[i].reinitialised, expect_reinit[i]) << i;
+  }
+}
+
+TEST(OdometryPredictionTest, PredictionPutsFeaturesWhereTheSceneSaysTheyGo) {
+  // Frame 0's features with depth from the stereo pair, predicted into frame 3 (12 cm, 3°) with
+  // the true motion, against the exact projection of the surface point (ray-cast depth).
+  const StereoCamera cam = HallwayCamera();
+  const CorridorRenderer renderer;
+  const StereoFrame& f0 = CorridorSequence()[0];
+  const OdometryOptions defaults;
+  DisparityOptions disparity_options = defaults.disparity;
+  disparity_options.num_disparities = 32;
+  DisparityEstimator disparity(disparity_options);
+  const DisparityResult d = disparity.Compute(f0.left, f0.right);
+  ASSERT_TRUE(d.ok) << d.message;
+  std::vector<Feature> features = CreateFeatureDetector(defaults.detector)->Detect(f0.left);
+  AttachDepth(d.disparity_px, cam, &features, defaults.depth);
+  const Eigen::Isometry3d T_0_3 = TrueMotionFromFirst(3);
+  const std::vector<Eigen::Vector2d> predicted =
+      PredictFeaturePositions(cam, features, T_0_3, 1e-3);
+  ASSERT_EQ(predicted.size(), features.size());
+  std::vector<double> errors;
+  for (size_t i = 0; i < features.size(); ++i) {
+    if (!features[i].has_depth()) {
+      EXPECT_FALSE(predicted[i].allFinite());
+      continue;
+    }
+    const Eigen::Vector2d& uv = features[i].uv_px;
+    const double z = renderer.DepthAt(cam, CorridorPose(0), uv.x(), uv.y());
+    Eigen::Vector2d truth;
+    ASSERT_TRUE(cam.ProjectLeft(T_0_3.inverse() * cam.BackprojectDepth(uv.x(), uv.y(), z), &truth));
+    errors.push_back((predicted[i] - truth).norm());
+  }
+  ASSERT_GT(errors.size(), 100u);
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.3);       // median: sub-pixel
+  EXPECT_LT(errors[errors.size() * 9 / 10], 1.0);  // 90 %
+}
+
+TEST(OdometryPredictionTest, ImageShiftCorrectionRecoversAPan) {
+  // The prior knows the translation but not the pan; the image shift of the centre point (at
+  // 2 m) under the true motion gives back the true rotation.
+  const StereoCamera cam = HallwayCamera();
+  for (double yaw_deg : {-6.0, -1.0, 0.5, 4.0}) {
+    const Eigen::Isometry3d T_true =
+        MakePose(Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                 Eigen::Vector3d(0.02, 0.0, 0.04));
+    const double depth_m = 2.0;
+    const Eigen::Vector3d p_curr = T_true.inverse() * Eigen::Vector3d(0.0, 0.0, depth_m);
+    const Eigen::Vector2d shift(cam.fx_px * p_curr.x() / p_curr.z(),
+                                cam.fy_px * p_curr.y() / p_curr.z());
+    const Eigen::Isometry3d T_prior = MakePose(Eigen::Matrix3d::Identity(), T_true.translation());
+    const Eigen::Isometry3d T = CorrectPriorWithImageShift(cam, T_prior, shift, depth_m);
+    EXPECT_THAT(T, IsNearPose(T_true, 1e-9, 1e-12)) << yaw_deg;
+    // Without the depth (far away), the translation's parallax is taken as rotation.
+    const Eigen::Isometry3d T_far = CorrectPriorWithImageShift(cam, T_prior, shift, -1.0);
+    EXPECT_GT(RotationAngleRad(T_far.linear(), T_true.linear()), 1e-3) << yaw_deg;
+  }
+}
+
 // ---- (4) Invalid input -----------------------------------------------------------------------
 
 TEST(OdometryLostTest, InvalidInputIsLostWithAMessage) {

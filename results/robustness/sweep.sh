@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Robustness sweep of issue #9, the figures in results/robustness/summary.md: l_hallway with
+# texture seeds 1-10 (only textures.seed changed) x frame strides 1, 2, 3, 5 (and 8 on seed 7)
+# x four VO configurations, plus camera.pitch_deg 10 and a 640x480 camera (same field of view).
+# Each hallway is rendered once (vobench render, KITTI layout) and every run reads the same
+# frames (vobench run --dataset --stride), which gives the same trajectories as simulating each
+# run anew (suites/robustness.yaml) at a tenth of the time.
+#   results/robustness/sweep.sh [WORK_DIR]      # default /tmp/vobench_robustness; ~40 min at -j2
+#   CONFIGS="default paper" results/robustness/sweep.sh   # a subset of the configurations
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+ROOT=$(pwd)
+BIN="$ROOT/build/vobench"
+WORK="${1:-/tmp/vobench_robustness}"
+JOBS="${JOBS:-2}"
+mkdir -p "$WORK"
+[ -x "$BIN" ] || { echo "sweep: build first (./setup.sh)"; exit 1; }
+
+# Scenario variants of scenes/l_hallway.yaml (scene path made absolute).
+variant() {  # name sed-expression
+  sed -e "s|^name: l_hallway|name: $1|" -e "s|^scene: hallway_l.xml|scene: $ROOT/scenes/hallway_l.xml|" \
+      -e "$2" scenes/l_hallway.yaml > "$WORK/$1.yaml"
+}
+datasets=()
+for s in 1 2 3 4 5 6 7 8 9 10; do variant "seed$s" "s|^  seed: 7 |  seed: $s |"; datasets+=("seed$s"); done
+variant pitch10 "s|^  pitch_deg: 0 |  pitch_deg: 10 |"; datasets+=(pitch10)
+variant vga "s|^  width: 320|  width: 640|;s|^  height: 240|  height: 480|"; datasets+=(vga)
+printf '%s\n' "${datasets[@]}" | xargs -P "$JOBS" -I{} bash -c \
+  '[ -d "'"$WORK"'/ds_{}" ] || "'"$BIN"'" render "'"$WORK"'/{}.yaml" --out "'"$WORK"'/ds_{}" -q > /dev/null'
+
+# VO configurations (partial VO YAMLs over the defaults).
+printf 'matcher:\n  type: svd_ncc_gabor\n' > "$WORK/default.yaml"
+printf 'matcher:\n  type: svd_ncc_gabor\n  prediction: none\nreinit_after_lost_frames: 1\n' > "$WORK/paper.yaml"
+printf 'matcher:\n  type: lucas_kanade\n' > "$WORK/lucas_kanade.yaml"
+printf 'matcher:\n  type: ncc_mutual\n' > "$WORK/ncc_mutual.yaml"
+runs=()
+for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual}; do
+  for s in 1 2 3 4 5 6 7 8 9 10; do for k in 1 2 3 5; do runs+=("seed$s $k $c"); done; done
+  runs+=("seed7 8 $c" "pitch10 1 $c" "vga 1 $c")
+done
+printf '%s\n' "${runs[@]}" | xargs -P "$JOBS" -L1 bash -c \
+  'out="'"$WORK"'/runs/$0_s$1_$2"; [ -f "$out/metrics.json" ] || "'"$BIN"'" run --dataset "'"$WORK"'/ds_$0" --stride $1 --config "'"$WORK"'/$2.yaml" --out "$out" --no-plots -q > /dev/null'
+/usr/bin/python3 results/robustness/summarize.py "$WORK/runs" results/robustness
