@@ -134,6 +134,7 @@ bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::Ste
         // The same prediction for every matcher: constant velocity from the previous pair.
         vo::MatchPrediction prediction;
         if (o.prediction == vo::PredictionMode::kMotionPrior && k >= static_cast<size_t>(s)) {
+          prediction.radius_scale = o.prediction_radius_scale;
           const Eigen::Isometry3d T_curr_ref =
               (frames[k - s].T_world_cam0.inverse() * frames[k].T_world_cam0).inverse();
           for (const vo::Feature& f : a.frame.features) {

@@ -14,17 +14,17 @@
 // stereo disparity (features without depth are dropped, as in the paper).
 #pragma once
 
+#include <Eigen/Geometry>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
-#include <opencv2/core.hpp>
 
 #include "vo/camera.h"
 #include "vo/disparity.h"
 #include "vo/features.h"
 #include "vo/matcher.h"
+#include "vo/odometry.h"
 
 namespace harness {
 
@@ -37,23 +37,27 @@ struct GroundTruthFrame {
 
 struct MatchEvalOptions {
   std::vector<int> strides = {1, 2, 3, 5, 8};  // frame strides k -> k+s, each >= 1
-  std::vector<vo::MatcherType> matchers = {     // matchers to evaluate
-      vo::MatcherType::kSvdProximity, vo::MatcherType::kSvdNcc,   vo::MatcherType::kSvdNccGabor,
+  std::vector<vo::MatcherType> matchers = {    // matchers to evaluate
+      vo::MatcherType::kSvdProximity, vo::MatcherType::kSvdNcc,      vo::MatcherType::kSvdNccGabor,
       vo::MatcherType::kNccMutual,    vo::MatcherType::kLucasKanade, vo::MatcherType::kKalman,
       vo::MatcherType::kSiftRatio};
-  vo::DetectorOptions detector;        // Harris by default; kSiftRatio always uses SIFT
-  vo::DisparityOptions disparity;      // for dropping features without depth
+  vo::DetectorOptions detector;    // Harris by default; kSiftRatio always uses SIFT
+  vo::DisparityOptions disparity;  // for dropping features without depth
   vo::DepthSamplingOptions depth;
-  vo::MatcherOptions matcher;          // per-matcher options (type is overridden)
-  vo::PredictionMode prediction = vo::PredictionMode::kMotionPrior;  // kMotionPrior: every
-                                       // matcher searches around the same predicted positions,
-                                       // the features' stereo 3D points moved by a
-                                       // constant-velocity prior (the ground-truth motion of the
-                                       // previous pair of the same stride; none for the first
-                                       // pair), as the VO predicts; kNone: previous positions
-  double correct_px = 2.0;             // a match is correct within this of the GT position (px)
-  double depth_agree_rel = 0.03;       // visibility: |z_gt - z_proj| <= this * z_proj + 0.01 m
-  double ambiguous_depth_rel = 0.05;   // GT depth spread in 3x3 above this * z: feature left out
+  vo::MatcherOptions matcher;  // per-matcher options (type is overridden)
+  vo::PredictionMode prediction =
+      vo::PredictionMode::kMotionPrior;  // kMotionPrior: every
+                                         // matcher searches around the same predicted positions,
+                                         // the features' stereo 3D points moved by a
+                                         // constant-velocity prior (the ground-truth motion of the
+                                         // previous pair of the same stride; none for the first
+                                         // pair), as the VO predicts; kNone: previous positions
+  double prediction_radius_scale =
+      vo::RobustTrackingOptions().prior_radius_scale;  // gate scale around that prediction,
+                                                       // as the VO's prior pass uses it
+  double correct_px = 2.0;            // a match is correct within this of the GT position (px)
+  double depth_agree_rel = 0.03;      // visibility: |z_gt - z_proj| <= this * z_proj + 0.01 m
+  double ambiguous_depth_rel = 0.05;  // GT depth spread in 3x3 above this * z: feature left out
 
   bool IsValid(std::string* error) const;
 };
@@ -61,8 +65,8 @@ struct MatchEvalOptions {
 struct MatchEvalRow {
   std::string matcher;
   int stride = 0;
-  int pairs = 0;       // frame pairs evaluated
-  long matches = 0;    // evaluated matches (prev feature with unambiguous ground truth)
+  int pairs = 0;     // frame pairs evaluated
+  long matches = 0;  // evaluated matches (prev feature with unambiguous ground truth)
   long correct = 0;
   long possible = 0;
   double precision = 0.0, recall = 0.0, f1 = 0.0;
@@ -73,8 +77,7 @@ struct MatchEvalRow {
 // `progress` (may be null) is called with (done, total) work units.
 bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::StereoCamera& camera,
                       const MatchEvalOptions& options, std::vector<MatchEvalRow>* rows,
-                      std::string* error,
-                      const std::function<void(int, int)>& progress = nullptr);
+                      std::string* error, const std::function<void(int, int)>& progress = nullptr);
 
 // Ground-truth position in frame b of a point seen at uv_px with depth z in frame a; false when
 // it is not visible in b (outside, behind, occluded). Exposed for tests.
@@ -105,7 +108,8 @@ void AccumulateVoMatchStats(const vo::StereoCamera& camera, const GroundTruthFra
                             const std::vector<bool>& inlier_mask, const MatchEvalOptions& options,
                             VoMatchStats* stats);
 
-// Writes rows as CSV (header: matcher,stride,pairs,matches,correct,possible,precision,recall,f1,ms_per_pair).
+// Writes rows as CSV (header:
+// matcher,stride,pairs,matches,correct,possible,precision,recall,f1,ms_per_pair).
 bool WriteMatchEvalCsv(const std::string& path, const std::vector<MatchEvalRow>& rows,
                        std::string* error);
 

@@ -180,6 +180,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"tracking.image_shift.min_score", Number(&o->tracking.image_shift.min_score, -1.0, 1.0)},
       {"tracking.image_shift.max_shift_fraction_x",
        Number(&o->tracking.image_shift.max_shift_fraction_x, 0.01, 0.9)},
+      {"tracking.prior_radius_scale", Number(&o->tracking.prior_radius_scale, 0.05, 20.0)},
       {"tracking.shift_radius_scale", Number(&o->tracking.shift_radius_scale, 0.05, 20.0)},
       {"tracking.confident_min_inliers", Number(&o->tracking.confident_min_inliers, 0, 100000)},
       {"tracking.confident_inlier_fraction",
@@ -189,6 +190,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"tracking.rotation_from_shift", Bool(&o->tracking.rotation_from_shift)},
       {"tracking.rotation_min_shift_score",
        Number(&o->tracking.rotation_min_shift_score, -1.0, 1.0)},
+      {"tracking.velocity_window_frames", Number(&o->tracking.velocity_window_frames, 1, 10)},
       {"tracking.reliable_min_inliers", Number(&o->tracking.reliable_min_inliers, 3, 100000)},
   };
 }

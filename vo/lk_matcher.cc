@@ -87,7 +87,9 @@ std::vector<Match> LucasKanadeMatcher::DoMatch(const MatchFrame& prev, const Mat
                              options_.max_level, criteria, flow_flags, options_.min_eig_threshold);
   }
   // 3. Association with the current features (greedy one-to-one by distance).
-  const double radius = options_.association_radius_px * prediction.radius_scale;
+  // (Not scaled by prediction.radius_scale: it is the detector's repeatability, not a search
+  // gate; the prediction only seeds the flow.)
+  const double radius = options_.association_radius_px;
   const PointGrid grid(FeaturePositions(curr.features), radius);
   std::vector<CandidatePair> candidates;
   for (int i = 0; i < s.num_prev; ++i) {

@@ -124,7 +124,8 @@ struct MatchPrediction {
                                        // or empty; non-finite entries fall back to the
                                        // previous position
   double radius_scale = 1.0;  // scales every position gate of the matcher (SVD σ and cutoff,
-                              // NCC search radius, Kalman gate, LK association radius): < 1
+                              // NCC search radius, Kalman gate, SIFT radius; LK's prediction
+                              // seeds the flow, its association radius is unscaled): < 1
                               // for a guided re-match around a known motion, > 1 for a weak
                               // prior; in [0.05, 20]
 

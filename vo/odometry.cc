@@ -157,7 +157,9 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
     return FailPart("image_shift", part_error, error);
   }
   std::ostringstream msg;
-  if (!(shift_radius_scale >= 0.05 && shift_radius_scale <= 20.0)) {
+  if (!(prior_radius_scale >= 0.05 && prior_radius_scale <= 20.0)) {
+    msg << "prior_radius_scale must be in [0.05, 20], got " << prior_radius_scale;
+  } else if (!(shift_radius_scale >= 0.05 && shift_radius_scale <= 20.0)) {
     msg << "shift_radius_scale must be in [0.05, 20], got " << shift_radius_scale;
   } else if (confident_min_inliers < 0) {
     msg << "confident_min_inliers must be >= 0, got " << confident_min_inliers;
@@ -167,6 +169,8 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
     msg << "guided_radius_scale must be in [0.05, 20], got " << guided_radius_scale;
   } else if (!(rotation_min_shift_score >= -1.0 && rotation_min_shift_score <= 1.0)) {
     msg << "rotation_min_shift_score must be in [-1, 1], got " << rotation_min_shift_score;
+  } else if (velocity_window_frames < 1) {
+    msg << "velocity_window_frames must be >= 1, got " << velocity_window_frames;
   } else if (reliable_min_inliers < 3) {
     msg << "reliable_min_inliers must be >= 3, got " << reliable_min_inliers;
   }
@@ -505,6 +509,7 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
   PredictionSource source = PredictionSource::kNone;
   if (T_ref_curr_prior != nullptr) {
     prediction.uv_px = PredictPositions(*T_ref_curr_prior);
+    prediction.radius_scale = o.prior_radius_scale;
     source = PredictionSource::kMotionPrior;
   }
   times.predict_ms += MsSince(t);
@@ -692,7 +697,14 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
           ? Eigen::Isometry3d(T_world_cam0_by_frame_.at(reference_.frame_index).inverse() *
                               T_world_curr)
           : T_ref_curr_initial;
-  const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
+  Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
+  // Averaged over the last velocity_window_frames frames of the (bundle-adjusted) window.
+  const int64_t oldest = result.frame_index - options_.tracking.velocity_window_frames;
+  const auto first = T_world_cam0_by_frame_.lower_bound(oldest);
+  if (first != T_world_cam0_by_frame_.end() && first->first < result.frame_index) {
+    per_frame = Root(Eigen::Isometry3d(first->second.inverse() * T_world_curr),
+                     result.frame_index - first->first);
+  }
   const bool reliable =
       ransac.num_inliers >= options_.tracking.reliable_min_inliers && !ba_rejected;
   if (IsFinite(per_frame) && (reliable || !has_velocity_)) {

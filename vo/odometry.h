@@ -126,6 +126,10 @@ struct RobustTrackingOptions {
                                // (image_motion.h) and match again around it
   ImageShiftOptions image_shift = DefaultTrackingImageShiftOptions();  // the coarse-to-fine
                                                                        // estimate
+  double prior_radius_scale = 0.5;  // the matcher's position gates around the motion prior's
+                                    // prediction are scaled by this, in [0.05, 20]: the
+                                    // prediction leaves a few pixels (SVD σ 10 → 5 px), and
+                                    // a contradicted prior falls to the coarse-to-fine pass
   double shift_radius_scale = 2.0;  // the matcher's position gates are widened by this around
                                     // a shift estimate (a global shift ignores parallax),
                                     // in [0.05, 20]
@@ -144,6 +148,8 @@ struct RobustTrackingOptions {
                                           // explains the shift left after the prior, see
                                           // CorrectPriorWithImageShift), when that shift is found
   double rotation_min_shift_score = 0.6;  // ... with at least this ZNCC, in [-1, 1]
+  int velocity_window_frames = 1;         // the constant velocity is the mean per-frame motion over
+                                          // the window's frames of the last this many frames, >= 1
   int reliable_min_inliers = 30;          // only a motion with at least this many inliers (and an
                                           // accepted bundle adjustment, when it runs) updates the
                                           // constant-velocity prior, >= 3; = confident_min_inliers:
