@@ -191,6 +191,10 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"tracking.rotation_min_shift_score",
        Number(&o->tracking.rotation_min_shift_score, -1.0, 1.0)},
       {"tracking.velocity_window_frames", Number(&o->tracking.velocity_window_frames, 1, 10)},
+      {"tracking.rotation_min_peak_ratio",
+       Number(&o->tracking.rotation_min_peak_ratio, 1.0, 1000.0)},
+      {"tracking.rotation_min_residual_px",
+       Number(&o->tracking.rotation_min_residual_px, 0.0, 1000.0)},
       {"tracking.reliable_min_inliers", Number(&o->tracking.reliable_min_inliers, 3, 100000)},
   };
 }

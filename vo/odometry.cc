@@ -169,6 +169,10 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
     msg << "guided_radius_scale must be in [0.05, 20], got " << guided_radius_scale;
   } else if (!(rotation_min_shift_score >= -1.0 && rotation_min_shift_score <= 1.0)) {
     msg << "rotation_min_shift_score must be in [-1, 1], got " << rotation_min_shift_score;
+  } else if (!(rotation_min_peak_ratio >= 1.0) || !std::isfinite(rotation_min_peak_ratio)) {
+    msg << "rotation_min_peak_ratio must be finite and >= 1, got " << rotation_min_peak_ratio;
+  } else if (!(rotation_min_residual_px >= 0.0) || !std::isfinite(rotation_min_residual_px)) {
+    msg << "rotation_min_residual_px must be finite and >= 0, got " << rotation_min_residual_px;
   } else if (velocity_window_frames < 1) {
     msg << "velocity_window_frames must be >= 1, got " << velocity_window_frames;
   } else if (reliable_min_inliers < 3) {
@@ -317,8 +321,11 @@ void StereoOdometry::Reset() {
 
 OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
                                       TimePoint start) {
-  // Never hand out a non-finite pose: fall back to the previous output.
-  const Eigen::Isometry3d T = IsFinite(T_world_cam0) ? T_world_cam0 : T_world_prev_;
+  // Never hand out a non-finite pose: fall back to the previous output. The rotation is
+  // re-projected onto SO(3), so rounding in long chains of composed motions (a long bridge of
+  // lost frames) cannot accumulate into a non-rigid transform.
+  Eigen::Isometry3d T = IsFinite(T_world_cam0) ? T_world_cam0 : T_world_prev_;
+  T.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
   result.T_world_cam0 = T;
   result.T_prev_curr = result.frame_index == 0 ? Eigen::Isometry3d::Identity()
                                                : Eigen::Isometry3d(T_world_prev_.inverse() * T);
@@ -368,11 +375,27 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
   const Clock::time_point t = Clock::now();
   const ImageShiftResult shift = EstimateImageShift(previous_left_, current_left_, o.image_shift);
   result->times.predict_ms += MsSince(t);
-  if (!shift.ok || !(shift.score >= o.rotation_min_shift_score)) return predicted;
-  const Eigen::Isometry3d T_prev_curr_prior = T_world_prev_.inverse() * predicted;
+  if (!shift.ok || !(shift.score >= o.rotation_min_shift_score) ||
+      !(shift.second_best_ratio >= o.rotation_min_peak_ratio)) {
+    return predicted;
+  }
+  // The prior's own frame-to-frame motion (not T_world_prev⁻¹ · predicted, which would feed
+  // rounding in the composed poses back into the prior, frame after frame).
+  const Eigen::Isometry3d T_prev_curr_prior =
+      prior != nullptr && IsFinite(prior->T_prev_curr)
+          ? prior->T_prev_curr
+          : (has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity());
   const Eigen::Isometry3d T_prev_curr =
       CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, current_depth_m_);
   if (!IsFinite(T_prev_curr)) return predicted;
+  // The shift the prior itself predicts: the correction's rotation seen at the image centre.
+  const double residual_px =
+      camera_.fx_px *
+      Eigen::AngleAxisd(T_prev_curr_prior.linear().transpose() * T_prev_curr.linear()).angle();
+  if (residual_px <= o.rotation_min_residual_px) return predicted;
+  // The measured rotation becomes the prior's rotation (a turn goes on through the next frames
+  // that have no usable shift); the prior's translation stays.
+  if (prior == nullptr && has_velocity_) velocity_.linear() = T_prev_curr.linear();
   result->rotation_from_shift = true;
   result->image_shift_ok = true;
   result->image_shift_px = shift.shift_px;
@@ -595,13 +618,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
         << matches.size() << " matches; need " << options_.min_inliers << ")";
     if (!ransac.message.empty()) why << ": " << ransac.message;
     result.times.motion_ms += MsSince(motion_start);
-    // A poor reference (a plain stretch) after a loss is not waited on when this frame has
-    // plenty of features.
-    const int rich = 2 * options_.min_features;
-    const bool reference_poor = consecutive_lost_ > 0 &&
-                                static_cast<int>(ref_features.size()) < rich &&
-                                static_cast<int>(frame.features.size()) >= rich;
-    if (consecutive_lost_ >= options_.reinit_after_lost_frames || reference_poor) {
+    // After a loss, a frame that has plenty of features but cannot be matched to the last good
+    // one (even with the coarse-to-fine search) starts again at once: waiting longer would
+    // only extrapolate further.
+    const bool rich = static_cast<int>(frame.features.size()) >= 2 * options_.min_features;
+    if (consecutive_lost_ >= options_.reinit_after_lost_frames || (consecutive_lost_ > 0 && rich)) {
       // The reference is stale: start again from this frame at its predicted pose.
       return Initialise(std::move(result), std::move(frame),
                         why.str() + "; re-initialised at the predicted pose", start, prior);
@@ -705,10 +726,13 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     per_frame = Root(Eigen::Isometry3d(first->second.inverse() * T_world_curr),
                      result.frame_index - first->first);
   }
-  const bool reliable =
-      ransac.num_inliers >= options_.tracking.reliable_min_inliers && !ba_rejected;
-  if (IsFinite(per_frame) && (reliable || !has_velocity_)) {
-    velocity_ = per_frame;
+  // Weight of this motion in the prior: 1 from reliable_min_inliers inliers up, less below
+  // (a weak motion moves the prior only part of the way), 0 when the BA was rejected.
+  const double weight = ba_rejected ? 0.0
+                                    : std::min(1.0, static_cast<double>(ransac.num_inliers) /
+                                                        options_.tracking.reliable_min_inliers);
+  if (IsFinite(per_frame) && (weight > 0.0 || !has_velocity_)) {
+    velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
     has_velocity_ = true;
     velocity_frame_index_ = result.frame_index;
   }

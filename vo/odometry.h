@@ -141,19 +141,30 @@ struct RobustTrackingOptions {
   bool guided_rematch = true;              // after RANSAC, predict every reference feature with the
                                // estimated motion and match again in a tight window; the
                                // second pass is kept when it has at least as many inliers
-  double guided_radius_scale = 0.3;       // gate scale of that pass (σ 10 px → 3 px), [0.05, 20]
-  bool rotation_from_shift = true;        // a frame without a measured motion (too few features, no
-                                          // consensus) takes the prior's motion corrected by the
-                                          // image shift from the previous frame (the rotation that
-                                          // explains the shift left after the prior, see
-                                          // CorrectPriorWithImageShift), when that shift is found
-  double rotation_min_shift_score = 0.6;  // ... with at least this ZNCC, in [-1, 1]
-  int velocity_window_frames = 1;         // the constant velocity is the mean per-frame motion over
-                                          // the window's frames of the last this many frames, >= 1
-  int reliable_min_inliers = 30;          // only a motion with at least this many inliers (and an
-                                          // accepted bundle adjustment, when it runs) updates the
-                                          // constant-velocity prior, >= 3; = confident_min_inliers:
-                                          // a motion the matcher trusts is one the prior may repeat
+  double guided_radius_scale = 0.3;  // gate scale of that pass (σ 10 px → 3 px), [0.05, 20]
+  bool rotation_from_shift = true;   // a frame without a measured motion (too few features, no
+                                     // consensus) takes the prior's motion corrected by the
+                                     // image shift from the previous frame (the rotation that
+                                     // explains the shift left after the prior, see
+                                     // CorrectPriorWithImageShift), when that shift is found
+  double rotation_min_shift_score = 0.85;  // ... with at least this ZNCC, in [-1, 1]: real
+                                           // structure scores 0.9-0.99 between successive
+                                           // frames, false peaks on plain, smoothly shaded
+                                           // walls ~0.7 (measured on the plain corridor)
+  double rotation_min_peak_ratio = 1.05;   // ... and an unambiguous peak: best / second-best
+                                           // peak score (ImageShiftResult::second_best_ratio)
+                                           // at least this, >= 1
+  double rotation_min_residual_px = 3.0;   // ... and only when the shift differs from the one
+                                           // the prior predicts by more than this (pixels),
+                                           // >= 0: smaller residuals are within what a global
+                                           // shift cannot tell from parallax and zoom (forward
+                                           // motion past plain walls), so the prior stands
+  int velocity_window_frames = 1;  // the constant velocity is the mean per-frame motion over
+                                   // the window's frames of the last this many frames, >= 1
+  int reliable_min_inliers = 30;   // only a motion with at least this many inliers (and an
+                                   // accepted bundle adjustment, when it runs) updates the
+                                   // constant-velocity prior, >= 3; = confident_min_inliers:
+                                   // a motion the matcher trusts is one the prior may repeat
 
   bool IsValid(std::string* error) const;
 };

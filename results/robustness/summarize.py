@@ -39,7 +39,8 @@ def main(runs_dir, out_dir):
     seeds = ["seed%d" % s for s in range(1, 11)]
     md = ["# Robustness sweep (issue #9)", "",
           "l_hallway (16 m, 485 frames), only `textures.seed` changed; frame strides 1, 2, 3, 5 "
-          "(the in-place turn moves the image ~10 px per frame at stride 1, ~49 px at stride 5). "
+          "(the in-place turn moves the image ~10 px per frame at stride 1, ~49 px at stride 5), "
+          "plus a pitched and a 640x480 camera and the low-texture `plain_corridor` scene. "
           "Made by `results/robustness/sweep.sh` (same frames as `suites/robustness.yaml`). "
           "Cells: end-pose error in % of the path / frames without a measured motion.", ""]
     for c, title in CONFIGS:
@@ -63,7 +64,8 @@ def main(runs_dir, out_dir):
                 k, " | ".join(cells), "%.3f" % max(errs) if errs else "—",
                 "%.3f" % statistics.median(errs) if errs else "—", lost))
         extra = [("seed 7, stride 8", get("seed7", 8, c)), ("camera.pitch_deg 10", get("pitch10", 1, c)),
-                 ("640x480 camera", get("vga", 1, c))]
+                 ("640x480 camera", get("vga", 1, c))] + [
+                     ("plain_corridor (12 m), stride %d" % k, get("corridor", k, c)) for k in (1, 2, 3, 5)]
         md += ["", "| other | end-pose error | ATE | lost / re-initialised | VO ms/frame |",
                "| --- | --- | --- | --- | --- |"]
         for label, r in extra:

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Robustness sweep of issue #9, the figures in results/robustness/summary.md: l_hallway with
 # texture seeds 1-10 (only textures.seed changed) x frame strides 1, 2, 3, 5 (and 8 on seed 7)
-# x four VO configurations, plus camera.pitch_deg 10 and a 640x480 camera (same field of view).
+# x four VO configurations, plus camera.pitch_deg 10, a 640x480 camera (same field of view) and
+# the low-texture plain_corridor scene at strides 1, 2, 3, 5.
 # Each hallway is rendered once (vobench render, KITTI layout) and every run reads the same
 # frames (vobench run --dataset --stride), which gives the same trajectories as simulating each
 # run anew (suites/robustness.yaml) at a tenth of the time.
@@ -25,6 +26,8 @@ datasets=()
 for s in 1 2 3 4 5 6 7 8 9 10; do variant "seed$s" "s|^  seed: 7 |  seed: $s |"; datasets+=("seed$s"); done
 variant pitch10 "s|^  pitch_deg: 0 |  pitch_deg: 10 |"; datasets+=(pitch10)
 variant vga "s|^  width: 320|  width: 640|;s|^  height: 240|  height: 480|"; datasets+=(vga)
+sed -e "s|^scene: corridor_plain.xml|scene: $ROOT/scenes/corridor_plain.xml|" scenes/plain_corridor.yaml \
+  > "$WORK/corridor.yaml"; datasets+=(corridor)  # the low-texture corridor, a scene of its own
 printf '%s\n' "${datasets[@]}" | xargs -P "$JOBS" -I{} bash -c \
   '[ -d "'"$WORK"'/ds_{}" ] || "'"$BIN"'" render "'"$WORK"'/{}.yaml" --out "'"$WORK"'/ds_{}" -q > /dev/null'
 
@@ -37,6 +40,7 @@ runs=()
 for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual}; do
   for s in 1 2 3 4 5 6 7 8 9 10; do for k in 1 2 3 5; do runs+=("seed$s $k $c"); done; done
   runs+=("seed7 8 $c" "pitch10 1 $c" "vga 1 $c")
+  for k in 1 2 3 5; do runs+=("corridor $k $c"); done
 done
 printf '%s\n' "${runs[@]}" | xargs -P "$JOBS" -L1 bash -c \
   'out="'"$WORK"'/runs/$0_s$1_$2"; [ -f "$out/metrics.json" ] || "'"$BIN"'" run --dataset "'"$WORK"'/ds_$0" --stride $1 --config "'"$WORK"'/$2.yaml" --out "$out" --no-plots -q > /dev/null'

@@ -409,11 +409,12 @@ Eigen::Isometry3d EstimatedMotionFromFirst(const std::vector<OdometryResult>& re
   return results[0].T_world_cam0.inverse() * results[i].T_world_cam0;
 }
 
-std::vector<OdometryResult> RunCorridor(const OdometryOptions& options,
-                                        const std::vector<int>& black_frames = {}) {
+// The VO over `frames`, with the frames listed in `black_frames` replaced by black images.
+std::vector<OdometryResult> RunFrames(const std::vector<StereoFrame>& frames,
+                                      const OdometryOptions& options,
+                                      const std::vector<int>& black_frames) {
   StereoOdometry vo(HallwayCamera(), options);
   std::vector<OdometryResult> results;
-  const std::vector<StereoFrame>& frames = CorridorSequence();
   for (size_t i = 0; i < frames.size(); ++i) {
     const bool black = std::find(black_frames.begin(), black_frames.end(), static_cast<int>(i)) !=
                        black_frames.end();
@@ -422,6 +423,11 @@ std::vector<OdometryResult> RunCorridor(const OdometryOptions& options,
                             : vo.Process(frames[i].left, frames[i].right, 0.1 * i));
   }
   return results;
+}
+
+std::vector<OdometryResult> RunCorridor(const OdometryOptions& options,
+                                        const std::vector<int>& black_frames = {}) {
+  return RunFrames(CorridorSequence(), options, black_frames);
 }
 
 // ---- (2) Rendered sequence ------------------------------------------------------------------
@@ -561,7 +567,7 @@ Eigen::Isometry3d TurnPose(int i) {
   return MakePose(R_hall_cam(yaw), t);
 }
 
-std::vector<OdometryResult> RunTurn(const OdometryOptions& options, const std::vector<int>& black) {
+const std::vector<StereoFrame>& TurnSequence() {
   static const std::vector<StereoFrame> frames = [] {
     const CorridorRenderer renderer;
     std::vector<StereoFrame> out(12);
@@ -570,15 +576,11 @@ std::vector<OdometryResult> RunTurn(const OdometryOptions& options, const std::v
     }
     return out;
   }();
-  StereoOdometry vo(HallwayCamera(), options);
-  std::vector<OdometryResult> results;
-  for (size_t i = 0; i < frames.size(); ++i) {
-    const bool is_black = std::find(black.begin(), black.end(), static_cast<int>(i)) != black.end();
-    const cv::Mat zeros = cv::Mat::zeros(frames[i].left.size(), CV_8UC1);
-    results.push_back(is_black ? vo.Process(zeros, zeros, 0.1 * i)
-                               : vo.Process(frames[i].left, frames[i].right, 0.1 * i));
-  }
-  return results;
+  return frames;
+}
+
+std::vector<OdometryResult> RunTurn(const OdometryOptions& options, const std::vector<int>& black) {
+  return RunFrames(TurnSequence(), options, black);
 }
 
 Eigen::Isometry3d TrueTurnMotion(int a, int b) { return TurnPose(a).inverse() * TurnPose(b); }
@@ -616,6 +618,30 @@ TEST(OdometryPredictionTest, FastTurnIsTrackedAndAGapIsMeasuredNotExtrapolated) 
   }
   EXPECT_EQ(lost, 2);
   EXPECT_EQ(reinit, 0);
+}
+
+TEST(OdometryPredictionTest, AnExternalMotionPriorBridgesBlackFramesExactly) {
+  // The same turn with a caller's prior (e.g. wheel odometry, here exact): the black frames 7
+  // and 8 get the prior's pose, not the constant-velocity extrapolation.
+  StereoOdometry vo(HallwayCamera(), OdometryOptions());
+  std::vector<OdometryResult> r;
+  for (int i = 0; i < 10; ++i) {
+    const cv::Mat black = cv::Mat::zeros(HallwayCamera().height, HallwayCamera().width, CV_8UC1);
+    const bool is_black = i == 7 || i == 8;
+    const cv::Mat& left = is_black ? black : TurnSequence()[i].left;
+    const cv::Mat& right = is_black ? black : TurnSequence()[i].right;
+    MotionPrior prior;
+    prior.T_prev_curr = i > 0 ? TrueTurnMotion(i - 1, i) : Eigen::Isometry3d::Identity();
+    r.push_back(vo.Process(left, right, 0.1 * i, i > 0 ? &prior : nullptr));
+  }
+  for (int i : {7, 8}) {
+    EXPECT_EQ(r[i].status, TrackingStatus::kLost);
+    // The pose is the previous output moved by the prior: exact relative motion.
+    EXPECT_THAT(r[i].T_prev_curr, IsNearPose(TrueTurnMotion(i - 1, i), 1e-9, 1e-9)) << i;
+  }
+  EXPECT_TRUE(r[9].motion_measured) << r[9].message;
+  EXPECT_EQ(r[9].reference_frame_index, 6);
+  EXPECT_THAT(EstimatedMotion(r, 0, 9), IsNearPose(TrueTurnMotion(0, 9), 0.5 * kDeg, 0.02));
 }
 
 TEST(OdometryPredictionTest, ThePapersUnpredictedFormLosesTheFastTurn) {
