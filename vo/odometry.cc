@@ -306,7 +306,6 @@ void StereoOdometry::Reset() {
   T_world_prev_ = Eigen::Isometry3d::Identity();
   velocity_ = Eigen::Isometry3d::Identity();
   has_velocity_ = false;
-  velocity_frame_index_ = -1;
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
@@ -734,7 +733,6 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   if (IsFinite(per_frame) && (weight > 0.0 || !has_velocity_)) {
     velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
     has_velocity_ = true;
-    velocity_frame_index_ = result.frame_index;
   }
   result.motion_measured = true;
 

@@ -60,12 +60,13 @@
 // wall is followed, not extrapolated. The reference frame, the tracks and the window are kept.
 // The next frames are matched against that reference (the last good frame) with the
 // coarse-to-fine pass, so the motion across the gap is measured; success gives kRecovered.
-// When the motion still fails after reinit_after_lost_frames lost frames, or the reference is
-// poor (fewer than 2 · min_features features) while the current frame is rich, the pipeline
+// When the motion still fails after reinit_after_lost_frames lost frames, or the current frame
+// is rich (at least 2 · min_features features) yet cannot be matched after a loss, the pipeline
 // re-initialises on the current frame at its bridged pose (kRecovered, reinitialised = true):
-// tracks and window restart, the constant velocity is kept. The prior is updated only from a
-// reliable motion (tracking.reliable_min_inliers, BA not rejected), so a weak estimate just
-// before a loss is not extrapolated over the gap. Frames without a measured motion (lost and
+// tracks and window restart, the constant velocity is kept. Each measured motion moves the
+// prior in proportion to its support (tracking.reliable_min_inliers; not at all when the BA was
+// rejected), so one weak estimate just before a loss is not extrapolated over the gap, while a
+// long weakly textured stretch still updates it. Frames without a measured motion (lost and
 // re-initialised ones) are what IsLostFrame() counts. The frame after a kRecovered frame is
 // kTracking again.
 //
@@ -146,7 +147,8 @@ struct RobustTrackingOptions {
                                      // consensus) takes the prior's motion corrected by the
                                      // image shift from the previous frame (the rotation that
                                      // explains the shift left after the prior, see
-                                     // CorrectPriorWithImageShift), when that shift is found
+                                     // CorrectPriorWithImageShift), when that shift is found;
+                                     // the measured rotation then becomes the prior's
   double rotation_min_shift_score = 0.85;  // ... with at least this ZNCC, in [-1, 1]: real
                                            // structure scores 0.9-0.99 between successive
                                            // frames, false peaks on plain, smoothly shaded
@@ -161,10 +163,12 @@ struct RobustTrackingOptions {
                                            // motion past plain walls), so the prior stands
   int velocity_window_frames = 1;  // the constant velocity is the mean per-frame motion over
                                    // the window's frames of the last this many frames, >= 1
-  int reliable_min_inliers = 30;   // only a motion with at least this many inliers (and an
-                                   // accepted bundle adjustment, when it runs) updates the
-                                   // constant-velocity prior, >= 3; = confident_min_inliers:
-                                   // a motion the matcher trusts is one the prior may repeat
+  int reliable_min_inliers = 30;   // a motion with at least this many inliers replaces the
+                                   // constant-velocity prior; one with fewer moves it only
+                                   // inliers / this of the way (slerp), one whose bundle
+                                   // adjustment was rejected not at all; >= 3. 30 =
+                                   // confident_min_inliers: a motion the matcher trusts is
+                                   // one the prior may repeat
 
   bool IsValid(std::string* error) const;
 };
@@ -465,7 +469,6 @@ class StereoOdometry {
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();      // constant-velocity model: last
                                                                 // estimated per-frame T_prev_curr
   bool has_velocity_ = false;
-  int64_t velocity_frame_index_ = -1;  // frame whose reliable motion set velocity_
 
   Eigen::Matrix3d R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   PlaneOrientationResult orientation_result_;

@@ -644,6 +644,25 @@ TEST(OdometryPredictionTest, AnExternalMotionPriorBridgesBlackFramesExactly) {
   EXPECT_THAT(EstimatedMotion(r, 0, 9), IsNearPose(TrueTurnMotion(0, 9), 0.5 * kDeg, 0.02));
 }
 
+TEST(OdometryPredictionTest, AFrameWithoutDepthFollowsTheTurnByItsImageShift) {
+  // Frames 7 and 8 lose their right image (no depth, no motion), but the left images still show
+  // how the view turned: frame 8, where the turn has stopped while the constant velocity says
+  // 7° more, takes its rotation from the image shift instead of the extrapolation.
+  StereoOdometry vo(HallwayCamera(), OdometryOptions());
+  std::vector<OdometryResult> r;
+  const cv::Mat black = cv::Mat::zeros(HallwayCamera().height, HallwayCamera().width, CV_8UC1);
+  for (int i = 0; i < 10; ++i) {
+    const StereoFrame& f = TurnSequence()[i];
+    r.push_back(vo.Process(f.left, i == 7 || i == 8 ? black : f.right, 0.1 * i));
+  }
+  for (int i : {7, 8}) EXPECT_TRUE(IsLostFrame(r[i])) << r[i].message;
+  EXPECT_TRUE(r[8].rotation_from_shift) << r[8].message;
+  EXPECT_LT(RotationAngleRad(EstimatedMotion(r, 7, 8).linear(), TrueTurnMotion(7, 8).linear()),
+            0.6 * kDeg);
+  EXPECT_LT(RotationAngleRad(EstimatedMotion(r, 6, 8).linear(), TrueTurnMotion(6, 8).linear()),
+            0.8 * kDeg);
+}
+
 TEST(OdometryPredictionTest, ThePapersUnpredictedFormLosesTheFastTurn) {
   // The same frames without prediction (matcher.prediction: none): 28 px per frame is beyond
   // the σ = 10 px proximity gate, so the turn is not measured (the failure the prediction fixes).
