@@ -391,15 +391,18 @@ struct StereoFrame {
   cv::Mat left, right;
 };
 
+// 12 stereo pairs of the corridor seen from pose(0) ... pose(11).
+std::vector<StereoFrame> RenderSequence(const std::function<Eigen::Isometry3d(int)>& pose) {
+  const CorridorRenderer renderer;
+  std::vector<StereoFrame> out(12);
+  for (int i = 0; i < 12; ++i) {
+    renderer.Render(HallwayCamera(), pose(i), &out[i].left, &out[i].right);
+  }
+  return out;
+}
+
 const std::vector<StereoFrame>& CorridorSequence() {
-  static const std::vector<StereoFrame> frames = [] {
-    const CorridorRenderer renderer;
-    std::vector<StereoFrame> out(12);
-    for (int i = 0; i < 12; ++i) {
-      renderer.Render(HallwayCamera(), CorridorPose(i), &out[i].left, &out[i].right);
-    }
-    return out;
-  }();
+  static const std::vector<StereoFrame> frames = RenderSequence(CorridorPose);
   return frames;
 }
 
@@ -568,14 +571,7 @@ Eigen::Isometry3d TurnPose(int i) {
 }
 
 const std::vector<StereoFrame>& TurnSequence() {
-  static const std::vector<StereoFrame> frames = [] {
-    const CorridorRenderer renderer;
-    std::vector<StereoFrame> out(12);
-    for (int i = 0; i < 12; ++i) {
-      renderer.Render(HallwayCamera(), TurnPose(i), &out[i].left, &out[i].right);
-    }
-    return out;
-  }();
+  static const std::vector<StereoFrame> frames = RenderSequence(TurnPose);
   return frames;
 }
 
