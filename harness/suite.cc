@@ -531,7 +531,13 @@ bool CheckOutDir(const fs::path& dir, const std::string& name, std::string* erro
     return false;
   }
   if (!fs::exists(dir / "suite.json")) {
-    if (fs::directory_iterator(dir, ec) == fs::directory_iterator()) return true;
+    // Empty, or a shard started at the same time is just writing its manifest (only
+    // WriteFileAtomically's "suite.json.tmp<pid>" is there yet).
+    bool being_created = true;
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      being_created &= entry.path().filename().string().rfind("suite.json.tmp", 0) == 0;
+    }
+    if (!ec && being_created) return true;
     *error = dir.string() +
              ": exists and is not a vobench suite folder (no suite.json); choose another --out";
     return false;
