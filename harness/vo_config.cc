@@ -173,6 +173,8 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"ba_max_points", Number(&o->ba_max_points, 0, 100000)},
       {"prior_weight", Number(&o->prior_weight, 0.0, 1.0)},
       {"estimate_initial_orientation", Bool(&o->estimate_initial_orientation)},
+      {"adaptive_min_features", Number(&o->adaptive_min_features, 0, 100000)},
+      {"adaptive_quality_level", Number(&o->adaptive_quality_level, 0.0, 0.999)},
       {"min_features", Number(&o->min_features, 0, 100000)},
       {"min_inliers", Number(&o->min_inliers, 3, 100000)},
       {"reinit_after_lost_frames", Number(&o->reinit_after_lost_frames, 1, 100000)},

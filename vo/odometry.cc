@@ -217,6 +217,10 @@ bool OdometryOptions::IsValid(std::string* error) const {
     msg << "ba_max_points must be >= 0 (0 = no limit), got " << ba_max_points;
   } else if (orientation_sample_step_px < 1) {
     msg << "orientation_sample_step_px must be >= 1, got " << orientation_sample_step_px;
+  } else if (adaptive_min_features < 0) {
+    msg << "adaptive_min_features must be >= 0 (0 = off), got " << adaptive_min_features;
+  } else if (!(adaptive_quality_level >= 0.0 && adaptive_quality_level < 1.0)) {
+    msg << "adaptive_quality_level must be in [0, 1), got " << adaptive_quality_level;
   } else if (min_features < 3) {
     msg << "min_features must be >= 3, got " << min_features;
   } else if (min_inliers < 3) {
@@ -286,6 +290,12 @@ StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions
   }
   disparity_ = std::make_unique<DisparityEstimator>(options_.disparity);
   detector_ = CreateFeatureDetector(options_.detector, &why);
+  if (options_.adaptive_min_features > 0 && options_.detector.type == DetectorType::kHarris) {
+    DetectorOptions weak = options_.detector;
+    weak.harris.quality_level =
+        std::min(options_.detector.harris.quality_level, options_.adaptive_quality_level);
+    weak_detector_ = CreateFeatureDetector(weak, &why);
+  }
   matcher_ = CreateFrameMatcher(options_.matcher, &why);
   if (!detector_ || !matcher_) {
     std::fprintf(stderr, "vo::StereoOdometry: %s\n", why.c_str());
@@ -791,6 +801,11 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   // Features in the left image.
   t = Clock::now();
   FeatureSet set = detector_->DetectWithDescriptors(left);
+  if (weak_detector_ && static_cast<int>(set.features.size()) < options_.adaptive_min_features) {
+    // A weakly textured view: detect again with the lower relative threshold.
+    FeatureSet more = weak_detector_->DetectWithDescriptors(left);
+    if (more.features.size() > set.features.size()) set = std::move(more);
+  }
   result.times.detect_ms = MsSince(t);
   result.num_features = static_cast<int>(set.features.size());
 
