@@ -135,14 +135,9 @@ bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::Ste
         vo::MatchPrediction prediction;
         if (o.prediction == vo::PredictionMode::kMotionPrior && k >= static_cast<size_t>(s)) {
           prediction.radius_scale = o.prediction_radius_scale;
-          const Eigen::Isometry3d T_curr_ref =
-              (frames[k - s].T_world_cam0.inverse() * frames[k].T_world_cam0).inverse();
-          for (const vo::Feature& f : a.frame.features) {
-            Eigen::Vector2d uv = Eigen::Vector2d::Constant(std::nan(""));
-            if (!f.p_cam0.allFinite() || !camera.ProjectLeft(T_curr_ref * f.p_cam0, &uv))
-              uv = Eigen::Vector2d::Constant(std::nan(""));
-            prediction.uv_px.push_back(uv);
-          }
+          const Eigen::Isometry3d T_ref_curr =
+              frames[k - s].T_world_cam0.inverse() * frames[k].T_world_cam0;
+          prediction.uv_px = vo::PredictFeaturePositions(camera, a.frame.features, T_ref_curr, 1e-6);
         }
         const auto t0 = std::chrono::steady_clock::now();
         const std::vector<vo::Match> matches = matcher->MatchFrames(a.frame, b.frame, prediction);

@@ -192,7 +192,6 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"tracking.rotation_from_shift", Bool(&o->tracking.rotation_from_shift)},
       {"tracking.rotation_min_shift_score",
        Number(&o->tracking.rotation_min_shift_score, -1.0, 1.0)},
-      {"tracking.velocity_window_frames", Number(&o->tracking.velocity_window_frames, 1, 10)},
       {"tracking.rotation_min_peak_ratio",
        Number(&o->tracking.rotation_min_peak_ratio, 1.0, 1000.0)},
       {"tracking.rotation_min_residual_px",

@@ -173,8 +173,6 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
     msg << "rotation_min_peak_ratio must be finite and >= 1, got " << rotation_min_peak_ratio;
   } else if (!(rotation_min_residual_px >= 0.0) || !std::isfinite(rotation_min_residual_px)) {
     msg << "rotation_min_residual_px must be finite and >= 0, got " << rotation_min_residual_px;
-  } else if (velocity_window_frames < 1) {
-    msg << "velocity_window_frames must be >= 1, got " << velocity_window_frames;
   } else if (reliable_min_inliers < 3) {
     msg << "reliable_min_inliers must be >= 3, got " << reliable_min_inliers;
   }
@@ -325,7 +323,6 @@ void StereoOdometry::Reset() {
   prev_call_index_map_.clear();
   current_left_ = cv::Mat();
   previous_left_ = cv::Mat();
-  current_depth_m_ = -1.0;
 }
 
 OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
@@ -341,7 +338,6 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
   T_world_prev_ = T;
   previous_left_ = current_left_;
   current_left_ = cv::Mat();
-  current_depth_m_ = -1.0;
   result.times.total_ms = MsSince(start);
   return result;
 }
@@ -389,13 +385,18 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
     return predicted;
   }
   // The prior's own frame-to-frame motion (not T_world_prev⁻¹ · predicted, which would feed
-  // rounding in the composed poses back into the prior, frame after frame).
-  const Eigen::Isometry3d T_prev_curr_prior =
-      prior != nullptr && IsFinite(prior->T_prev_curr)
-          ? prior->T_prev_curr
-          : (has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity());
+  // rounding in the composed poses back into the prior, frame after frame), corrected at the
+  // median depth of this frame's features (last_features_; none: far away).
+  const Eigen::Isometry3d T_prev_curr_prior = PriorMotion(prior);
+  double depth_m = -1.0;
+  if (!last_features_.empty()) {
+    std::vector<double> z;
+    for (const Feature& f : last_features_) z.push_back(f.p_cam0.z());
+    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+    depth_m = z[z.size() / 2];
+  }
   const Eigen::Isometry3d T_prev_curr =
-      CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, current_depth_m_);
+      CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m);
   if (!IsFinite(T_prev_curr)) return predicted;
   // The shift the prior itself predicts: the correction's rotation seen at the image centre.
   const double residual_px =
@@ -411,9 +412,13 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
   return T_world_prev_ * T_prev_curr;
 }
 
+Eigen::Isometry3d StereoOdometry::PriorMotion(const MotionPrior* prior) const {
+  if (prior != nullptr && IsFinite(prior->T_prev_curr)) return prior->T_prev_curr;
+  return has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity();
+}
+
 Eigen::Isometry3d StereoOdometry::PredictedPose(const MotionPrior* prior) const {
-  if (prior != nullptr && IsFinite(prior->T_prev_curr)) return T_world_prev_ * prior->T_prev_curr;
-  return has_velocity_ ? Eigen::Isometry3d(T_world_prev_ * velocity_) : T_world_prev_;
+  return T_world_prev_ * PriorMotion(prior);
 }
 
 OdometryResult StereoOdometry::Lost(OdometryResult result, const std::string& message,
@@ -719,22 +724,15 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     result.times.ba_ms = MsSince(ba_start);
   }
 
-  // Constant-velocity model: the (refined) motion from the reference, per frame, taken only
-  // from a reliable motion (enough inliers, bundle adjustment not rejected), so one weak
-  // estimate before a loss is not extrapolated over the gap.
+  // Constant-velocity model: the (refined) motion from the reference, per frame, blended into
+  // the prior by its support, so one weak estimate before a loss is not extrapolated over the
+  // gap.
   const Eigen::Isometry3d T_ref_curr =
       T_world_cam0_by_frame_.count(reference_.frame_index)
           ? Eigen::Isometry3d(T_world_cam0_by_frame_.at(reference_.frame_index).inverse() *
                               T_world_curr)
           : T_ref_curr_initial;
-  Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
-  // Averaged over the last velocity_window_frames frames of the (bundle-adjusted) window.
-  const int64_t oldest = result.frame_index - options_.tracking.velocity_window_frames;
-  const auto first = T_world_cam0_by_frame_.lower_bound(oldest);
-  if (first != T_world_cam0_by_frame_.end() && first->first < result.frame_index) {
-    per_frame = Root(Eigen::Isometry3d(first->second.inverse() * T_world_curr),
-                     result.frame_index - first->first);
-  }
+  const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
   // Weight of this motion in the prior: 1 from reliable_min_inliers inliers up, less below
   // (a weak motion moves the prior only part of the way), 0 when the BA was rejected.
   const double weight = ba_rejected ? 0.0
@@ -832,12 +830,6 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   result.times.depth_ms = MsSince(t);
   result.num_features_with_depth = static_cast<int>(frame.features.size());
   last_features_ = frame.features;
-  if (!frame.features.empty()) {  // median depth, for the image-shift bridge of a lost frame
-    std::vector<double> z;
-    for (const Feature& f : frame.features) z.push_back(f.p_cam0.z());
-    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
-    current_depth_m_ = z[z.size() / 2];
-  }
   if (result.num_features_with_depth < options_.min_features) {
     std::ostringstream msg;
     msg << "too few features with depth (" << result.num_features_with_depth << " of "

@@ -161,14 +161,12 @@ struct RobustTrackingOptions {
                                            // >= 0: smaller residuals are within what a global
                                            // shift cannot tell from parallax and zoom (forward
                                            // motion past plain walls), so the prior stands
-  int velocity_window_frames = 1;  // the constant velocity is the mean per-frame motion over
-                                   // the window's frames of the last this many frames, >= 1
-  int reliable_min_inliers = 30;   // a motion with at least this many inliers replaces the
-                                   // constant-velocity prior; one with fewer moves it only
-                                   // inliers / this of the way (slerp), one whose bundle
-                                   // adjustment was rejected not at all; >= 3. 30 =
-                                   // confident_min_inliers: a motion the matcher trusts is
-                                   // one the prior may repeat
+  int reliable_min_inliers = 30;           // a motion with at least this many inliers replaces the
+                                           // constant-velocity prior; one with fewer moves it only
+                                           // inliers / this of the way (slerp), one whose bundle
+                                           // adjustment was rejected not at all; >= 3. 30 =
+                                           // confident_min_inliers: a motion the matcher trusts is
+                                           // one the prior may repeat
 
   bool IsValid(std::string* error) const;
 };
@@ -437,6 +435,9 @@ class StereoOdometry {
   // Positions of the reference features in the current image under T_ref_curr (NaN where a
   // point falls behind the camera or has no depth).
   std::vector<Eigen::Vector2d> PredictPositions(const Eigen::Isometry3d& T_ref_curr) const;
+  // The prior's motion since the previous output: the caller's prior, else the constant
+  // velocity, else none (identity).
+  Eigen::Isometry3d PriorMotion(const MotionPrior* prior) const;
   // The predicted T_world_cam0 of the newest frame: the previous output moved by the prior.
   Eigen::Isometry3d PredictedPose(const MotionPrior* prior) const;
   // The pose of a frame without a measured motion: the predicted pose, corrected by the image
@@ -486,9 +487,8 @@ class StereoOdometry {
   std::vector<Match> last_matches_;
   std::vector<bool> last_inlier_mask_;
   std::vector<Feature> last_reference_features_;
-  cv::Mat current_left_;           // this call's left image (for the image shift of a lost frame)
-  double current_depth_m_ = -1.0;  // median depth of this call's features (metres), -1 = none
-  cv::Mat previous_left_;          // the previous call's left image (empty after ProcessFeatures)
+  cv::Mat current_left_;   // this call's left image (for the image shift of a lost frame)
+  cv::Mat previous_left_;  // the previous call's left image (empty after ProcessFeatures)
   std::vector<int> prev_call_index_map_;  // ProcessFeatures: given index → kept index of the
                                           // previous call's features (empty when unusable)
 };
