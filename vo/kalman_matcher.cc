@@ -159,9 +159,7 @@ std::vector<Match> KalmanMatcher::DoMatch(const MatchFrame& prev, const MatchFra
     const Eigen::Matrix2d Si = S.inverse();
     const double max_eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(S).eigenvalues()(1);
     const double radius = std::min(max_radius, std::sqrt(gate_chi2 * max_eig));
-    const Eigen::Vector2d predicted = prediction.empty()
-                                          ? Eigen::Vector2d(t.x.head<2>())
-                                          : prediction.Centre(i, Eigen::Vector2d(t.x.head<2>()));
+    const Eigen::Vector2d predicted = prediction.Centre(i, Eigen::Vector2d(t.x.head<2>()));
     const double grad_var = t.g_var + rg2;
     grid.ForEachWithin(predicted, radius, [&](int j, double) {
       ++s.num_candidates;
