@@ -242,7 +242,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   csv << "frame,time_s,status,features,features_with_depth,matches,inliers,rms_reprojection_px,ba_ran,"
          "disparity_ms,detect_ms,depth_ms,match_ms,motion_ms,ba_ms,total_ms,x_m,y_m,z_m,gt_distance_m,"
          "translation_error_m,rotation_error_deg,motion_measured,reinitialised,prediction,"
-         "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms\n";
+         "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_disparities,"
+         "disparity_pixels\n";
   for (size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
     const Eigen::Vector3d t = est[i].translation();
@@ -255,7 +256,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
         << Fmt(te_m[i], 6) << "," << Fmt(re_deg[i], 5) << "," << (r.motion_measured ? 1 : 0) << ","
         << (r.reinitialised ? 1 : 0) << "," << vo::ToString(r.prediction) << "," << r.num_first_pass_inliers
         << "," << Fmt(r.image_shift_px.x(), 2) << "," << Fmt(r.image_shift_px.y(), 2) << ","
-        << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << "\n";
+        << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << "," << r.num_disparities << ","
+        << r.disparity_pixels << "\n";
   }
   const std::string options_yaml = VoConfigToYaml(odometry->options());
   if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(times, est), error) ||

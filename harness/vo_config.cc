@@ -71,6 +71,15 @@ Entry Prediction(vo::PredictionMode* field) {
           [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
 }
 
+Entry DisparityModeEntry(vo::DisparityMode* field) {
+  return {[field](const YAML::Node& n, std::string* why) {
+            if (vo::ParseDisparityMode(n.Scalar(), field)) return true;
+            *why = "expected dense or at_features, got '" + n.Scalar() + "'";
+            return false;
+          },
+          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
+}
+
 Entry DisparityAlgorithmEntry(vo::DisparityAlgorithm* field) {
   return {[field](const YAML::Node& n, std::string* why) {
             for (vo::DisparityAlgorithm a :
@@ -147,7 +156,14 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"disparity.block_size", Number(&o->disparity.block_size, 5, 255)},
       {"disparity.uniqueness_ratio", Number(&o->disparity.uniqueness_ratio, 0, 100)},
       {"disparity.left_right_max_diff_px", Number(&o->disparity.left_right_max_diff_px, -1.0, 1000.0)},
+      {"disparity.min_texture", Number(&o->disparity.min_texture, 0.0, 1000.0)},
+      {"disparity.speckle_window_size", Number(&o->disparity.speckle_window_size, 0, 100000)},
       {"disparity_min_depth_m", Number(&o->disparity_min_depth_m, 0.01, kInf)},
+      {"disparity_mode", DisparityModeEntry(&o->disparity_mode)},
+      {"disparity_range_from_scene", Bool(&o->disparity_range_from_scene)},
+      {"disparity_range_margin", Number(&o->disparity_range_margin, 0.0, 100.0)},
+      {"disparity_range_margin_px", Number(&o->disparity_range_margin_px, 0.0, 1000.0)},
+
       {"matcher.type", Matcher(&o->matcher.type)},
       {"matcher.prediction", Prediction(&o->matcher.prediction)},
       {"matcher.ncc.window_px", Number(&o->matcher.ncc.window_px, 3, 63)},

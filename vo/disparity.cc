@@ -31,21 +31,25 @@ std::string DescribeMat(const cv::Mat& m) {
   return s.str();
 }
 
+// The samplers read the map through `at(x, y)` (a disparity, or < 0 when invalid) on a
+// rows x cols grid, so the dense map and the disparity evaluated on demand share them.
+
 // Nearest valid disparity around (u, v) within `radius` (Chebyshev) of the nearest pixel;
 // ties resolved by scan order (row, then column). Returns kInvalidDisparity when none.
-float SampleNearest(const cv::Mat& disparity, double u, double v, int radius) {
+template <class At>
+float SampleNearest(const At& at, int rows, int cols, double u, double v, int radius) {
   const int xi = static_cast<int>(std::lround(u));
   const int yi = static_cast<int>(std::lround(v));
   float best = kInvalidDisparity;
   double best_dist2 = std::numeric_limits<double>::infinity();
-  for (int y = std::max(0, yi - radius); y <= std::min(disparity.rows - 1, yi + radius); ++y) {
-    const float* row = disparity.ptr<float>(y);
-    for (int x = std::max(0, xi - radius); x <= std::min(disparity.cols - 1, xi + radius); ++x) {
-      if (!(row[x] >= 0.0f)) continue;
+  for (int y = std::max(0, yi - radius); y <= std::min(rows - 1, yi + radius); ++y) {
+    for (int x = std::max(0, xi - radius); x <= std::min(cols - 1, xi + radius); ++x) {
+      const float d = at(x, y);
+      if (!(d >= 0.0f)) continue;
       const double dist2 = (x - u) * (x - u) + (y - v) * (y - v);
       if (dist2 < best_dist2) {
         best_dist2 = dist2;
-        best = row[x];
+        best = d;
       }
     }
   }
@@ -54,7 +58,8 @@ float SampleNearest(const cv::Mat& disparity, double u, double v, int radius) {
 
 // Bilinear interpolation over the valid pixels of the 2x2 neighbourhood of (u, v), weights
 // renormalised; falls back to SampleNearest at depth edges or without valid weight.
-float SampleBilinear(const cv::Mat& disparity, double u, double v,
+template <class At>
+float SampleBilinear(const At& at, int rows, int cols, double u, double v,
                      const DepthSamplingOptions& options) {
   const int x0 = static_cast<int>(std::floor(u));
   const int y0 = static_cast<int>(std::floor(v));
@@ -65,14 +70,14 @@ float SampleBilinear(const cv::Mat& disparity, double u, double v,
   float hi = -std::numeric_limits<float>::infinity();
   for (int dy = 0; dy <= 1; ++dy) {
     const int y = y0 + dy;
-    if (y < 0 || y >= disparity.rows) continue;
+    if (y < 0 || y >= rows) continue;
     for (int dx = 0; dx <= 1; ++dx) {
       const int x = x0 + dx;
-      if (x < 0 || x >= disparity.cols) continue;
-      const float d = disparity.at<float>(y, x);
-      if (!(d >= 0.0f)) continue;
+      if (x < 0 || x >= cols) continue;
       const double w = (dx ? ax : 1.0 - ax) * (dy ? ay : 1.0 - ay);
       if (w <= 0.0) continue;
+      const float d = at(x, y);
+      if (!(d >= 0.0f)) continue;
       sum_w += w;
       sum_wd += w * d;
       lo = std::min(lo, d);
@@ -80,9 +85,30 @@ float SampleBilinear(const cv::Mat& disparity, double u, double v,
     }
   }
   if (sum_w <= 0.0 || hi - lo > options.max_spread_px) {
-    return SampleNearest(disparity, u, v, options.search_radius_px);
+    return SampleNearest(at, rows, cols, u, v, options.search_radius_px);
   }
   return static_cast<float>(sum_wd / sum_w);
+}
+
+// Texture-filter threshold on the window SUM of |I(x+1) - I(x-1)| (an integer): the window
+// mean is below 2 · min_texture exactly when the sum is below this.
+int MinTextureSum(const DisparityOptions& o) {
+  return static_cast<int>(std::ceil(2.0 * o.min_texture * o.block_size * o.block_size));
+}
+
+// That sum at one pixel, borders replicated (as cv::Sobel + cv::boxFilter with
+// BORDER_REPLICATE in the dense path).
+int TextureSum(const cv::Mat& image, int x, int y, int half) {
+  const int w = image.cols, h = image.rows;
+  int sum = 0;
+  for (int dy = -half; dy <= half; ++dy) {
+    const uint8_t* row = image.ptr<uint8_t>(std::min(std::max(y + dy, 0), h - 1));
+    for (int dx = -half; dx <= half; ++dx) {
+      const int xc = std::min(std::max(x + dx, 0), w - 1);
+      sum += std::abs(row[std::min(xc + 1, w - 1)] - row[std::max(xc - 1, 0)]);
+    }
+  }
+  return sum;
 }
 
 }  // namespace
@@ -174,6 +200,11 @@ struct DisparityEstimator::Impl {
   cv::Mat padded_a, padded_b, flipped_a, flipped_b, raw_fixed;
   cv::Mat left_fixed, right_fixed;  // CV_16S, 1/16 px, cropped to the image
   cv::Mat gradient, texture, low_texture;
+  // PrepareAtPixels: the pair's left image (texture filter), per-pixel caches of the left
+  // (post-filtered) and right views in 1/16 px (kUnevaluated until computed), counts.
+  bool prepared = false;
+  cv::Mat sparse_image, sparse_left, sparse_right;
+  PixelCounts counts;
 };
 
 namespace {
@@ -218,38 +249,64 @@ DisparityEstimator::DisparityEstimator(const DisparityOptions& options)
 
 DisparityEstimator::~DisparityEstimator() = default;
 
-DisparityResult DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& right) {
-  DisparityResult result;
-  const DisparityOptions& o = options_;
+namespace {
+
+// Value of a sparse cache entry not computed yet.
+constexpr int16_t kUnevaluated = INT16_MIN;
+
+// The checks Compute and PrepareAtPixels share; false with result->message set.
+bool CheckPair(const DisparityOptions& o, const cv::Mat& left, const cv::Mat& right,
+               int num_disparities, DisparityResult* result) {
   std::string error;
   if (!o.IsValid(&error)) {
-    result.message = "invalid DisparityOptions: " + error;
-    return result;
+    result->message = "invalid DisparityOptions: " + error;
+    return false;
+  }
+  if (num_disparities != 0 && (num_disparities < 16 || num_disparities % 16 != 0)) {
+    result->message = "num_disparities must be 0 (the options') or a positive multiple of 16, got " +
+                      std::to_string(num_disparities);
+    return false;
   }
   // Inputs: rectified 8-bit grey pair of one size.
   if (left.empty() || right.empty()) {
-    result.message = "left and right images must be non-empty (left is " + DescribeMat(left) +
-                     ", right is " + DescribeMat(right) + ")";
-    return result;
+    result->message = "left and right images must be non-empty (left is " + DescribeMat(left) +
+                      ", right is " + DescribeMat(right) + ")";
+    return false;
   }
   if (left.type() != CV_8UC1 || right.type() != CV_8UC1) {
-    result.message = "left and right images must be CV_8UC1 (left is " + DescribeMat(left) +
-                     ", right is " + DescribeMat(right) + ")";
-    return result;
+    result->message = "left and right images must be CV_8UC1 (left is " + DescribeMat(left) +
+                      ", right is " + DescribeMat(right) + ")";
+    return false;
   }
   if (left.size() != right.size()) {
-    result.message = "left and right images must have the same size (left is " + DescribeMat(left) +
-                     ", right is " + DescribeMat(right) + ")";
-    return result;
+    result->message = "left and right images must have the same size (left is " +
+                      DescribeMat(left) + ", right is " + DescribeMat(right) + ")";
+    return false;
   }
-  const int max_disparity = o.min_disparity_px + o.num_disparities - 1;
+  const int nd = num_disparities > 0 ? num_disparities : o.num_disparities;
+  const int max_disparity = o.min_disparity_px + nd - 1;
   if (left.rows < o.block_size || left.cols < o.block_size ||
       (!o.full_width && left.cols <= max_disparity + o.block_size)) {
     std::ostringstream msg;
     msg << "image " << DescribeMat(left) << " is too small for block_size " << o.block_size
         << (o.full_width ? "" : " and the disparity search range (full_width = false)");
-    result.message = msg.str();
-    return result;
+    result->message = msg.str();
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+DisparityResult DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& right,
+                                            int num_disparities) {
+  DisparityResult result;
+  const DisparityOptions& o = options_;
+  if (!CheckPair(o, left, right, num_disparities, &result)) return result;
+  const int nd = num_disparities > 0 ? num_disparities : o.num_disparities;
+  const int max_disparity = o.min_disparity_px + nd - 1;
+  if (impl_->matcher && impl_->matcher->getNumDisparities() != nd) {
+    impl_->matcher->setNumDisparities(nd);
   }
 
   Impl& s = *impl_;
@@ -275,13 +332,14 @@ DisparityResult DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& 
   };
 
   // Confidence (texture) filter input, SVS style: mean |I(x+1) - I(x-1)| over the window.
+  // Compared as a window sum (integer, so the pixel-wise evaluation gets the same answer).
   const bool texture_filter = o.min_texture > 0.0;
-  const float min_texture_sum = static_cast<float>(2.0 * o.min_texture);
+  const int min_texture_sum = MinTextureSum(o);
   if (texture_filter) {
     cv::Sobel(left, s.gradient, CV_16S, 1, 0, /*ksize=*/1, 1.0, 0.0, cv::BORDER_REPLICATE);
     cv::convertScaleAbs(s.gradient, s.gradient);  // |I(x+1) - I(x-1)|, CV_8U
-    cv::boxFilter(s.gradient, s.texture, CV_32F, cv::Size(o.block_size, o.block_size),
-                  cv::Point(-1, -1), /*normalize=*/true, cv::BORDER_REPLICATE);
+    cv::boxFilter(s.gradient, s.texture, CV_32S, cv::Size(o.block_size, o.block_size),
+                  cv::Point(-1, -1), /*normalize=*/false, cv::BORDER_REPLICATE);
   }
 
   const bool lr_check = o.left_right_max_diff_px > 0.0;
@@ -293,7 +351,8 @@ DisparityResult DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& 
       cv::compare(s.texture, min_texture_sum, s.low_texture, cv::CMP_LT);
       discard = &s.low_texture;
     }
-    s.sad->Compute(left, right, &s.left_fixed, lr_check ? &s.right_fixed : nullptr, discard);
+    s.sad->Compute(left, right, &s.left_fixed, lr_check ? &s.right_fixed : nullptr, discard,
+                   nd);
   } else {
     // Correlation along the epipolar lines, sub-pixel (1/16 px), left view.
     match(*s.matcher, left, right, &s.left_fixed);
@@ -315,7 +374,7 @@ DisparityResult DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& 
   for (int y = 0; y < left.rows; ++y) {
     int16_t* d_row = s.left_fixed.ptr<int16_t>(y);
     const int16_t* r_row = lr_check ? s.right_fixed.ptr<int16_t>(y) : nullptr;
-    const float* t_row = texture_filter ? s.texture.ptr<float>(y) : nullptr;
+    const int* t_row = texture_filter ? s.texture.ptr<int>(y) : nullptr;
     for (int x = 0; x < left.cols; ++x) {
       const int16_t d = d_row[x];
       if (d < min_fixed) {
@@ -359,6 +418,74 @@ DisparityResult DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& 
   return result;
 }
 
+DisparityResult DisparityEstimator::PrepareAtPixels(const cv::Mat& left, const cv::Mat& right,
+                                                    int num_disparities) {
+  DisparityResult result;
+  Impl& s = *impl_;
+  s.prepared = false;
+  s.counts = PixelCounts();
+  if (!CheckPair(options_, left, right, num_disparities, &result)) return result;
+  if (!s.sad) {
+    result.message = std::string("disparity at single pixels needs algorithm ") +
+                     ToString(DisparityAlgorithm::kBlockMatchingOneVolume) + ", not " +
+                     ToString(options_.algorithm);
+    return result;
+  }
+  s.sad->Prepare(left, right, num_disparities);
+  left.copyTo(s.sparse_image);
+  s.sparse_left.create(left.size(), CV_16S);
+  s.sparse_left.setTo(kUnevaluated);
+  s.sparse_right.create(left.size(), CV_16S);
+  s.sparse_right.setTo(kUnevaluated);
+  s.prepared = true;
+  result.ok = true;
+  return result;
+}
+
+float DisparityEstimator::DisparityAt(int x, int y) {
+  Impl& s = *impl_;
+  if (!s.prepared || x < 0 || y < 0 || x >= s.sparse_left.cols || y >= s.sparse_left.rows) {
+    return kInvalidDisparity;
+  }
+  int16_t& cached = s.sparse_left.at<int16_t>(y, x);
+  if (cached != kUnevaluated) return cached < 0 ? kInvalidDisparity : cached / 16.0f;
+  const DisparityOptions& o = options_;
+  ++s.counts.left;
+  // The post-filters of Compute, in its order of effect (texture first: it needs no costs).
+  cached = kInvalidFixed;
+  if (o.min_texture > 0.0 &&
+      TextureSum(s.sparse_image, x, y, o.block_size / 2) < MinTextureSum(o)) {
+    ++s.counts.rejected_texture;
+    return kInvalidDisparity;
+  }
+  const int16_t d = s.sad->LeftAt(x, y);
+  const int min_fixed = o.min_disparity_px * kDisparityScale;
+  if (d < min_fixed) return kInvalidDisparity;
+  const int x_r_fixed = x * kDisparityScale - d + kDisparityScale / 2;
+  if (x_r_fixed < 0) return kInvalidDisparity;  // lands left of the right image
+  if (o.left_right_max_diff_px > 0.0) {
+    const int x_r = x_r_fixed / kDisparityScale;
+    int16_t& d_r = s.sparse_right.at<int16_t>(y, x_r);
+    if (d_r == kUnevaluated) {
+      d_r = s.sad->RightAt(x_r, y);
+      ++s.counts.right;
+    }
+    if (d_r < min_fixed ||
+        std::abs(static_cast<int>(d) - d_r) > o.left_right_max_diff_px * kDisparityScale) {
+      ++s.counts.rejected_left_right;
+      return kInvalidDisparity;
+    }
+  }
+  cached = d;
+  return d / 16.0f;
+}
+
+DisparityEstimator::PixelCounts DisparityEstimator::pixel_counts() const { return impl_->counts; }
+
+cv::Size DisparityEstimator::prepared_size() const {
+  return impl_->prepared ? impl_->sparse_left.size() : cv::Size();
+}
+
 DisparityResult ComputeDisparity(const cv::Mat& left, const cv::Mat& right,
                                  const DisparityOptions& options) {
   DisparityEstimator estimator(options);
@@ -368,8 +495,13 @@ DisparityResult ComputeDisparity(const cv::Mat& left, const cv::Mat& right,
 // ------------------------------------------------------------------------------------------
 // Features <- disparity
 
-AttachDepthResult AttachDepth(const cv::Mat& disparity, const StereoCamera& cam,
-                              std::vector<Feature>* features, const DepthSamplingOptions& options) {
+namespace {
+
+// AttachDepth over a disparity read through at(x, y) on a rows x cols grid.
+template <class At>
+AttachDepthResult AttachDepthWith(const At& at, int rows, int cols, const StereoCamera& cam,
+                                  std::vector<Feature>* features,
+                                  const DepthSamplingOptions& options) {
   AttachDepthResult result;
   std::string error;
   if (features == nullptr) {
@@ -384,14 +516,10 @@ AttachDepthResult AttachDepth(const cv::Mat& disparity, const StereoCamera& cam,
     result.message = "invalid StereoCamera: " + error;
     return result;
   }
-  if (disparity.empty() || disparity.type() != CV_32FC1) {
-    result.message = "disparity must be a non-empty CV_32FC1 map, got " + DescribeMat(disparity);
-    return result;
-  }
-  if (disparity.cols != cam.width || disparity.rows != cam.height) {
+  if (cols != cam.width || rows != cam.height) {
     std::ostringstream msg;
-    msg << "disparity is " << disparity.cols << "x" << disparity.rows << " but the camera is "
-        << cam.width << "x" << cam.height;
+    msg << "disparity is " << cols << "x" << rows << " but the camera is " << cam.width << "x"
+        << cam.height;
     result.message = msg.str();
     return result;
   }
@@ -402,11 +530,11 @@ AttachDepthResult AttachDepth(const cv::Mat& disparity, const StereoCamera& cam,
     const double u = f.uv_px.x();
     const double v = f.uv_px.y();
     float d = kInvalidDisparity;
-    if (std::isfinite(u) && std::isfinite(v) && u > -0.5 && v > -0.5 && u < disparity.cols - 0.5 &&
-        v < disparity.rows - 0.5) {
+    if (std::isfinite(u) && std::isfinite(v) && u > -0.5 && v > -0.5 && u < cols - 0.5 &&
+        v < rows - 0.5) {
       d = options.sampling == DisparitySampling::kNearest
-              ? SampleNearest(disparity, u, v, options.search_radius_px)
-              : SampleBilinear(disparity, u, v, options);
+              ? SampleNearest(at, rows, cols, u, v, options.search_radius_px)
+              : SampleBilinear(at, rows, cols, u, v, options);
     }
     if (d > 0.0f && d >= min_d && d <= max_d) {
       f.disparity_px = d;
@@ -420,6 +548,36 @@ AttachDepthResult AttachDepth(const cv::Mat& disparity, const StereoCamera& cam,
   }
   result.ok = true;
   return result;
+}
+
+}  // namespace
+
+AttachDepthResult AttachDepth(const cv::Mat& disparity, const StereoCamera& cam,
+                              std::vector<Feature>* features, const DepthSamplingOptions& options) {
+  if (disparity.empty() || disparity.type() != CV_32FC1) {
+    AttachDepthResult result;
+    result.message = "disparity must be a non-empty CV_32FC1 map, got " + DescribeMat(disparity);
+    return result;
+  }
+  const auto at = [&disparity](int x, int y) { return disparity.at<float>(y, x); };
+  return AttachDepthWith(at, disparity.rows, disparity.cols, cam, features, options);
+}
+
+AttachDepthResult AttachDepth(DisparityEstimator* estimator, const StereoCamera& cam,
+                              std::vector<Feature>* features, const DepthSamplingOptions& options) {
+  if (estimator == nullptr) {
+    AttachDepthResult result;
+    result.message = "estimator must not be null";
+    return result;
+  }
+  const cv::Size size = estimator->prepared_size();
+  if (size.width == 0) {
+    AttachDepthResult result;
+    result.message = "the estimator holds no prepared pair (PrepareAtPixels)";
+    return result;
+  }
+  const auto at = [estimator](int x, int y) { return estimator->DisparityAt(x, y); };
+  return AttachDepthWith(at, size.height, size.width, cam, features, options);
 }
 
 int DropFeaturesWithoutDepth(std::vector<Feature>* features) {

@@ -97,9 +97,33 @@ class DisparityEstimator {
   DisparityEstimator& operator=(const DisparityEstimator&) = delete;
 
   // Disparity of the left image. left/right: rectified CV_8UC1 of the same non-empty size
-  // (wider than the search range when full_width is false). Never throws; rejected inputs
+  // (wider than the search range when full_width is false). num_disparities: this pair's
+  // search range (a multiple of 16, >= 16), 0 = the options'. Never throws; rejected inputs
   // or options give ok = false and a message.
-  DisparityResult Compute(const cv::Mat& left, const cv::Mat& right);
+  DisparityResult Compute(const cv::Mat& left, const cv::Mat& right, int num_disparities = 0);
+
+  // Disparity only where it is read (algorithm kBlockMatchingOneVolume only):
+  // PrepareAtPixels() takes the pair (same checks as Compute; result.disparity_px stays
+  // empty), then DisparityAt(x, y) evaluates one left pixel on first use (later calls read it
+  // back). Each pixel gets exactly the value of Compute's map with speckle_window_size = 0 —
+  // the same prefilter, window costs, uniqueness test, sub-pixel step, texture filter and
+  // left-right check (its right-view pixel evaluated alone as well) — bit for bit; the
+  // speckle filter, a whole-map operation, is not applied. Costs about
+  // 2 · block_size² · num_disparities / 16 vector operations per pixel, against the dense
+  // map's ~4 · num_disparities / 16 per pixel of the whole image.
+  DisparityResult PrepareAtPixels(const cv::Mat& left, const cv::Mat& right,
+                                  int num_disparities = 0);
+  // Disparity (pixels, 1/16 px steps) of the left pixel (x, y) of the prepared pair, or
+  // kInvalidDisparity (also outside the image or before a successful PrepareAtPixels).
+  float DisparityAt(int x, int y);
+  // Counts since the last PrepareAtPixels: left pixels evaluated, right-view pixels evaluated
+  // for their left-right check, and pixels removed by each post-filter.
+  struct PixelCounts {
+    int left = 0, right = 0, rejected_texture = 0, rejected_left_right = 0;
+  };
+  PixelCounts pixel_counts() const;
+  // Size of the pair of the last successful PrepareAtPixels (0 x 0 when none).
+  cv::Size prepared_size() const;
 
   const DisparityOptions& options() const { return options_; }
 
@@ -147,6 +171,13 @@ struct AttachDepthResult {
 // images). Features outside the map, on invalid disparity, with d <= 0, or with depth outside
 // [min_depth_m, max_depth_m] get disparity_px = -1 and p_cam0 = NaN.
 AttachDepthResult AttachDepth(const cv::Mat& disparity, const StereoCamera& cam,
+                              std::vector<Feature>* features,
+                              const DepthSamplingOptions& options = DepthSamplingOptions());
+
+// The same, reading the disparity from a DisparityEstimator prepared with PrepareAtPixels on
+// images of cam's size: only the pixels the sampling reads are evaluated, and the result
+// equals AttachDepth on Compute's map (speckle filter off) bit for bit.
+AttachDepthResult AttachDepth(DisparityEstimator* estimator, const StereoCamera& cam,
                               std::vector<Feature>* features,
                               const DepthSamplingOptions& options = DepthSamplingOptions());
 

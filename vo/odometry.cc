@@ -201,6 +201,18 @@ bool OdometryOptions::IsValid(std::string* error) const {
     msg << "disparity_min_depth_m must be finite and > 0, got " << disparity_min_depth_m;
   } else if (max_num_disparities < 16 || max_num_disparities % 16 != 0) {
     msg << "max_num_disparities must be a multiple of 16 and >= 16, got " << max_num_disparities;
+  } else if (disparity_mode != DisparityMode::kDense &&
+             disparity_mode != DisparityMode::kAtFeatures) {
+    msg << "disparity_mode: unknown value " << static_cast<int>(disparity_mode);
+  } else if (disparity_mode == DisparityMode::kAtFeatures &&
+             disparity.algorithm != DisparityAlgorithm::kBlockMatchingOneVolume) {
+    msg << "disparity_mode at_features needs disparity.algorithm "
+        << ToString(DisparityAlgorithm::kBlockMatchingOneVolume) << " (got "
+        << ToString(disparity.algorithm) << "); use disparity_mode dense with it";
+  } else if (!(disparity_range_margin >= 0.0) || !std::isfinite(disparity_range_margin) ||
+             !(disparity_range_margin_px >= 0.0) || !std::isfinite(disparity_range_margin_px)) {
+    msg << "disparity_range_margin and disparity_range_margin_px must be finite and >= 0, got "
+        << disparity_range_margin << " and " << disparity_range_margin_px;
   } else if (ba_window_frames < 3 || ba_window_frames > 10) {
     msg << "ba_window_frames must be in [3, 10], got " << ba_window_frames;
   } else if (ba.num_fixed_poses >= ba_window_frames) {
@@ -228,6 +240,26 @@ bool OdometryOptions::IsValid(std::string* error) const {
   }
   if (msg.tellp() != 0) return Fail(msg, error);
   return true;
+}
+
+const char* ToString(DisparityMode mode) {
+  switch (mode) {
+    case DisparityMode::kDense:
+      return "dense";
+    case DisparityMode::kAtFeatures:
+      return "at_features";
+  }
+  return "unknown";
+}
+
+bool ParseDisparityMode(const std::string& name, DisparityMode* mode) {
+  for (DisparityMode m : {DisparityMode::kDense, DisparityMode::kAtFeatures}) {
+    if (name == ToString(m)) {
+      *mode = m;
+      return true;
+    }
+  }
+  return false;
 }
 
 const char* ToString(PredictionSource source) {
@@ -314,6 +346,7 @@ void StereoOdometry::Reset() {
   T_world_prev_ = Eigen::Isometry3d::Identity();
   velocity_ = Eigen::Isometry3d::Identity();
   has_velocity_ = false;
+  scene_num_disparities_ = 0;
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
@@ -336,6 +369,20 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
   result.T_prev_curr = result.frame_index == 0 ? Eigen::Isometry3d::Identity()
                                                : Eigen::Isometry3d(T_world_prev_.inverse() * T);
   T_world_prev_ = T;
+  // Next frame's disparity search range from the depths of this one (full after a loss).
+  scene_num_disparities_ = 0;
+  if (options_.disparity_range_from_scene && result.status != TrackingStatus::kLost) {
+    double max_disparity = 0.0;
+    for (const Feature& f : last_features_) {
+      if (f.has_depth()) max_disparity = std::max(max_disparity, f.disparity_px);
+    }
+    const double wanted = max_disparity * (1.0 + options_.disparity_range_margin) +
+                          options_.disparity_range_margin_px;
+    const int n = 16 * static_cast<int>(std::ceil(wanted / 16.0));
+    if (max_disparity > 0.0 && n < options_.disparity.num_disparities) {
+      scene_num_disparities_ = std::max(16, n);
+    }
+  }
   previous_left_ = current_left_;
   current_left_ = cv::Mat();
   result.times.total_ms = MsSince(start);
@@ -789,9 +836,17 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
 
   current_left_ = left.clone();  // the caller may reuse its buffer
 
-  // Dense disparity.
+  // Disparity: the whole map (dense mode, or the first frame's plane-based orientation), or
+  // its pixels prepared for evaluation where the features read them.
+  const bool orientation_frame =
+      !reference_.valid && !initialised_ && options_.estimate_initial_orientation;
+  const bool dense = options_.disparity_mode == DisparityMode::kDense || orientation_frame;
+  result.num_disparities = scene_num_disparities_ > 0 ? scene_num_disparities_
+                                                      : options_.disparity.num_disparities;
   Clock::time_point t = Clock::now();
-  const DisparityResult disparity = disparity_->Compute(left, right);
+  const DisparityResult disparity =
+      dense ? disparity_->Compute(left, right, result.num_disparities)
+            : disparity_->PrepareAtPixels(left, right, result.num_disparities);
   result.times.disparity_ms = MsSince(t);
   if (!disparity.ok)
     return Lost(std::move(result), "disparity: " + disparity.message, start, prior);
@@ -809,7 +864,16 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
 
   // Depth from the disparity map; features without depth are dropped (with their descriptors).
   t = Clock::now();
-  AttachDepth(disparity.disparity_px, camera_, &set.features, options_.depth);
+  if (dense) {
+    AttachDepth(disparity.disparity_px, camera_, &set.features, options_.depth);
+    result.disparity_pixels = camera_.width * camera_.height;
+  } else {
+    AttachDepth(disparity_.get(), camera_, &set.features, options_.depth);
+    const DisparityEstimator::PixelCounts counts = disparity_->pixel_counts();
+    result.disparity_pixels = counts.left + counts.right;
+    result.times.disparity_ms += MsSince(t);  // the evaluation is the disparity stage's work
+    t = Clock::now();
+  }
   MatchFrame frame;
   frame.frame_id = result.frame_index;
   std::vector<int> kept;

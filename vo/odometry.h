@@ -1,10 +1,13 @@
 // The stereo visual-odometry pipeline: one call per stereo pair, the camera's pose back.
 // Kwolek, PAPER.md (the whole table), sections IV–V of the paper:
 //
-//   frame 0      disparity → features (left image) → depth → [plane-based initial orientation]
-//   frame k > 0  disparity (area-based, texture filter, left-right check)       disparity.h
+//   frame 0      dense disparity → features (left image) → depth → [plane-based initial
+//                orientation]
+//   frame k > 0  disparity prepared (area-based; search range from the scene)  disparity.h
 //                → features (Harris | SIFT, bucketed)                           features.h
-//                → AttachDepth, features without depth dropped                 disparity.h
+//                → AttachDepth: the disparity evaluated at the pixels the features read
+//                  (texture filter, uniqueness, left-right check; disparity_mode dense = the
+//                  whole map), features without depth dropped                   disparity.h
 //                → match to the reference frame (SVD · NCC · Gabor by default)  matcher.h
 //                → RANSAC + Horn (T_ref_curr), seeded by track ages             ransac.h
 //                → tracks (inlier matches only)                                 tracks.h
@@ -179,12 +182,34 @@ struct MotionPrior {
   Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
 };
 
+// Where the pipeline evaluates the disparity.
+enum class DisparityMode {
+  kDense,       // the whole map of every frame (any disparity.algorithm; the speckle filter)
+  kAtFeatures,  // only the pixels the features' depth sampling reads, and the right-view
+                // pixels of their left-right check (DisparityEstimator::PrepareAtPixels):
+                // the same values as the dense map there without its speckle filter, bit for
+                // bit; needs disparity.algorithm block_matching_one_volume. The first frame's
+                // plane-based orientation still reads a dense map (that one frame)
+};
+// "dense", "at_features".
+const char* ToString(DisparityMode mode);
+bool ParseDisparityMode(const std::string& name, DisparityMode* mode);
+
 struct OdometryOptions {
   DetectorOptions detector = DefaultOdometryDetectorOptions();  // feature detection (left)
   DisparityOptions disparity =
-      DefaultOdometryDisparityOptions();  // dense disparity;
+      DefaultOdometryDisparityOptions();  // the block matcher and its post-filters;
                                           // num_disparities is replaced by the value
                                           // derived from the camera when derive_num_disparities
+  DisparityMode disparity_mode = DisparityMode::kAtFeatures;  // see DisparityMode
+  bool disparity_range_from_scene = true;  // search range per frame from the depths seen:
+                                           // the previous frame's largest feature disparity
+                                           // · (1 + disparity_range_margin) +
+                                           // disparity_range_margin_px, rounded up to 16 and
+                                           // at most the camera-derived range; the full range
+                                           // on the first frame and after a lost frame
+  double disparity_range_margin = 0.25;     // relative margin of that range, >= 0
+  double disparity_range_margin_px = 8.0;   // absolute margin (pixels), >= 0
   bool derive_num_disparities = true;     // search range from the camera: the smallest multiple
                                        // of 16 >= fx · baseline / disparity_min_depth_m, clamped
                                        // to [16, max_num_disparities] (and < image width)
@@ -267,7 +292,7 @@ const char* ToString(TrackingStatus status);
 // Wall-clock time of each stage of one frame (milliseconds, std::chrono::steady_clock);
 // 0 for stages that did not run.
 struct StageTimes {
-  double disparity_ms = 0.0;    // dense disparity
+  double disparity_ms = 0.0;    // disparity (dense map, or the features' pixels)
   double detect_ms = 0.0;       // feature detection
   double depth_ms = 0.0;        // AttachDepth + dropping features without depth
   double match_ms = 0.0;        // inter-frame matching (cue computation included)
@@ -322,6 +347,10 @@ struct OdometryResult {
   Eigen::Vector2d image_shift_px = Eigen::Vector2d::Zero();  // that shift (pixels), when ok
   int num_first_pass_inliers = 0;  // inliers of the first (prior-centred) pass, before the
                                    // coarse-to-fine and guided passes
+  int num_disparities = 0;           // the disparity search range of this frame (pixels)
+  int disparity_pixels = 0;          // pixels whose disparity was evaluated (the whole image
+                                     // with disparity_mode dense; left + right-view pixels
+                                     // with at_features)
   StageTimes times;
   bool initial_orientation_ok = false;  // first frame only: the hallway orientation was found
                                         // and defines the world frame
@@ -480,6 +509,7 @@ class StereoOdometry {
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();      // constant-velocity model: last
                                                                 // estimated per-frame T_prev_curr
   bool has_velocity_ = false;
+  int scene_num_disparities_ = 0;  // next frame's search range from the scene; 0 = full
 
   Eigen::Matrix3d R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   PlaneOrientationResult orientation_result_;

@@ -20,23 +20,42 @@ namespace {
 
 constexpr int16_t kNoCost = INT16_MAX;
 
-// cv::StereoBM's PREFILTER_XSOBEL: the 3x3 x-Sobel response clipped to [-cap, cap] and offset
-// by cap (so 0..2 cap), rows mirrored at the top and bottom (reflect-101), the first and last
-// columns set to cap (no gradient).
-void PrefilterXSobel(const cv::Mat& src, int cap, cv::Mat* dst) {
-  dst->create(src.size(), CV_8UC1);
+// cv::StereoBM's PREFILTER_XSOBEL of the image padded by `pad_left` columns on the left,
+// `half` on the right and `half` rows above and below (BORDER_REPLICATE): the 3x3 x-Sobel
+// response clipped to [-cap, cap] and offset by cap (so 0..2 cap), the padded image's rows
+// mirrored at its top and bottom (reflect-101), its first and last columns set to cap.
+// Computed from the unpadded image without building the padded one: replicated rows and
+// columns make reflect-101 on the padded image the same as clamping into the image, and every
+// padding column has equal neighbours (response 0, value cap).
+void PrefilterXSobelPadded(const cv::Mat& src, int cap, int pad_left, int half, cv::Mat* dst) {
   const int w = src.cols, h = src.rows;
-  for (int y = 0; y < h; ++y) {
-    const int y0 = y > 0 ? y - 1 : std::min(1, h - 1);
-    const int y2 = y < h - 1 ? y + 1 : std::max(h - 2, 0);
-    const uint8_t* r0 = src.ptr<uint8_t>(y0);
-    const uint8_t* r1 = src.ptr<uint8_t>(y);
-    const uint8_t* r2 = src.ptr<uint8_t>(y2);
-    uint8_t* out = dst->ptr<uint8_t>(y);
-    out[0] = out[w - 1] = static_cast<uint8_t>(cap);
-    for (int x = 1; x < w - 1; ++x) {
-      const int v = (r0[x + 1] - r0[x - 1]) + 2 * (r1[x + 1] - r1[x - 1]) + (r2[x + 1] - r2[x - 1]);
-      out[x] = static_cast<uint8_t>(std::min(std::max(v, -cap), cap) + cap);
+  dst->create(h + 2 * half, w + pad_left + half, CV_8UC1);
+  std::vector<int16_t> diff(3 * static_cast<size_t>(w));
+  for (int Y = 0; Y < dst->rows; ++Y) {
+    uint8_t* out = dst->ptr<uint8_t>(Y);
+    std::fill(out, out + pad_left, static_cast<uint8_t>(cap));
+    std::fill(out + pad_left + w, out + dst->cols, static_cast<uint8_t>(cap));
+    // Rows Y - 1, Y, Y + 1 of the padded image, clamped into the source.
+    for (int r = 0; r < 3; ++r) {
+      const int y = std::min(std::max(Y - half - 1 + r, 0), h - 1);
+      const uint8_t* row = src.ptr<uint8_t>(y);
+      int16_t* d = &diff[static_cast<size_t>(r) * w];
+      if (w == 1) {
+        d[0] = 0;
+        continue;
+      }
+      d[0] = static_cast<int16_t>(row[1] - row[0]);
+      for (int x = 1; x < w - 1; ++x) d[x] = static_cast<int16_t>(row[x + 1] - row[x - 1]);
+      d[w - 1] = static_cast<int16_t>(row[w - 1] - row[w - 2]);
+    }
+    const int16_t* d0 = &diff[0];
+    const int16_t* d1 = &diff[static_cast<size_t>(w)];
+    const int16_t* d2 = &diff[2 * static_cast<size_t>(w)];
+    uint8_t* o = out + pad_left;
+    const int16_t lo = static_cast<int16_t>(-cap), hi = static_cast<int16_t>(cap);
+    for (int x = 0; x < w; ++x) {
+      const int16_t v = static_cast<int16_t>(d0[x] + 2 * d1[x] + d2[x]);
+      o[x] = static_cast<uint8_t>(std::min(std::max(v, lo), hi) + cap);
     }
   }
 }
@@ -72,8 +91,21 @@ inline void UpdateColumn(int16_t* colsum, uint8_t a_add, const uint8_t* r_add, u
 #endif
 }
 
+// colsum[k] += |a - r[k]|.
 inline void AddColumn(int16_t* colsum, uint8_t a, const uint8_t* r, int n) {
+#ifdef __SSE2__
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i va = _mm_set1_epi8(static_cast<char>(a));
+  for (int k = 0; k < n; k += 16) {
+    const __m128i rv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r + k));
+    const __m128i d = _mm_or_si128(_mm_subs_epu8(va, rv), _mm_subs_epu8(rv, va));
+    __m128i* c = reinterpret_cast<__m128i*>(colsum + k);
+    _mm_storeu_si128(c, _mm_add_epi16(_mm_loadu_si128(c), _mm_unpacklo_epi8(d, zero)));
+    _mm_storeu_si128(c + 1, _mm_add_epi16(_mm_loadu_si128(c + 1), _mm_unpackhi_epi8(d, zero)));
+  }
+#else
   for (int k = 0; k < n; ++k) colsum[k] = static_cast<int16_t>(colsum[k] + AbsDiff(a, r[k]));
+#endif
 }
 
 // c[k] = prev[k] + add[k] - sub[k]: the window cost one pixel to the right.
@@ -208,6 +240,13 @@ inline int16_t SubPixel(int d, int c, int p, int n) {
 
 namespace {
 
+// Largest window side of the sparse evaluation (SadBlockMatcherOptions::IsValid bounds the
+// window by its 16-bit cost: block_size <= 127 even at prefilter_cap 1).
+constexpr int kMaxWindow = 129;
+
+// Uniqueness threshold of a best cost v: v (1 + uniqueness_ratio / 100), in 1/256 steps.
+inline int Threshold(int v, int uniq256) { return v + ((v * uniq256) >> 8); }
+
 // Everything the row loop needs (set up by Compute).
 struct RowContext {
   int w = 0, h = 0, nd = 0, dmin = 0, win = 0, half = 0, pad_left = 0, padded_w = 0, ncols = 0,
@@ -230,7 +269,6 @@ void ProcessRows(const RowContext& c) {
   const int w = c.w, h = c.h, nd = c.nd, dmin = c.dmin, win = c.win, half = c.half;
   const int pad_left = c.pad_left, ncols = c.ncols, nq = c.nq, uniq256 = c.uniq256;
   auto base = [&](int j) { return c.padded_w - 1 - (pad_left - half + j) + dmin; };
-  auto threshold = [&](int v) { return v + ((v * uniq256) >> 8); };
   for (int y = 0; y < h; ++y) {
     if (y > 0) {  // slide the window down: add padded row y + 2 half, drop row y - 1
       const uint8_t* l_add = c.left_pf->ptr<uint8_t>(y + win - 1);
@@ -265,7 +303,7 @@ void ProcessRows(const RowContext& c) {
       int best = 0;
       int16_t best_cost = 0;
       K::ArgMin(cx, nd, &best, &best_cost);
-      if (uniq256 > 0 && !(skip && skip[x]) && K::Ambiguous(cx, nd, best, threshold(best_cost))) {
+      if (uniq256 > 0 && !(skip && skip[x]) && K::Ambiguous(cx, nd, best, Threshold(best_cost, uniq256))) {
         lout[x] = kSadInvalidFixed;
         continue;
       }
@@ -291,7 +329,7 @@ void ProcessRows(const RowContext& c) {
     std::fill(c.right_ambiguous, c.right_ambiguous + nq, 0);
     if (uniq256 > 0) {
       for (int q = 0; q < nq; ++q) {
-        c.right_thresh[q] = static_cast<int16_t>(std::min<int>(threshold(c.right_min[q]), INT16_MAX));
+        c.right_thresh[q] = static_cast<int16_t>(std::min<int>(Threshold(c.right_min[q], uniq256), INT16_MAX));
       }
       for (int start = 0; start < K::kLanes; ++start) {
         for (int x = start; x < w; x += K::kLanes) {
@@ -323,9 +361,100 @@ void ProcessRows(const RowContext& c) {
   }
 }
 
+// One left pixel of Compute's left view: its window costs summed directly (window rows and
+// columns outermost, the disparities in the vector lanes), then the same arg-min, uniqueness
+// test and sub-pixel step.
+template <class K>
+int16_t LeftAtImpl(const SadBlockMatcher::Geometry& g, const cv::Mat& left_pf,
+                   const cv::Mat& right_pf_reversed, int16_t* c, int x, int y) {
+  const int nd = g.nd;
+  // Reversed right index of column x + i's candidate k: base(x + i) + k = rev0 - i + k.
+  const int rev0 = g.padded_w - 1 - (g.pad_left - g.half + x) + g.dmin;
+  const uint8_t* a_rows[kMaxWindow];
+  const uint8_t* b_rows[kMaxWindow];
+  for (int r = 0; r < g.win; ++r) {
+    a_rows[r] = left_pf.ptr<uint8_t>(y + r) + g.pad_left - g.half + x;
+    b_rows[r] = right_pf_reversed.ptr<uint8_t>(y + r) + rev0;
+  }
+  K::WindowCosts(a_rows, b_rows, -1, g.win, nd, c);
+  int best = 0;
+  int16_t best_cost = 0;
+  K::ArgMin(c, nd, &best, &best_cost);
+  if (g.uniq256 > 0 && K::Ambiguous(c, nd, best, Threshold(best_cost, g.uniq256))) {
+    return kSadInvalidFixed;
+  }
+  const int p = best > 0 ? c[best - 1] : c[1];
+  const int n = best < nd - 1 ? c[best + 1] : c[nd - 2];
+  return SubPixel(g.dmin + best, best_cost, p, n);
+}
+
+// One right pixel of Compute's right view: the costs D[k] = C(xr + dmin + k, k) of the left
+// pixels that land on it (the right window fixed, the left one sliding with k), the minimum
+// with Compute's tie order (left pixels visited lane-interleaved: by x mod lanes, then x), its
+// uniqueness test and sub-pixel step.
+template <class K>
+int16_t RightAtImpl(const SadBlockMatcher::Geometry& g, const cv::Mat& left_pf,
+                    const cv::Mat& right_pf, int16_t* d, uint8_t* segment, int xr, int y) {
+  const int nd = g.nd;
+  const int nk = std::min(nd, g.w - xr - g.dmin);  // candidates with a left pixel x < w
+  if (nk <= 0) return kSadInvalidFixed;
+  const int l0 = g.pad_left - g.half + xr + g.dmin;  // left window column of k = 0
+  const int r0 = g.pad_left - g.half + xr;           // the right window's first column
+  const int segment_len = nd + g.win - 1;
+  const int available = std::min(segment_len, g.padded_w - l0);
+  const uint8_t* a_rows[kMaxWindow];
+  const uint8_t* b_rows[kMaxWindow];
+  for (int r = 0; r < g.win; ++r) {
+    // The left row from l0 on, zero past the padded image (only k >= nk read those).
+    uint8_t* row_segment = segment + static_cast<size_t>(r) * segment_len;
+    std::copy_n(left_pf.ptr<uint8_t>(y + r) + l0, available, row_segment);
+    std::fill(row_segment + available, row_segment + segment_len, 0);
+    a_rows[r] = right_pf.ptr<uint8_t>(y + r) + r0;
+    b_rows[r] = row_segment;
+  }
+  K::WindowCosts(a_rows, b_rows, 1, g.win, nd, d);
+  const int lanes = g.avx2 ? 16 : 8;
+  int best = -1, best_key = 0;
+  int16_t best_cost = kNoCost;
+  for (int k = 0; k < nk; ++k) {
+    const int x = xr + g.dmin + k;
+    const int key = (x % lanes) * (g.w + lanes) + x;  // Compute's visiting order
+    if (d[k] < best_cost || (best >= 0 && d[k] == best_cost && key < best_key)) {
+      best = k;
+      best_cost = d[k];
+      best_key = key;
+    }
+  }
+  if (best < 0) return kSadInvalidFixed;
+  if (g.uniq256 > 0) {
+    const int thresh = std::min(Threshold(best_cost, g.uniq256), int{INT16_MAX});
+    for (int k = 0; k < nk; ++k) {
+      if (d[k] <= thresh && (k < best - 1 || k > best + 1)) return kSadInvalidFixed;
+    }
+  }
+  const bool has_p = best > 0;
+  const bool has_n = best + 1 < nk;
+  int p = has_p ? d[best - 1] : -1;
+  int n = has_n ? d[best + 1] : -1;
+  if (!has_p) p = has_n ? n : best_cost;
+  if (!has_n) n = p;
+  return SubPixel(g.dmin + best, best_cost, p, n);
+}
+
 // The kernels of the baseline build (SSE2 on x86-64, scalar elsewhere).
 struct KernelsBaseline {
   static constexpr int kLanes = 8;  // int16 lanes of a vector
+  static void AddColumn(int16_t* colsum, uint8_t a, const uint8_t* r, int n) {
+    vo::AddColumn(colsum, a, r, n);
+  }
+  // out[k] = sum over r, i < win of |a_rows[r][i] - b_rows[r][i * b_step + k]|, k < n.
+  static void WindowCosts(const uint8_t* const* a_rows, const uint8_t* const* b_rows, int b_step,
+                          int win, int n, int16_t* out) {
+    std::fill(out, out + n, 0);
+    for (int r = 0; r < win; ++r) {
+      for (int i = 0; i < win; ++i) vo::AddColumn(out, a_rows[r][i], b_rows[r] + i * b_step, n);
+    }
+  }
   static void UpdateColumn(int16_t* colsum, uint8_t a_add, const uint8_t* r_add, uint8_t a_sub,
                            const uint8_t* r_sub, int n) {
     vo::UpdateColumn(colsum, a_add, r_add, a_sub, r_sub, n);
@@ -352,6 +481,16 @@ struct KernelsBaseline {
 __attribute__((flatten)) void ProcessRowsBaseline(const RowContext& c) {
   ProcessRows<KernelsBaseline>(c);
 }
+__attribute__((flatten)) int16_t LeftAtBaseline(const SadBlockMatcher::Geometry& g,
+                                                const cv::Mat& lpf, const cv::Mat& rrev,
+                                                int16_t* c, int x, int y) {
+  return LeftAtImpl<KernelsBaseline>(g, lpf, rrev, c, x, y);
+}
+__attribute__((flatten)) int16_t RightAtBaseline(const SadBlockMatcher::Geometry& g,
+                                                 const cv::Mat& lpf, const cv::Mat& rpf,
+                                                 int16_t* d, uint8_t* seg, int xr, int y) {
+  return RightAtImpl<KernelsBaseline>(g, lpf, rpf, d, seg, xr, y);
+}
 
 #if VO_SAD_HAVE_AVX2
 // The same kernels with 256-bit vectors (16 int16 lanes), compiled for AVX2 only here and
@@ -359,6 +498,15 @@ __attribute__((flatten)) void ProcessRowsBaseline(const RowContext& c) {
 #define VO_AVX2 __attribute__((target("avx2")))
 struct KernelsAvx2 {
   static constexpr int kLanes = 16;
+  VO_AVX2 static void AddColumn(int16_t* colsum, uint8_t a, const uint8_t* r, int n) {
+    const __m128i va = _mm_set1_epi8(static_cast<char>(a));
+    for (int k = 0; k < n; k += 16) {
+      const __m128i rv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r + k));
+      const __m128i d = _mm_or_si128(_mm_subs_epu8(va, rv), _mm_subs_epu8(rv, va));
+      __m256i* p = reinterpret_cast<__m256i*>(colsum + k);
+      _mm256_storeu_si256(p, _mm256_add_epi16(_mm256_loadu_si256(p), _mm256_cvtepu8_epi16(d)));
+    }
+  }
   VO_AVX2 static void UpdateColumn(int16_t* colsum, uint8_t a_add, const uint8_t* r_add,
                                    uint8_t a_sub, const uint8_t* r_sub, int n) {
     const __m128i va = _mm_set1_epi8(static_cast<char>(a_add));
@@ -373,6 +521,47 @@ struct KernelsAvx2 {
           _mm256_add_epi16(_mm256_loadu_si256(p), _mm256_cvtepu8_epi16(da)),
           _mm256_cvtepu8_epi16(ds));
       _mm256_storeu_si256(p, sum);
+    }
+  }
+  // WindowCosts with up to 64 disparities per pass held in registers.
+  template <int kBlocks>
+  VO_AVX2 static void WindowCostsBlock(const uint8_t* const* a_rows, const uint8_t* const* b_rows,
+                                       int b_step, int win, int k0, int16_t* out) {
+    __m256i acc[kBlocks];
+    for (int b = 0; b < kBlocks; ++b) acc[b] = _mm256_setzero_si256();
+    for (int r = 0; r < win; ++r) {
+      const uint8_t* a = a_rows[r];
+      const uint8_t* row = b_rows[r] + k0;
+      for (int i = 0; i < win; ++i) {
+        const __m128i va = _mm_set1_epi8(static_cast<char>(a[i]));
+        const uint8_t* bp = row + i * b_step;
+        for (int b = 0; b < kBlocks; ++b) {
+          const __m128i rv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bp + 16 * b));
+          const __m128i d = _mm_or_si128(_mm_subs_epu8(va, rv), _mm_subs_epu8(rv, va));
+          acc[b] = _mm256_add_epi16(acc[b], _mm256_cvtepu8_epi16(d));
+        }
+      }
+    }
+    for (int b = 0; b < kBlocks; ++b) {
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + k0 + 16 * b), acc[b]);
+    }
+  }
+  VO_AVX2 static void WindowCosts(const uint8_t* const* a_rows, const uint8_t* const* b_rows,
+                                  int b_step, int win, int n, int16_t* out) {
+    int k0 = 0;
+    for (; k0 + 64 <= n; k0 += 64) WindowCostsBlock<4>(a_rows, b_rows, b_step, win, k0, out);
+    switch ((n - k0) / 16) {
+      case 3:
+        WindowCostsBlock<3>(a_rows, b_rows, b_step, win, k0, out);
+        break;
+      case 2:
+        WindowCostsBlock<2>(a_rows, b_rows, b_step, win, k0, out);
+        break;
+      case 1:
+        WindowCostsBlock<1>(a_rows, b_rows, b_step, win, k0, out);
+        break;
+      default:
+        break;
     }
   }
   VO_AVX2 static void SlideRight(int16_t* c, const int16_t* prev, const int16_t* add,
@@ -457,6 +646,16 @@ struct KernelsAvx2 {
 VO_AVX2 __attribute__((flatten)) void ProcessRowsAvx2(const RowContext& c) {
   ProcessRows<KernelsAvx2>(c);
 }
+VO_AVX2 __attribute__((flatten)) int16_t LeftAtAvx2(const SadBlockMatcher::Geometry& g,
+                                                    const cv::Mat& lpf, const cv::Mat& rrev,
+                                                    int16_t* c, int x, int y) {
+  return LeftAtImpl<KernelsAvx2>(g, lpf, rrev, c, x, y);
+}
+VO_AVX2 __attribute__((flatten)) int16_t RightAtAvx2(const SadBlockMatcher::Geometry& g,
+                                                     const cv::Mat& lpf, const cv::Mat& rpf,
+                                                     int16_t* d, uint8_t* seg, int xr, int y) {
+  return RightAtImpl<KernelsAvx2>(g, lpf, rpf, d, seg, xr, y);
+}
 #undef VO_AVX2
 #endif  // VO_SAD_HAVE_AVX2
 
@@ -483,24 +682,59 @@ bool SadBlockMatcherOptions::IsValid(std::string* error) const {
   return false;
 }
 
-void SadBlockMatcher::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* left_fixed,
-                              cv::Mat* right_fixed, const cv::Mat* discard) {
+void SadBlockMatcher::Prepare(const cv::Mat& left, const cv::Mat& right, int num_disparities) {
   const SadBlockMatcherOptions& o = options_;
-  const int w = left.cols, h = left.rows;
-  const int nd = o.num_disparities;
-  const int dmin = o.min_disparity_px;
-  const int dmax = dmin + nd - 1;
-  const int half = o.block_size / 2;
-  const int win = o.block_size;
+  Geometry& g = geometry_;
+  g.w = left.cols;
+  g.h = left.rows;
+  g.nd = num_disparities > 0 ? num_disparities : o.num_disparities;
+  g.dmin = o.min_disparity_px;
+  g.half = o.block_size / 2;
+  g.win = o.block_size;
   // Padding: search range + half a window on the left, half a window elsewhere.
-  const int pad_left = dmax + half;
-  const int padded_w = w + pad_left + half;
-  cv::copyMakeBorder(left, padded_, half, half, pad_left, half, cv::BORDER_REPLICATE);
-  PrefilterXSobel(padded_, o.prefilter_cap, &left_pf_);
-  cv::copyMakeBorder(right, padded_, half, half, pad_left, half, cv::BORDER_REPLICATE);
-  PrefilterXSobel(padded_, o.prefilter_cap, &right_pf_);
+  g.pad_left = g.dmin + g.nd - 1 + g.half;
+  g.padded_w = g.w + g.pad_left + g.half;
+  g.uniq256 = o.uniqueness_ratio * 256 / 100;
+#if VO_SAD_HAVE_AVX2
+  g.avx2 = o.allow_avx2 && __builtin_cpu_supports("avx2");
+#else
+  g.avx2 = false;
+#endif
+  PrefilterXSobelPadded(left, o.prefilter_cap, g.pad_left, g.half, &left_pf_);
+  PrefilterXSobelPadded(right, o.prefilter_cap, g.pad_left, g.half, &right_pf_);
   // Mirrored right rows: the right pixels X - d for d = dmin, dmin + 1, ... are then contiguous.
   cv::flip(right_pf_, right_pf_reversed_, 1);
+  pixel_costs_.resize(g.nd);
+  segment_.resize(static_cast<size_t>(g.nd + g.win) * g.win);
+}
+
+int16_t SadBlockMatcher::LeftAt(int x, int y) {
+#if VO_SAD_HAVE_AVX2
+  if (geometry_.avx2) {
+    return LeftAtAvx2(geometry_, left_pf_, right_pf_reversed_, pixel_costs_.data(), x, y);
+  }
+#endif
+  return LeftAtBaseline(geometry_, left_pf_, right_pf_reversed_, pixel_costs_.data(), x, y);
+}
+
+int16_t SadBlockMatcher::RightAt(int xr, int y) {
+#if VO_SAD_HAVE_AVX2
+  if (geometry_.avx2) {
+    return RightAtAvx2(geometry_, left_pf_, right_pf_, pixel_costs_.data(), segment_.data(), xr,
+                       y);
+  }
+#endif
+  return RightAtBaseline(geometry_, left_pf_, right_pf_, pixel_costs_.data(), segment_.data(),
+                         xr, y);
+}
+
+void SadBlockMatcher::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* left_fixed,
+                              cv::Mat* right_fixed, const cv::Mat* discard, int num_disparities) {
+  Prepare(left, right, num_disparities);
+  const Geometry& g = geometry_;
+  const int w = g.w, h = g.h, nd = g.nd, dmin = g.dmin, half = g.half, win = g.win;
+  const int dmax = dmin + nd - 1;
+  const int pad_left = g.pad_left, padded_w = g.padded_w;
 
   // Column j (0 .. w + 2 half - 1) is padded column X = pad_left - half + j; its right
   // candidates for disparity index k sit at reversed index base(j) + k.
@@ -517,7 +751,7 @@ void SadBlockMatcher::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat
   right_thresh_.resize(nq);
   left_fixed->create(h, w, CV_16S);
   if (right_fixed) right_fixed->create(h, w, CV_16S);
-  const int uniq256 = o.uniqueness_ratio * 256 / 100;
+  const int uniq256 = g.uniq256;
 
   // Window of the first row: padded rows 0 .. 2 half.
   for (int r = 0; r < win; ++r) {
@@ -553,7 +787,7 @@ void SadBlockMatcher::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat
   ctx.right_fixed = right_fixed;
   ctx.discard = discard;
 #if VO_SAD_HAVE_AVX2
-  if (o.allow_avx2 && __builtin_cpu_supports("avx2")) {
+  if (g.avx2) {
     ProcessRowsAvx2(ctx);
     return;
   }

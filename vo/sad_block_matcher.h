@@ -59,18 +59,41 @@ class SadBlockMatcher {
   // where none: *left_fixed per left pixel, *right_fixed (when not null) per right pixel.
   // `discard` (optional, CV_8UC1 of the image size): nonzero marks left pixels the caller
   // throws away anyway (e.g. its texture filter); their uniqueness test is skipped, so their
-  // output may hold a non-unique estimate.
+  // output may hold a non-unique estimate. num_disparities: this pair's search range (a
+  // multiple of 16, >= 16; 0 = the options').
   void Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* left_fixed,
-               cv::Mat* right_fixed, const cv::Mat* discard = nullptr);
+               cv::Mat* right_fixed, const cv::Mat* discard = nullptr, int num_disparities = 0);
+
+  // Sparse evaluation: Prepare() prefilters and pads the pair once (same inputs as Compute,
+  // and num_disparities: the search range of this pair, a multiple of 16 >= 16, 0 = the
+  // options'); then LeftAt / RightAt give, at one pixel, exactly what Compute would write
+  // there (*left_fixed / *right_fixed, 1/16 px or kSadInvalidFixed), computing only that
+  // pixel's window costs (each window summed directly, the disparities in the SIMD lanes).
+  // Ties between equal right-view costs are broken in Compute's visiting order, so the right
+  // view matches bit for bit as well.
+  void Prepare(const cv::Mat& left, const cv::Mat& right, int num_disparities = 0);
+  int16_t LeftAt(int x, int y);    // 0 <= x < width, 0 <= y < height of the prepared pair
+  int16_t RightAt(int xr, int y);  // right-image pixel, same bounds
+  int prepared_num_disparities() const { return geometry_.nd; }
 
   const SadBlockMatcherOptions& options() const { return options_; }
 
+  // Geometry of the prepared pair (Prepare / Compute).
+  struct Geometry {
+    int w = 0, h = 0, nd = 0, dmin = 0, half = 0, win = 0, pad_left = 0, padded_w = 0,
+        uniq256 = 0;
+    bool avx2 = false;  // the AVX2 kernels are used (also sets the right view's tie order)
+  };
+
  private:
   SadBlockMatcherOptions options_;
+  Geometry geometry_;
   // Scratch, reused between calls.
-  cv::Mat padded_, left_pf_, right_pf_, right_pf_reversed_;
+  cv::Mat left_pf_, right_pf_, right_pf_reversed_;
   std::vector<int16_t> column_sums_, costs_, right_min_, right_best_, right_thresh_,
       right_ambiguous_;
+  std::vector<int16_t> pixel_costs_;  // sparse: one pixel's costs
+  std::vector<uint8_t> segment_;      // sparse right view: one window row of the left image
 };
 
 }  // namespace vo

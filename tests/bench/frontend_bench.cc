@@ -7,6 +7,9 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
+#include <map>
+#include <memory>
+#include <utility>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -170,6 +173,120 @@ void BM_AttachDepth(benchmark::State& state) {
   state.counters["features"] = static_cast<double>(features.size());
 }
 BENCHMARK(BM_AttachDepth)->Unit(benchmark::kMicrosecond);
+
+// ---- The pipeline's front end at the four camera sizes of results/speed/ -------------------
+// Arguments: width, height, num_disparities (the pipeline's camera-derived range for the
+// simulator rigs: 320x240 and 640x480 hallway heads (0.09 m) 32 and 64, EuRoC-like 752x480
+// (0.11 m) 80, KITTI-like 1241x376 (0.54 m) 256). The pair is tsukuba (or the synthetic
+// texture) resized to that size.
+
+const StereoPair& PairOfSize(int width, int height) {
+  static std::map<std::pair<int, int>, StereoPair> cache;
+  auto it = cache.find({width, height});
+  if (it == cache.end()) {
+    StereoPair p;
+    cv::resize(Pair().left, p.left, cv::Size(width, height), 0, 0, cv::INTER_LINEAR);
+    cv::resize(Pair().right, p.right, cv::Size(width, height), 0, 0, cv::INTER_LINEAR);
+    p.source = Pair().source;
+    it = cache.emplace(std::make_pair(width, height), p).first;
+  }
+  return it->second;
+}
+
+vo::StereoCamera CameraOfSize(int width, int height) {
+  vo::StereoCamera cam;
+  cam.width = width;
+  cam.height = height;
+  cam.fx_px = cam.fy_px = 0.72 * width;
+  cam.cx_px = (width - 1) / 2.0;
+  cam.cy_px = (height - 1) / 2.0;
+  cam.baseline_m = 0.1;
+  return cam;
+}
+
+vo::DisparityOptions PipelineDisparity(int num_disparities) {
+  vo::DisparityOptions o;
+  o.algorithm = vo::DisparityAlgorithm::kBlockMatchingOneVolume;
+  o.num_disparities = num_disparities;
+  return o;
+}
+
+void SizeArgs(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"w", "h", "ndisp"})
+      ->Args({320, 240, 32})
+      ->Args({640, 480, 64})
+      ->Args({752, 480, 80})
+      ->Args({1241, 376, 256})
+      ->Unit(benchmark::kMillisecond);
+}
+
+// The pipeline's detector (bucketed Harris, 300 features).
+void BM_PipelineHarris(benchmark::State& state) {
+  const StereoPair& p = PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  vo::DetectorOptions options;
+  options.max_features = 300;
+  options.bucket_cols = 8;
+  options.bucket_rows = 6;
+  options.max_per_bucket = 10;
+  std::unique_ptr<vo::FeatureDetector> detector = vo::CreateFeatureDetector(options);
+  size_t n = 0;
+  for (auto _ : state) {
+    const vo::FeatureSet set = detector->DetectWithDescriptors(p.left);
+    n = set.features.size();
+    benchmark::DoNotOptimize(set.features.data());
+  }
+  state.counters["features"] = static_cast<double>(n);
+}
+BENCHMARK(BM_PipelineHarris)->Apply(SizeArgs);
+
+// The dense map (disparity_mode dense).
+void BM_PipelineDisparityDense(benchmark::State& state) {
+  const StereoPair& p = PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  vo::DisparityEstimator estimator(PipelineDisparity(static_cast<int>(state.range(2))));
+  for (auto _ : state) {
+    const vo::DisparityResult r = estimator.Compute(p.left, p.right);
+    benchmark::DoNotOptimize(r.disparity_px.data);
+  }
+}
+BENCHMARK(BM_PipelineDisparityDense)->Apply(SizeArgs);
+
+// disparity_mode at_features: prepare the pair, then the depth of the detected features.
+void BM_PipelineDisparityAtFeatures(benchmark::State& state) {
+  const int w = static_cast<int>(state.range(0)), h = static_cast<int>(state.range(1));
+  const StereoPair& p = PairOfSize(w, h);
+  vo::DetectorOptions detector_options;
+  detector_options.max_features = 300;
+  detector_options.bucket_cols = 8;
+  detector_options.bucket_rows = 6;
+  detector_options.max_per_bucket = 10;
+  const std::vector<vo::Feature> features =
+      vo::CreateFeatureDetector(detector_options)->Detect(p.left);
+  const vo::StereoCamera cam = CameraOfSize(w, h);
+  vo::DisparityEstimator estimator(PipelineDisparity(static_cast<int>(state.range(2))));
+  int pixels = 0, with_depth = 0;
+  for (auto _ : state) {
+    estimator.PrepareAtPixels(p.left, p.right);
+    std::vector<vo::Feature> copy = features;
+    with_depth = vo::AttachDepth(&estimator, cam, &copy).num_with_depth;
+    pixels = estimator.pixel_counts().left + estimator.pixel_counts().right;
+    benchmark::DoNotOptimize(copy.data());
+  }
+  state.counters["features"] = static_cast<double>(features.size());
+  state.counters["with_depth"] = with_depth;
+  state.counters["pixels"] = pixels;
+}
+BENCHMARK(BM_PipelineDisparityAtFeatures)->Apply(SizeArgs);
+
+// Its fixed part alone (prefiltered, padded views; the caches).
+void BM_PipelineDisparityPrepare(benchmark::State& state) {
+  const StereoPair& p = PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  vo::DisparityEstimator estimator(PipelineDisparity(static_cast<int>(state.range(2))));
+  for (auto _ : state) {
+    const vo::DisparityResult r = estimator.PrepareAtPixels(p.left, p.right);
+    benchmark::DoNotOptimize(r.ok);
+  }
+}
+BENCHMARK(BM_PipelineDisparityPrepare)->Apply(SizeArgs);
 
 }  // namespace
 

@@ -55,3 +55,40 @@ TEST(DisparitySimTest, HallwayDisparityAgreesWithGroundTruthDepth) {
 }
 
 }  // namespace
+
+// The disparity at single pixels (the pipeline's default, disparity_mode at_features) equals
+// the dense map without its speckle filter at every pixel of rendered hallway frames.
+TEST(DisparitySimTest, DisparityAtPixelsEqualsTheDenseMapOnTheHallway) {
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(harness::ResolveScenario("l_hallway", &s, &error)) << error;
+  s.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(1.0, 0)};
+  auto simulator = sim::Simulator::Create(s, &error);
+  ASSERT_TRUE(simulator) << error;
+  vo::DisparityOptions o;
+  o.algorithm = vo::DisparityAlgorithm::kBlockMatchingOneVolume;
+  o.speckle_window_size = 0;
+  o.num_disparities = 32;  // the pipeline's range for this camera
+  vo::DisparityEstimator dense(o), sparse(o);
+  sim::StereoFrame f;
+  int frames = 0;
+  long valid = 0, pixels = 0;
+  while (simulator->Next(&f, &error) && frames < 3) {
+    if (frames++ > 0) {
+      for (int k = 0; k < 5; ++k) simulator->Next(&f, &error);
+    }
+    const vo::DisparityResult d = dense.Compute(f.left, f.right, 32);
+    ASSERT_TRUE(d.ok) << d.message;
+    ASSERT_TRUE(sparse.PrepareAtPixels(f.left, f.right, 32).ok);
+    for (int y = 0; y < f.left.rows; ++y) {
+      for (int x = 0; x < f.left.cols; ++x) {
+        const float expected = d.disparity_px.at<float>(y, x);
+        ASSERT_EQ(sparse.DisparityAt(x, y), expected) << "frame " << frames << " (" << x << ", " << y << ")";
+        valid += expected >= 0.0f;
+        ++pixels;
+      }
+    }
+  }
+  ASSERT_EQ(frames, 3);
+  EXPECT_GT(valid, pixels / 5);  // the comparison covers many valid pixels
+}

@@ -123,6 +123,8 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   o.ba.loss_scale_px = 2.5;
   o.ba_max_points = 55;
   o.disparity.algorithm = vo::DisparityAlgorithm::kSemiGlobal;
+  o.disparity_mode = vo::DisparityMode::kDense;  // at_features needs the one-volume matcher
+  o.disparity_range_margin_px = 4.0;
   o.disparity.block_size = 7;
   o.disparity_min_depth_m = 0.6;
   const std::string effective = harness::VoConfigToYaml(o);

@@ -520,6 +520,56 @@ TEST(OdometryRenderedTest, StageTimesAreFilled) {
   EXPECT_GT(results[0].times.orientation_ms, 0.0);
 }
 
+// Depth only at the features (the default) gives exactly what the dense map gives there when
+// the dense map skips its speckle filter: the same trajectory, bit for bit.
+TEST(OdometryRenderedTest, DisparityAtFeaturesEqualsTheDenseMapWithoutSpeckleFilter) {
+  OdometryOptions at_features;
+  at_features.disparity.speckle_window_size = 0;
+  ASSERT_EQ(at_features.disparity_mode, DisparityMode::kAtFeatures);
+  OdometryOptions dense = at_features;
+  dense.disparity_mode = DisparityMode::kDense;
+  const std::vector<OdometryResult> a = RunCorridor(at_features);
+  const std::vector<OdometryResult> b = RunCorridor(dense);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].num_features_with_depth, b[i].num_features_with_depth) << "frame " << i;
+    EXPECT_EQ(a[i].num_inliers, b[i].num_inliers) << "frame " << i;
+    EXPECT_TRUE(a[i].T_world_cam0.matrix() == b[i].T_world_cam0.matrix()) << "frame " << i;
+    // The dense map covers every pixel; at the features only a few per feature are evaluated
+    // (the first frame reads a dense map for its plane-based orientation).
+    EXPECT_EQ(b[i].disparity_pixels, 320 * 240);
+    if (i > 0) {
+      EXPECT_LT(a[i].disparity_pixels, 10 * a[i].num_features) << "frame " << i;
+    }
+  }
+}
+
+// The search range follows the scene: full on the first frame and after a lost frame, then
+// the largest disparity seen with its margin; the trajectory stays that of the full range.
+TEST(OdometryRenderedTest, DisparityRangeFollowsTheScene) {
+  OdometryOptions wide;
+  wide.derive_num_disparities = false;
+  wide.disparity.num_disparities = 128;
+  OdometryOptions fixed = wide;
+  fixed.disparity_range_from_scene = false;
+  const std::vector<OdometryResult> r = RunCorridor(wide, {6});
+  const std::vector<OdometryResult> full = RunCorridor(fixed, {6});
+  EXPECT_EQ(r[0].num_disparities, 128);
+  EXPECT_EQ(full[3].num_disparities, 128);
+  for (int i : {1, 2, 3, 4, 5, 8, 9}) {
+    EXPECT_LT(r[i].num_disparities, 128) << "frame " << i;
+    EXPECT_GE(r[i].num_disparities, 16) << "frame " << i;
+  }
+  EXPECT_EQ(r[6].status, TrackingStatus::kLost);
+  EXPECT_EQ(r[7].num_disparities, 128);  // the frame after the loss searches the full range
+  printf("[ scene range ] frames 1-3: %d %d %d disparities\n", r[1].num_disparities,
+         r[2].num_disparities, r[3].num_disparities);
+  for (size_t i = 1; i < r.size(); ++i) {
+    EXPECT_THAT(r[i].T_world_cam0, IsNearPose(full[i].T_world_cam0, 0.05 * kDeg, 0.002))
+        << "frame " << i;
+  }
+}
+
 // ---- (3) A black frame in the middle ---------------------------------------------------------
 
 TEST(OdometryLostTest, BlackFrameIsLostThenRecovers) {
@@ -878,6 +928,11 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
   rejects([](OdometryOptions* o) { o->ransac.confidence = 1.0; }, "ransac");
   rejects([](OdometryOptions* o) { o->ba.num_fixed_poses = 0; }, "ba");
   rejects([](OdometryOptions* o) { o->ba.num_fixed_poses = 5; }, "num_fixed_poses");
+  rejects([](OdometryOptions* o) { o->disparity.algorithm = DisparityAlgorithm::kBlockMatching; },
+          "disparity_mode at_features needs disparity.algorithm block_matching_one_volume");
+  rejects([](OdometryOptions* o) { o->disparity_range_margin = -0.1; }, "disparity_range_margin");
+  rejects([](OdometryOptions* o) { o->disparity_range_margin_px = NAN; },
+          "disparity_range_margin");
   rejects(
       [](OdometryOptions* o) {
         o->derive_num_disparities = false;
