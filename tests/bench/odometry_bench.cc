@@ -14,6 +14,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <string>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -26,16 +28,28 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr int kForwardFrames = 20;
 constexpr int kTurnFrames = 20;
 
-vo::StereoCamera HallwayCamera() {
+// The camera rigs of results/speed/ (as the simulator renders them): 0 = the hallway head
+// (320x240, fx 230 px, 0.09 m; the L-hallway rig), 1 = the same at 640x480, 2 = EuRoC-like (752x480, fx 458 px,
+// 0.11 m), 3 = KITTI-like (1241x376, fx 718 px, 0.54 m).
+vo::StereoCamera RigCamera(int rig) {
+  struct Rig {
+    int width, height;
+    double fx, baseline;
+  };
+  static const Rig rigs[] = {
+      {320, 240, 230.0, 0.09}, {640, 480, 460.0, 0.09}, {752, 480, 458.0, 0.11},
+      {1241, 376, 718.0, 0.54}};
+  const Rig& r = rigs[rig];
   vo::StereoCamera cam;
-  cam.width = 320;
-  cam.height = 240;
-  cam.fx_px = cam.fy_px = 230.0;
-  cam.cx_px = 159.5;
-  cam.cy_px = 119.5;
-  cam.baseline_m = 0.09;
+  cam.width = r.width;
+  cam.height = r.height;
+  cam.fx_px = cam.fy_px = r.fx;
+  cam.cx_px = (r.width - 1) / 2.0;
+  cam.cy_px = (r.height - 1) / 2.0;
+  cam.baseline_m = r.baseline;
   return cam;
 }
+
 
 // A corridor box in the hallway frame (x along, y left, z up), one random texture per face
 // (1 cm texels, blurred noise at two scales), ray-cast with 2 × 2 supersampling.
@@ -138,10 +152,13 @@ struct Sequence {
   std::vector<Eigen::Isometry3d> T_hall_cam0;
 };
 
-const Sequence& TheSequence() {
-  static const Sequence sequence = [] {
-    const Corridor corridor;
-    const vo::StereoCamera cam = HallwayCamera();
+const Sequence& TheSequence(int rig = 0) {
+  static std::map<int, Sequence> sequences;
+  auto it = sequences.find(rig);
+  if (it != sequences.end()) return it->second;
+  const Sequence sequence = [rig] {
+    static const Corridor corridor;
+    const vo::StereoCamera cam = RigCamera(rig);
     Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
     T_cam0_cam1.translation().x() = cam.baseline_m;
     Sequence s;
@@ -152,7 +169,7 @@ const Sequence& TheSequence() {
     }
     return s;
   }();
-  return sequence;
+  return sequences.emplace(rig, sequence).first->second;
 }
 
 double Median(std::vector<double> v) {
@@ -162,14 +179,14 @@ double Median(std::vector<double> v) {
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-void RunPipeline(benchmark::State& state, const vo::OdometryOptions& options) {
-  const Sequence& seq = TheSequence();
+void RunPipeline(benchmark::State& state, const vo::OdometryOptions& options, int rig = 0) {
+  const Sequence& seq = TheSequence(rig);
   const size_t n = seq.left.size();
   std::vector<double> total, disparity, detect, depth, match, motion, ba;
   int lost = 0;
   double end_error_m = 0.0, end_error_deg = 0.0;
   for (auto _ : state) {
-    vo::StereoOdometry vo(HallwayCamera(), options);
+    vo::StereoOdometry vo(RigCamera(rig), options);
     std::vector<vo::OdometryResult> results;
     for (size_t i = 0; i < n; ++i) {
       results.push_back(vo.Process(seq.left[i], seq.right[i], 0.1 * i));
@@ -205,6 +222,23 @@ void RunPipeline(benchmark::State& state, const vo::OdometryOptions& options) {
 
 void BM_OdometryDefault(benchmark::State& state) { RunPipeline(state, vo::OdometryOptions()); }
 BENCHMARK(BM_OdometryDefault)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The whole pipeline at the four camera sizes of results/speed/. Args: rig (RigCamera), disparity
+// mode (0 = at_features, the default; 1 = dense).
+void BM_OdometryAtSize(benchmark::State& state) {
+  vo::OdometryOptions options;
+  options.disparity_mode =
+      state.range(1) == 0 ? vo::DisparityMode::kAtFeatures : vo::DisparityMode::kDense;
+  const vo::StereoCamera cam = RigCamera(static_cast<int>(state.range(0)));
+  state.SetLabel(std::to_string(cam.width) + "x" + std::to_string(cam.height) + " " +
+                 vo::ToString(options.disparity_mode));
+  RunPipeline(state, options, static_cast<int>(state.range(0)));
+}
+BENCHMARK(BM_OdometryAtSize)
+    ->ArgNames({"rig", "dense"})
+    ->ArgsProduct({{0, 1, 2, 3}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
 
 void BM_OdometryNoBundleAdjustment(benchmark::State& state) {
   vo::OdometryOptions options;
