@@ -56,6 +56,10 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
   }
   r << "| lost frames (no measured motion) / re-initialisations | " << s.lost_frames << " / "
     << s.reinitialisations << " |\n";
+  if (s.frames_not_initialised > 0) {
+    r << "| frames before the VO initialised (no pose, not evaluated) | " << s.frames_not_initialised
+      << " |\n";
+  }
   r << "| VO time per frame, median / p95 | " << Fmt(s.vo_ms_median, 2) << " / " << Fmt(s.vo_ms_p95, 2) << " ms |\n";
   for (const auto& [k, v] : s.stage_ms_median) r << "| stage median: " << k << " | " << Fmt(v, 2) << " ms |\n";
   r << "\n![trajectory](trajectory.png)\n\n![errors](errors.png)\n\n![timing](timing.png)\n\n";
@@ -94,6 +98,7 @@ std::string MetricsJson(const RunSummary& s) {
     j["inlier_match_precision"] = s.match_stats.inlier_precision();
   }
   j["lost_frames"] = s.lost_frames;
+  j["frames_not_initialised"] = s.frames_not_initialised;
   j["reinitialisations"] = s.reinitialisations;
   j["vo_ms_median"] = s.vo_ms_median;
   j["vo_ms_p95"] = s.vo_ms_p95;
@@ -168,8 +173,30 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   }
   if (!error->empty()) return false;
   progress.Finish(static_cast<int>(results.size()));
+  // A bad start is a bad start, not a wrong world: the frames before the first one the VO
+  // initialised on (black, over-exposed, textureless) have no pose. They are listed in
+  // per_frame.csv as not_initialised and left out of the trajectories and the metrics, whose
+  // world and ground truth are anchored at that first frame.
+  size_t first = 0;
+  while (first < results.size() && results[first].status == vo::TrackingStatus::kLost) ++first;
+  if (first == results.size()) {
+    *error = name + ": the VO never initialised on any of the " + std::to_string(results.size()) +
+             " frames (" + (results.empty() ? std::string("no frames") : results.back().message) + ")";
+    return false;
+  }
+  const std::vector<vo::OdometryResult> not_initialised(results.begin(), results.begin() + first);
+  results.erase(results.begin(), results.begin() + first);
+  est.erase(est.begin(), est.begin() + first);
+  gt.erase(gt.begin(), gt.begin() + first);
+  times.erase(times.begin(), times.begin() + first);
+  std::vector<size_t> kept_gt_frames;
+  for (size_t i : gt_frames) {
+    if (i >= first) kept_gt_frames.push_back(i - first);
+  }
+  gt_frames.swap(kept_gt_frames);
   if (results.size() < 2) {
-    *error = name + ": fewer than 2 frames";
+    *error = name + ": fewer than 2 frames" +
+             (first > 0 ? " after the first " + std::to_string(first) + " (not initialised)" : "");
     return false;
   }
 
@@ -191,6 +218,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   if (has_gt) s.metrics = ComputeTrajectoryMetrics(est_at_gt, gt_at_gt);
   s.frame_stride = stride;
   s.metrics.frames = static_cast<int>(results.size());
+  s.frames_not_initialised = static_cast<int>(first);
   std::vector<double> total, feats, inl;
   std::map<std::string, std::vector<double>> stages;
   for (const auto& r : results) {
@@ -244,10 +272,18 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
          "translation_error_m,rotation_error_deg,motion_measured,reinitialised,prediction,"
          "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_disparities,"
          "disparity_pixels\n";
+  for (size_t i = 0; i < not_initialised.size(); ++i) {  // no pose, no error
+    const auto& r = not_initialised[i];
+    csv << i << "," << FormatDouble(r.time_s) << ",not_initialised," << r.num_features << ","
+        << r.num_features_with_depth << ",0,0,0.0000,0," << Fmt(r.times.disparity_ms, 3) << ","
+        << Fmt(r.times.detect_ms, 3) << "," << Fmt(r.times.depth_ms, 3) << ",0.000,0.000,0.000,"
+        << Fmt(r.times.total_ms, 3) << ",nan,nan,nan,nan,nan,nan,0,0,none,0,0.00,0.00,0.000,0.000,"
+        << r.num_disparities << "," << r.disparity_pixels << "\n";
+  }
   for (size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
     const Eigen::Vector3d t = est[i].translation();
-    csv << i << "," << FormatDouble(times[i]) << "," << vo::ToString(r.status) << "," << r.num_features << ","
+    csv << i + first << "," << FormatDouble(times[i]) << "," << vo::ToString(r.status) << "," << r.num_features << ","
         << r.num_features_with_depth << "," << r.num_matches << "," << r.num_inliers << "," << Fmt(r.rms_reprojection_px)
         << "," << (r.ba_ran ? 1 : 0) << "," << Fmt(r.times.disparity_ms, 3) << "," << Fmt(r.times.detect_ms, 3) << ","
         << Fmt(r.times.depth_ms, 3) << "," << Fmt(r.times.match_ms, 3) << "," << Fmt(r.times.motion_ms, 3) << ","

@@ -32,6 +32,8 @@ struct RunSummary {
   TrajectoryMetrics metrics;
   int lost_frames = 0;        // frames without a measured motion (vo::IsLostFrame)
   int reinitialisations = 0;  // of those, frames the VO re-initialised on
+  int frames_not_initialised = 0;  // frames before the first one the VO initialised on: no
+                                   // pose, not in the trajectories, metrics or lost_frames
   double vo_ms_median = 0.0;
   double vo_ms_p95 = 0.0;
   std::map<std::string, double> stage_ms_median;  // disparity, detect, depth, match, motion, ba

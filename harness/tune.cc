@@ -718,6 +718,9 @@ bool MetricByName(const TrajectoryMetrics& m, const std::string& name, double* v
   return false;
 }
 
+// Score of a sequence the VO never initialised on.
+constexpr double kUnusableScore = 1e9;
+
 bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& options,
                    const TuneObjective& objective, SequenceScore* score, std::string* error) {
   std::string why;
@@ -735,8 +738,17 @@ bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& opti
   for (const DatasetFrame& f : sequence.frames) {
     const vo::OdometryResult r = odometry->Process(f.left, f.right, f.time_s);
     if (vo::IsLostFrame(r)) ++s.lost_frames;
+    // Frames before the first one the VO initialised on have no pose (as in `run`): they are
+    // penalised as lost frames and left out of the trajectory, anchored at that first frame.
+    if (est.empty() && r.status == vo::TrackingStatus::kLost) continue;
     est.push_back(r.T_world_cam0);
     gt.push_back(f.T_world_cam0);
+  }
+  if (est.size() < 2) {  // never (or only at the last frame) initialised: the worst score
+    s.metric = kUnusableScore;
+    s.score = kUnusableScore;
+    *score = s;
+    return true;
   }
   s.metrics = ComputeTrajectoryMetrics(est, gt);
   s.metrics.frames = static_cast<int>(est.size());

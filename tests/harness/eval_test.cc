@@ -6,6 +6,8 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -340,9 +342,12 @@ class EvalBadInputTest : public ::testing::Test {
       for (int i = 0; i < 8; ++i) {
         DatasetFrame f;
         f.time_s = 0.1 * i;
-        f.left.create(120, 160, CV_8UC1);
-        rng.fill(f.left, cv::RNG::UNIFORM, 0, 256);
-        f.right = f.left.clone();
+        // A random texture seen 6 px apart (disparity 6), so the VO initialises on it.
+        cv::Mat wide(120, 166, CV_8UC1);
+        rng.fill(wide, cv::RNG::UNIFORM, 0, 256);
+        cv::GaussianBlur(wide, wide, cv::Size(3, 3), 0.8);
+        f.left = wide(cv::Rect(0, 0, 160, 120)).clone();
+        f.right = wide(cv::Rect(6, 0, 160, 120)).clone();
         f.has_gt = true;
         f.T_world_cam0.translation() = Eigen::Vector3d(0.0, 0.0, 0.05 * i);
         ASSERT_TRUE(writer.Add(f, &error)) << error;
