@@ -431,6 +431,14 @@ DisparityResult DisparityEstimator::PrepareAtPixels(const cv::Mat& left, const c
                      ToString(options_.algorithm);
     return result;
   }
+  // The dense path's buffers (a first frame's map) are not needed by the sparse one.
+  if (!s.left_fixed.empty()) {
+    for (cv::Mat* m : {&s.padded_a, &s.padded_b, &s.flipped_a, &s.flipped_b, &s.raw_fixed,
+                       &s.left_fixed, &s.right_fixed, &s.gradient, &s.texture, &s.low_texture}) {
+      m->release();
+    }
+    s.sad->ReleaseDenseScratch();
+  }
   s.sad->Prepare(left, right, num_disparities);
   left.copyTo(s.sparse_image);
   s.sparse_left.create(left.size(), CV_16S);

@@ -708,6 +708,13 @@ void SadBlockMatcher::Prepare(const cv::Mat& left, const cv::Mat& right, int num
   segment_.resize(static_cast<size_t>(g.nd + g.win) * g.win);
 }
 
+void SadBlockMatcher::ReleaseDenseScratch() {
+  for (std::vector<int16_t>* v : {&column_sums_, &costs_, &right_min_, &right_best_,
+                                  &right_thresh_, &right_ambiguous_}) {
+    std::vector<int16_t>().swap(*v);
+  }
+}
+
 int16_t SadBlockMatcher::LeftAt(int x, int y) {
 #if VO_SAD_HAVE_AVX2
   if (geometry_.avx2) {

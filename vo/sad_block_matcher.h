@@ -75,6 +75,9 @@ class SadBlockMatcher {
   int16_t LeftAt(int x, int y);    // 0 <= x < width, 0 <= y < height of the prepared pair
   int16_t RightAt(int xr, int y);  // right-image pixel, same bounds
   int prepared_num_disparities() const { return geometry_.nd; }
+  // Frees the buffers only Compute uses (its cost volume rows, column sums, right-view
+  // minima), e.g. when a caller switches to the sparse evaluation for good.
+  void ReleaseDenseScratch();
 
   const SadBlockMatcherOptions& options() const { return options_; }
 
