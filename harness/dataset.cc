@@ -19,6 +19,9 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "sim/scenario.h"
+#include "sim/yaml_input.h"
+
 namespace harness {
 namespace fs = std::filesystem;
 namespace {
@@ -60,6 +63,33 @@ std::string FrameName(size_t index, const char* extension) {
 
 std::string SizeText(const cv::Mat& m) {
   return std::to_string(m.cols) + "x" + std::to_string(m.rows);
+}
+
+// A rig in the plausible ranges the simulator also keeps (sim/scenario.h): baseline 1 mm .. 5 m,
+// horizontal and vertical fields of view from the focal lengths and the image size in
+// (1, 170) degrees. A value outside is refused rather than run into inf/NaN metrics.
+// Empty when fine, else the problem. Width and height must be known (> 0).
+std::string RigProblem(const vo::StereoCamera& c) {
+  std::ostringstream e;
+  if (!(c.baseline_m >= sim::kMinBaselineM && c.baseline_m <= sim::kMaxBaselineM)) {
+    e << "baseline " << FormatDouble(c.baseline_m) << " m is outside the plausible range "
+      << FormatDouble(sim::kMinBaselineM) << " .. " << FormatDouble(sim::kMaxBaselineM)
+      << " m (1 mm to 5 m)";
+    return e.str();
+  }
+  if (c.width <= 0 || c.height <= 0) return "";
+  const double fov_deg[2] = {2.0 * std::atan(c.width / (2.0 * c.fx_px)) * 180.0 / M_PI,
+                             2.0 * std::atan(c.height / (2.0 * c.fy_px)) * 180.0 / M_PI};
+  for (int k = 0; k < 2; ++k) {
+    if (!(fov_deg[k] > sim::kMinFovDeg && fov_deg[k] < sim::kMaxFovDeg)) {
+      e << (k == 0 ? "fx " : "fy ") << FormatDouble(k == 0 ? c.fx_px : c.fy_px) << " px gives a "
+        << (k == 0 ? "horizontal" : "vertical") << " field of view of " << fov_deg[k]
+        << " deg over " << (k == 0 ? c.width : c.height) << " px; expected "
+        << sim::kMinFovDeg << " .. " << sim::kMaxFovDeg << " deg";
+      return e.str();
+    }
+  }
+  return "";
 }
 
 bool IsRotation(const Eigen::Matrix3d& R, double tolerance) {
@@ -570,6 +600,8 @@ bool ReadKittiCalib(const std::string& path, vo::StereoCamera* camera, std::stri
     return Fail(error, path +
                            ": baseline (P0[3] - P1[3]) / fx = " + FormatDouble(camera->baseline_m) +
                            " m, expected > 0 (P1 column 4 holds -fx * baseline)");
+  if (const std::string problem = RigProblem(*camera); !problem.empty())
+    return Fail(error, path + ": " + problem + " (baseline = (P0[3] - P1[3]) / fx)");
   return true;
 }
 
@@ -635,6 +667,8 @@ bool KittiReader::Open(const std::string& dir, const Options& options, std::stri
   camera_.height = left.rows;
   std::string why;
   if (!camera_.IsValid(&why)) return Fail(error, Join(dir_, "calib.txt") + ": " + why);
+  if (const std::string problem = RigProblem(camera_); !problem.empty())
+    return Fail(error, Join(dir_, "calib.txt") + ": " + problem);
   has_depth_ = options_.load_depth && fs::is_directory(Join(dir_, "depth"), ec);
   return true;
 }
@@ -695,8 +729,10 @@ bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibr
     text += lines[i] + "\n";
   }
   EurocCameraCalibration c;
+  YAML::Node root;
+  std::string yaml_error;
+  if (!sim::LoadYamlDocument(text, path, &root, &yaml_error)) return Fail(error, yaml_error);
   try {
-    const YAML::Node root = YAML::Load(text);
     auto require = [&](const char* key, const char* expected) -> YAML::Node {
       const YAML::Node node = root[key];
       if (!node)
@@ -765,6 +801,7 @@ bool ReadEurocCameraCsv(const std::string& path, const std::string& image_dir,
   std::vector<std::string> lines;
   if (!ReadTextLines(path, &lines, error)) return false;
   images->clear();
+  IncreasingStamps<int64_t> order(path);
   for (size_t i = 0; i < lines.size(); ++i) {
     if (IsBlankOrComment(lines[i])) continue;
     const std::vector<std::string_view> f = SplitCsv(lines[i]);
@@ -772,9 +809,8 @@ bool ReadEurocCameraCsv(const std::string& path, const std::string& image_dir,
     if (f.size() != 2 || !ParseInt64(f[0], &t_ns) || f[1].empty())
       return Fail(error,
                   Where(path, static_cast<int>(i) + 1) + "expected '<timestamp ns>,<file name>'");
-    if (!images->emplace(t_ns, Join(image_dir, std::string(f[1]))).second)
-      return Fail(error, Where(path, static_cast<int>(i) + 1) + "duplicate timestamp " +
-                             std::to_string(t_ns));
+    if (!order.Next(t_ns, f[0], static_cast<int>(i) + 1, error)) return false;
+    images->emplace(t_ns, Join(image_dir, std::string(f[1])));  // unique: increasing stamps
   }
   return true;
 }
@@ -786,6 +822,7 @@ bool ReadEurocGroundTruth(const std::string& path, std::vector<int64_t>* t_ns,
   if (!ReadTextLines(path, &lines, error)) return false;
   std::vector<double> v;
   std::string what;
+  IncreasingStamps<int64_t> order(path);
   for (size_t i = 0; i < lines.size(); ++i) {
     if (IsBlankOrComment(lines[i])) continue;
     const int line_no = static_cast<int>(i) + 1;
@@ -796,6 +833,7 @@ bool ReadEurocGroundTruth(const std::string& path, std::vector<int64_t>* t_ns,
     if (comma == std::string::npos || !ParseInt64(head, &stamp))
       return Fail(error, Where(path, line_no) +
                              "expected '<timestamp ns>,p_x,p_y,p_z,q_w,q_x,q_y,q_z,...'");
+    if (!order.Next(stamp, head, line_no, error)) return false;
     const std::string_view rest = std::string_view(lines[i]).substr(comma + 1);
     const size_t fields = SplitCsv(rest).size();
     if (fields < 7 || !ParseNumbers(rest, fields, &v, &what))
@@ -1045,6 +1083,8 @@ bool ComputeStereoRectification(const EurocCameraCalibration& cam0,
       std::abs(t_rect0_rect1.x() - r.camera.baseline_m) > 1e-9 * t.norm() + 1e-12)
     return Fail(error, where + "rectification gave a degenerate pair" +
                            (why.empty() ? std::string() : ": " + why));
+  if (const std::string problem = RigProblem(r.camera); !problem.empty())
+    return Fail(error, where + "the rectified pair: " + problem);
   *rectification = r;
   return true;
 }
@@ -1181,7 +1221,7 @@ bool ReadTumImageList(const std::string& path, const std::string& dir, std::vect
     if (error) *error += " (expected the image list: 'timestamp filename' per line)";
     return false;
   }
-  std::map<double, int> seen;  // stamp -> line
+  IncreasingStamps<double> order(path);
   for (size_t i = 0; i < lines.size(); ++i) {
     if (IsBlankOrComment(lines[i])) continue;
     const int line_no = static_cast<int>(i) + 1;
@@ -1192,10 +1232,7 @@ bool ReadTumImageList(const std::string& path, const std::string& dir, std::vect
       return Fail(error, Where(path, line_no) +
                              "expected 'timestamp filename' (seconds, a path relative to " + dir +
                              ")");
-    const auto [it, inserted] = seen.emplace(t, line_no);
-    if (!inserted)
-      return Fail(error, Where(path, line_no) + "duplicate timestamp " + stamp + " (line " +
-                             std::to_string(it->second) + ")");
+    if (!order.Next(t, stamp, line_no, error)) return false;
     times_s->push_back(t);
     files->push_back(Join(dir, file));
   }
@@ -1257,6 +1294,8 @@ bool TumReader::Open(const std::string& dir, const Options& options, std::string
   camera_.height = left.rows;
   std::string why;
   if (!camera_.IsValid(&why)) return Fail(error, Join(dir_, "calib.txt") + ": " + why);
+  if (const std::string problem = RigProblem(camera_); !problem.empty())
+    return Fail(error, Join(dir_, "calib.txt") + ": " + problem);
 
   // Ground truth (optional).
   gt_index_.assign(times_s_.size(), -1);

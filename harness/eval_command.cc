@@ -2,7 +2,9 @@
 
 #include <cstdio>
 
+#include "harness/cli.h"
 #include "harness/eval.h"
+#include "harness/path_names.h"
 #include "harness/vo_config.h"
 
 namespace harness {
@@ -24,7 +26,8 @@ std::shared_ptr<EvalCommand> AddEvalCommand(CLI::App& app) {
   c->app->add_option("--out,-o", c->out,
                      "Run folder (default out/eval/<dataset folder name>); an earlier run there is "
                      "replaced");
-  c->app->add_option("--max-frames", c->max_frames, "Stop after N frames (0 = all)");
+  c->app->add_option("--max-frames", c->max_frames, "Stop after N frames (0 = all)")
+      ->check(AtLeast(0));
   c->app->add_option("--max-difference", c->max_difference_s,
                      "Largest ground-truth to frame time difference associated (s; default 0.02 "
                      "for kitti and tum, 0.003 for euroc)");
@@ -49,7 +52,7 @@ int EvalCommand::Run(const PrintTable& print_table) const {
   }
   options.max_difference_s = max_difference_s;
   if (max_frames < 0) {
-    std::fprintf(stderr, "vobench eval: --max-frames: expected N >= 0, got %d\n", max_frames);
+    std::fprintf(stderr, "vobench eval: --max-frames: must be >= 0, got %d\n", max_frames);
     return 2;
   }
   if (!options.IsValid(&error)) {
@@ -62,6 +65,10 @@ int EvalCommand::Run(const PrintTable& print_table) const {
     return 2;
   }
   RunOptions run_options;
+  if (out.empty() && !CheckPathName(DatasetName(dataset), "dataset folder name", &error)) {
+    std::fprintf(stderr, "vobench eval: %s (give --out)\n", error.c_str());
+    return 2;
+  }
   run_options.out_dir = out.empty() ? "out/eval/" + DatasetName(dataset) : out;
   run_options.progress = !quiet;
   run_options.plots = !no_plots;

@@ -11,8 +11,12 @@
 #include <filesystem>
 #include <sstream>
 
+#include "harness/cli.h"
+#include "harness/eval.h"
 #include "harness/eval_command.h"
+#include "harness/interrupt.h"
 #include "harness/match_eval.h"
+#include "harness/path_names.h"
 #include "harness/plots.h"
 #include "harness/progress.h"
 #include "harness/render.h"
@@ -109,7 +113,13 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
     std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
     return 2;
   }
-  if (out.empty()) out = "out/match_eval/" + scenario.name;
+  if (out.empty()) {
+    if (!harness::CheckPathName(scenario.name, "scenario name", &error)) {
+      std::fprintf(stderr, "vobench match-eval: %s (give --out)\n", error.c_str());
+      return 2;
+    }
+    out = "out/match_eval/" + scenario.name;
+  }
 
   // Simulate the scenario into memory: images, ground-truth depth and poses.
   auto simulator = sim::Simulator::Create(scenario, &error);
@@ -124,6 +134,11 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
     while ((max_frames <= 0 || static_cast<int>(frames.size()) < max_frames) && simulator->Next(&f, &error)) {
       frames.push_back({f.left, f.right, f.depth_m, f.T_world_cam0});
       progress.Update(static_cast<int>(frames.size()));
+      if (harness::InterruptSignal() != 0) {
+        error = harness::InterruptedMessage(static_cast<int>(frames.size()),
+                                            simulator->EstimatedFrames(), "frames", out);
+        break;
+      }
     }
     if (!error.empty()) {
       std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
@@ -142,6 +157,13 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
     return 1;
   }
   progress.Finish(static_cast<int>(rows.size()));
+  if (harness::InterruptSignal() != 0) {
+    std::fprintf(stderr, "vobench match-eval: %s\n",
+                 harness::InterruptedMessage(static_cast<int>(frames.size()),
+                                             static_cast<int>(frames.size()), "frames", out)
+                     .c_str());
+    return 1;
+  }
   std::filesystem::create_directories(out);
   const std::string csv = out + "/match_eval.csv";
   if (!harness::WriteMatchEvalCsv(csv, rows, &error) ||
@@ -182,6 +204,10 @@ void PrintRunTable(const harness::RunSummary& s, const std::string& out) {
 int RunRun(const std::string& scenario_arg, const std::string& config, const std::string& dataset,
            std::string out, int max_frames, int stride, bool no_plots, bool quiet) {
   std::string error;
+  if (max_frames < 0) {  // also refused by the option's check; kept for callers of RunRun
+    std::fprintf(stderr, "vobench run: --max-frames: must be >= 0, got %d\n", max_frames);
+    return 2;
+  }
   vo::OdometryOptions vo_options;
   if (!config.empty() && !harness::LoadVoConfig(config, &vo_options, &error)) {
     std::fprintf(stderr, "vobench run: %s\n", error.c_str());
@@ -195,7 +221,14 @@ int RunRun(const std::string& scenario_arg, const std::string& config, const std
   harness::RunSummary summary;
   bool ok;
   if (!dataset.empty()) {
-    if (out.empty()) out = "out/run/" + std::filesystem::path(dataset).filename().string();
+    if (out.empty()) {
+      const std::string name = harness::DatasetName(dataset);
+      if (!harness::CheckPathName(name, "dataset folder name", &error)) {
+        std::fprintf(stderr, "vobench run: %s (give --out)\n", error.c_str());
+        return 2;
+      }
+      out = "out/run/" + name;
+    }
     options.out_dir = out;
     ok = harness::RunKittiDataset(dataset, vo_options, options, &summary, &error);
   } else {
@@ -204,7 +237,13 @@ int RunRun(const std::string& scenario_arg, const std::string& config, const std
       std::fprintf(stderr, "vobench run: %s\n", error.c_str());
       return 2;
     }
-    if (out.empty()) out = "out/run/" + scenario.name;
+    if (out.empty()) {
+      if (!harness::CheckPathName(scenario.name, "scenario name", &error)) {
+        std::fprintf(stderr, "vobench run: %s (give --out)\n", error.c_str());
+        return 2;
+      }
+      out = "out/run/" + scenario.name;
+    }
     options.out_dir = out;
     ok = harness::RunScenario(scenario, vo_options, options, &summary, &error);
   }
@@ -223,6 +262,9 @@ int main(int argc, char** argv) {
   // The VO runs on one thread (the timings vobench reports are single-threaded, as the speed
   // target asks); OpenCV's own thread pool would otherwise split StereoBM and filters.
   cv::setNumThreads(1);
+  // Ctrl-C / SIGTERM: the commands stop at the next frame, remove their work folders and exit
+  // with 128 + the signal (harness/interrupt.h).
+  const harness::ScopedInterruptHandlers interrupt_handlers;
   CLI::App app{"vobench: simulation-in-the-loop test bench for stereo visual odometry"};
   app.require_subcommand(1);
   bool verbose = false;
@@ -249,7 +291,8 @@ int main(int argc, char** argv) {
                          "previous pair's ground truth, as the VO predicts) or none (the paper's form)")
       ->capture_default_str();
   match_eval->add_option("--out,-o", me_out, "Output folder (default out/match_eval/<scenario>)");
-  match_eval->add_option("--max-frames", me_max_frames, "Use only the first N frames (0 = all)");
+  match_eval->add_option("--max-frames", me_max_frames, "Use only the first N frames (0 = all)")
+      ->check(harness::AtLeast(0));
   match_eval->add_flag("-q,--quiet", quiet, "No progress display");
 
   std::string run_scenario = "l_hallway", run_config, run_dataset, run_out;
@@ -260,9 +303,10 @@ int main(int argc, char** argv) {
   run->add_option("--config", run_config, "VO options (YAML; see a run folder's vo_options.yaml)");
   run->add_option("--dataset", run_dataset, "Read a dataset folder in the KITTI layout instead of simulating");
   run->add_option("--out,-o", run_out, "Run folder (default out/run/<name>); an earlier run there is replaced");
-  run->add_option("--max-frames", run_max_frames, "Stop after N frames (0 = all)");
+  run->add_option("--max-frames", run_max_frames, "Stop after N frames (0 = all)")
+      ->check(harness::AtLeast(0));
   run->add_option("--stride", run_stride, "The VO sees every k-th frame (less overlap); --max-frames counts all frames")
-      ->check(CLI::PositiveNumber);
+      ->check(harness::AtLeast(1));
   run->add_flag("--no-plots", run_no_plots, "Skip the PNG plots");
   run->add_flag("-q,--quiet", quiet, "No progress display");
 
@@ -271,14 +315,22 @@ int main(int argc, char** argv) {
   CLI::App* tune = harness::AddTuneCommand(app, &tune_args);
   harness::AddSuiteCommands(app);  // suite, suite merge, check
 
-  CLI11_PARSE(app, argc, argv);
+  // Argument errors exit with 2 (one line on stderr); suite, suite merge and check run inside
+  // the parse (their callbacks) and give their own exit codes.
+  int rc = harness::ParseCommandLine(app, argc, argv);
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   spdlog::set_pattern("[%l] %v");
-  if (*render) return RunRender(scenario, out, format, overwrite, quiet);
-  if (*run) return RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_stride, run_no_plots, quiet);
-  if (*eval->app) return eval->Run(PrintRunTable);
-  if (*tune) return harness::RunTuneCommand(tune_args);
-  if (*match_eval)
-    return RunMatchEval(me_scenario, me_strides, me_matchers, me_prediction, me_out, me_max_frames, quiet);
-  return 0;
+  if (rc < 0) {
+    if (*render) rc = RunRender(scenario, out, format, overwrite, quiet);
+    else if (*run) rc = RunRun(run_scenario, run_config, run_dataset, run_out, run_max_frames, run_stride, run_no_plots, quiet);
+    else if (*eval->app) rc = eval->Run(PrintRunTable);
+    else if (*tune) rc = harness::RunTuneCommand(tune_args);
+    else if (*match_eval)
+      rc = RunMatchEval(me_scenario, me_strides, me_matchers, me_prediction, me_out, me_max_frames, quiet);
+    else rc = 0;
+  }
+  // A command stopped by SIGINT/SIGTERM has said so and removed its work; the exit status tells
+  // the shell which signal (130, 143).
+  if (rc != 0 && harness::InterruptSignal() != 0) rc = harness::InterruptExitCode();
+  return rc;
 }

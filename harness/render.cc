@@ -3,6 +3,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "harness/interrupt.h"
 #include "harness/progress.h"
 
 namespace harness {
@@ -67,8 +68,16 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
     if (!writer.Add(ToDatasetFrame(frame), error)) return false;
     progress.Update(++n);
     summary->sim_time_s = frame.time_s;
+    if (InterruptSignal() != 0) {  // SIGINT/SIGTERM: the writer removes its partial folder
+      *error = InterruptedMessage(n, simulator->EstimatedFrames(), "frames", out_dir);
+      return false;
+    }
   }
   if (!error->empty()) return false;
+  if (InterruptSignal() != 0) {
+    *error = InterruptedMessage(n, n, "frames", out_dir);
+    return false;
+  }
   if (!writer.Finish(error)) return false;
   progress.Finish(n);
 

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "harness/interrupt.h"
 #include "harness/plots.h"
 #include "harness/progress.h"
 #include "harness/render.h"
@@ -137,7 +138,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   const int stride = options.frame_stride;
   if (options.max_frames > 0 && (expected_frames <= 0 || expected_frames > options.max_frames))
     expected_frames = options.max_frames;
-  Progress progress("vo " + name, (expected_frames + stride - 1) / stride, options.progress);
+  const int expected_vo_frames = (expected_frames + stride - 1) / stride;
+  Progress progress("vo " + name, expected_vo_frames, options.progress);
   DatasetFrame frame;
   // Matcher statistics where the ground truth allows (frames with depth and pose): the VO's
   // matches to its reference frame (the last frame that was not lost) checked against them.
@@ -170,6 +172,11 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     if (frame.has_gt) gt_frames.push_back(results.size() - 1);
     gt.push_back(frame.T_world_cam0);
     progress.Update(static_cast<int>(results.size()));
+    if (InterruptSignal() != 0) {  // SIGINT/SIGTERM: the partial folder goes with `folder`
+      *error = InterruptedMessage(static_cast<int>(results.size()), expected_vo_frames, "frames",
+                                  options.out_dir);
+      return false;
+    }
   }
   if (!error->empty()) return false;
   progress.Finish(static_cast<int>(results.size()));
@@ -326,6 +333,11 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     if (!ok) std::fprintf(stderr, "warning: plots not made: %s\n", plot_error.c_str());
   }
   if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(s, options_yaml), error)) return false;
+  if (InterruptSignal() != 0) {  // during the plots or the files: still nothing published
+    *error = InterruptedMessage(static_cast<int>(results.size()), static_cast<int>(results.size()),
+                                "frames", options.out_dir);
+    return false;
+  }
   return folder.Publish("metrics.json", "run", error);
 }
 

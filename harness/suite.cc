@@ -3,14 +3,16 @@
 #include "harness/plots.h"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -24,12 +26,13 @@
 #include <sstream>
 #include <thread>
 
+#include "harness/interrupt.h"
 #include "harness/overrides.h"
+#include "harness/path_names.h"
 #include "harness/progress.h"
 #include "harness/trajectory_io.h"
 #include "harness/vo_config.h"
-
-extern char** environ;
+#include "sim/yaml_input.h"
 
 namespace harness {
 
@@ -128,10 +131,15 @@ std::string WithoutGeneratedLine(const std::string& message) {
   return std::regex_replace(message, kGeneratedLine, "($1)");
 }
 
-bool ValidName(const std::string& name) {
+// A name that becomes part of a run id, and so of a folder name (CheckPathName, the one path
+// rule) and of an unquoted summary.csv cell: also letters, digits, '_', '.', '-' only, and no
+// "__" (the separator of the id's parts).
+bool CheckRunIdPart(const std::string& name, const std::string& what, std::string* why) {
+  if (!CheckPathName(name, what, why)) return false;
   static const std::regex kName("[A-Za-z0-9_.-]+");
-  return std::regex_match(name, kName) && name.find("__") == std::string::npos && name != "." &&
-         name != "..";
+  if (std::regex_match(name, kName) && name.find("__") == std::string::npos) return true;
+  *why = what + " '" + name + "': expected letters, digits, '_', '.', '-' (no '__')";
+  return false;
 }
 
 // Checks every (dotted or nested) key of an override map against `reference` (an effective
@@ -206,12 +214,7 @@ bool ResolveSuiteScenario(const std::string& value, const fs::path& base_dir,
 bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
                 const std::string& base_dir, Suite* suite, std::string* error) {
   YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::ParserException& ex) {
-    *error = source_name + ":" + std::to_string(ex.mark.line + 1) + ": malformed YAML: " + ex.msg;
-    return false;
-  }
+  if (!sim::LoadYamlDocument(yaml_text, source_name, &root, error)) return false;
   if (!root.IsMap()) {
     *error =
         source_name + ": expected a YAML mapping at the top level (name, scenarios, configs, ...)";
@@ -223,9 +226,9 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
   r.CheckKeys(root, "", {"name", "max_frames", "scenarios", "configs", "seeds", "strides"});
   if (!r.String(root, "", "name", &s.name) && r.ok())
     r.Fail(root, "name", "required: the suite's name");
-  if (r.ok() && !ValidName(s.name))
-    r.Fail(root["name"], "name",
-           "expected letters, digits, '_', '.', '-' (no '__'), got '" + s.name + "'");
+  std::string name_error;
+  if (r.ok() && !CheckRunIdPart(s.name, "suite name", &name_error))
+    r.Fail(root["name"], "name", name_error);
   int default_max_frames = 0;
   if (root["max_frames"].IsDefined())
     r.Integer(root["max_frames"], "max_frames", 0, &default_max_frames);
@@ -251,9 +254,8 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
     if (!ResolveSuiteScenario(value, base_dir, e["scenario"], key + ".scenario", &base, &r)) break;
     sc.name = base.name;
     r.String(e, key, "name", &sc.name);
-    if (r.ok() && !ValidName(sc.name))
-      r.Fail(e["name"].IsDefined() ? e["name"] : e["scenario"], key + ".name",
-             "expected letters, digits, '_', '.', '-' (no '__'), got '" + sc.name + "'");
+    if (r.ok() && !CheckRunIdPart(sc.name, "scenario name", &name_error))
+      r.Fail(e["name"].IsDefined() ? e["name"] : e["scenario"], key + ".name", name_error);
     if (r.ok() && !names.insert(sc.name).second)
       r.Fail(e, key + ".name", "scenario name '" + sc.name + "' is used twice");
     sc.max_frames = default_max_frames;
@@ -290,9 +292,8 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
       r.Fail(e, key + ".name", "required: the configuration's name");
       break;
     }
-    if (!ValidName(c.name))
-      r.Fail(e["name"], key + ".name",
-             "expected letters, digits, '_', '.', '-' (no '__'), got '" + c.name + "'");
+    if (!CheckRunIdPart(c.name, "configuration name", &name_error))
+      r.Fail(e["name"], key + ".name", name_error);
     if (r.ok() && !names.insert(c.name).second)
       r.Fail(e["name"], key + ".name", "configuration name '" + c.name + "' is used twice");
     std::string file;
@@ -356,12 +357,8 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
 }
 
 bool LoadSuite(const std::string& path, Suite* suite, std::string* error) {
-  bool ok = false;
-  const std::string text = ReadWholeFile(path, &ok);
-  if (!ok || fs::is_directory(path)) {
-    *error = path + ": cannot read the suite file";
-    return false;
-  }
+  std::string text;
+  if (!sim::ReadInputFile(path, "YAML suite file", &text, error)) return false;
   if (!ParseSuite(text, path, fs::absolute(path).parent_path().string(), suite, error))
     return false;
   suite->source_path = path;
@@ -511,8 +508,13 @@ bool ReadManifest(const fs::path& dir, std::string* name, std::vector<SuiteRun>*
       r.stride = e.at("stride").get<int>();
       r.max_frames = e.at("max_frames").get<int>();
       r.spec_hash = e.at("spec_hash").get<std::string>();
-      if (r.index != static_cast<int>(runs->size()) || !ValidName(r.scenario))
-        throw std::runtime_error("run " + r.id + " is out of order or malformed");
+      std::string why;
+      if (r.index != static_cast<int>(runs->size()) ||
+          !CheckRunIdPart(r.scenario, "scenario name", &why) ||
+          !CheckRunIdPart(r.config, "configuration name", &why) ||
+          !CheckPathName(r.id, "run id", &why))
+        throw std::runtime_error("run " + r.id + " is out of order or malformed" +
+                                 (why.empty() ? "" : ": " + why));
       runs->push_back(r);
     }
   } catch (const std::exception& e) {
@@ -599,52 +601,58 @@ bool MakeDirs(const fs::path& out, std::string* error) {
 // ---------------------------------------------------------------------------------------------
 // Child processes.
 
-std::atomic<int> g_interrupt_signal{0};
-void OnInterrupt(int sig) { g_interrupt_signal = sig; }
-
-// Installs SIGINT/SIGTERM handlers for the lifetime of the object.
-class InterruptGuard {
- public:
-  InterruptGuard() {
-    g_interrupt_signal = 0;
-    struct sigaction sa = {};
-    sa.sa_handler = OnInterrupt;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~InterruptGuard() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-
- private:
-  struct sigaction old_int_ = {}, old_term_ = {};
-};
-
 std::string CommandLine(const std::vector<std::string>& argv) {
   std::string s;
   for (const auto& a : argv) s += (s.empty() ? "" : " ") + ShellQuoted(a);
   return s;
 }
 
-// Starts argv with stdout and stderr into `log_path`.
+// Starts argv with stdout and stderr into `log_path`. The child leads a process group of its
+// own (a Ctrl-C on the terminal reaches only this process, which stops the children itself) and
+// is killed by the kernel when this process dies, however it dies (PR_SET_PDEATHSIG SIGKILL):
+// no orphan goes on writing into a work folder that a resumed suite reuses.
 bool Spawn(const std::vector<std::string>& argv, const std::string& log_path, pid_t* pid,
            std::string* error) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  if (access(argv[0].c_str(), X_OK) != 0) {
+    *error = argv[0] + ": cannot start: " + std::strerror(errno);
+    return false;
+  }
+  // Everything the child needs is prepared before fork(): after it, only async-signal-safe
+  // calls (the parent may have threads).
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
-  const int rc = posix_spawn(pid, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) {
-    *error = argv[0] + ": cannot start: " + std::strerror(rc);
+  const char* log = log_path.c_str();
+  const pid_t parent = getpid();
+  sigset_t all, old_mask;
+  sigfillset(&all);
+  pthread_sigmask(SIG_SETMASK, &all, &old_mask);  // no handler runs in the child before exec
+  const pid_t child = fork();
+  if (child == 0) {
+    setpgid(0, 0);
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);  // the parent died before prctl
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    const int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0 || dup2(fd, STDOUT_FILENO) < 0 || dup2(fd, STDERR_FILENO) < 0) _exit(126);
+    if (fd != STDOUT_FILENO && fd != STDERR_FILENO) close(fd);
+    execv(args[0], args.data());
+    static const char kExecFailed[] = "vobench suite: exec of the run failed\n";
+    (void)!write(STDERR_FILENO, kExecFailed, sizeof(kExecFailed) - 1);
+    _exit(127);
+  }
+  const int fork_errno = errno;
+  pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+  if (child < 0) {
+    *error = argv[0] + ": cannot start: " + std::strerror(fork_errno);
     return false;
   }
+  setpgid(child, child);  // also here: no race with kill(-child) below
+  *pid = child;
   return true;
 }
 
@@ -1057,6 +1065,10 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
     return false;
   }
   const fs::path out = options.out_dir;
+  const std::string shard_tag = ShardTag(options.shard);
+  if (!CheckPathName(suite.name, "suite name", error) ||
+      !CheckPathName(shard_tag, "shard tag", error))
+    return false;
   const std::vector<SuiteRun> runs = ExpandSuite(suite);
   // The manifest first: a folder with suite.json is recognised as this suite's on resume.
   std::error_code ec;
@@ -1071,7 +1083,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
       !WriteFileAtomically((out / "suite.yaml").string(), suite.source_text, error) ||
       !MakeDirs(out, error))
     return false;
-  const fs::path work = WorkDir(out, ShardTag(options.shard));
+  const fs::path work = WorkDir(out, shard_tag);
   RemoveLeftovers(out, work);
   fs::create_directories(work, ec);
   if (ec) {
@@ -1099,7 +1111,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
         "suite %s: %d runs in this part, %d finished before (kept), %d to run, %d at once\n",
         suite.name.c_str(), total + result->kept, result->kept, total, options.jobs);
 
-  InterruptGuard interrupt_guard;
+  ScopedInterruptHandlers interrupt_handlers;
   // A progress bar on a terminal; a line per finished run (with the ETA) in any case.
   const bool tty = isatty(STDERR_FILENO) != 0;
   Progress progress("suite " + suite.name, total, options.progress && tty);
@@ -1109,7 +1121,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
   int done = 0;
   bool fatal = false;
   while ((!queue.empty() || !running.empty()) && !fatal) {
-    if (g_interrupt_signal != 0) break;
+    if (InterruptSignal() != 0) break;
     while (!queue.empty() && static_cast<int>(running.size()) < options.jobs) {
       Job job = queue.front();
       queue.pop_front();
@@ -1156,16 +1168,17 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
     }
     progress.Update(done);
   }
-  if (g_interrupt_signal != 0 || fatal) {
-    // Stop the children; their unfinished folders under tmp/ are removed (resume redoes them).
-    for (const auto& [pid, job] : running) kill(pid, SIGTERM);
+  if (InterruptSignal() != 0 || fatal) {
+    // Stop the children (their process groups: plots included); their unfinished folders under
+    // tmp/ are removed (resume redoes them).
+    for (const auto& [pid, job] : running) kill(-pid, SIGTERM);
     for (const auto& [pid, job] : running) {
       int status = 0;
       waitpid(pid, &status, 0);
     }
     RemoveLeftovers(out, work);
     if (!fatal)
-      *error = std::string("interrupted by signal ") + std::to_string(g_interrupt_signal.load()) +
+      *error = std::string("interrupted by signal ") + std::to_string(InterruptSignal()) +
                " after " + std::to_string(done) + " of " + std::to_string(total) +
                " runs; the finished ones are kept: run the same command again to resume";
     return false;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "harness/check.h"
+#include "harness/cli.h"  // kExitBadInput: bad suite, baseline or flags; nothing written
 #include "harness/overrides.h"
 #include "harness/suite.h"
 #include "harness/vo_config.h"
@@ -21,7 +22,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int kExitRunFailed = 1;  // a run failed or is missing; check: a metric got worse
-constexpr int kExitBadInput = 2;   // bad suite, baseline or flags; nothing written
 
 int DefaultJobs() { return std::max(1u, std::thread::hardware_concurrency()); }
 
@@ -213,7 +213,7 @@ void AddSuiteCommands(CLI::App& app) {
   suite->add_option("file", sa->file, "Suite YAML file (see suites/hallway.yaml)");
   suite->add_option("-j,--jobs", sa->jobs, "Runs at once (child processes)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(AtLeast(1));
   suite->add_option("--out,-o", sa->out,
                     "Output folder (default out/suite/<suite name>); re-running resumes");
   suite
@@ -249,7 +249,7 @@ void AddSuiteCommands(CLI::App& app) {
       ->capture_default_str();
   check->add_option("-j,--jobs", ca->jobs, "Runs at once")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(AtLeast(1));
   check->add_flag("--update", ca->update,
                   "Write a new baseline from this run (keeps the tolerance rule)");
   check->add_flag("-q,--quiet", ca->quiet, "No progress display");

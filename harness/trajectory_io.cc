@@ -221,6 +221,7 @@ bool ReadTum(const std::string& path, std::vector<StampedPose>* poses, std::stri
   std::vector<StampedPose> out;
   std::vector<double> v;
   std::string what;
+  IncreasingStamps<double> order(path);
   for (size_t i = 0; i < lines.size(); ++i) {
     const int line_no = static_cast<int>(i) + 1;
     if (IsBlankOrComment(lines[i])) continue;
@@ -228,6 +229,7 @@ bool ReadTum(const std::string& path, std::vector<StampedPose>* poses, std::stri
       SetError(error, Where(path, line_no) + what + " (TUM row: t tx ty tz qx qy qz qw)");
       return false;
     }
+    if (!order.Next(v[0], SplitFields(lines[i])[0], line_no, error)) return false;
     Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);  // (w, x, y, z)
     const double norm = q.norm();
     if (std::abs(norm - 1.0) > kTumQuaternionNormTolerance) {
@@ -310,6 +312,7 @@ bool WriteKittiTimes(const std::string& path, const std::vector<double>& times_s
 bool ReadKittiTimes(const std::string& path, std::vector<double>* times_s, std::string* error) {
   std::vector<std::string> lines;
   if (!ReadTextLines(path, &lines, error)) return false;
+  IncreasingStamps<double> order(path);
   std::vector<double> out;
   std::vector<double> v;
   std::string what;
@@ -320,6 +323,7 @@ bool ReadKittiTimes(const std::string& path, std::vector<double>* times_s, std::
       SetError(error, Where(path, line_no) + what + " (one time stamp in seconds per line)");
       return false;
     }
+    if (!order.Next(v[0], SplitFields(lines[i])[0], line_no, error)) return false;
     out.push_back(v[0]);
   }
   *times_s = std::move(out);

@@ -117,6 +117,38 @@ class PartialFolder {
 
 // True for a line that is empty, blank, or whose first non-blank character is '#'.
 bool IsBlankOrComment(std::string_view line);
+
+// The order check of every reader of time stamps (times.txt, TUM trajectories and image lists,
+// EuRoC data.csv files): each stamp must be later than the one before. T is double (seconds)
+// or int64_t (nanoseconds). Next() fails with
+//   "PATH:LINE: time stamp 0.3 is not after the previous one, 0.4 (line 4); expected strictly
+//    increasing time stamps"
+template <typename T>
+class IncreasingStamps {
+ public:
+  explicit IncreasingStamps(std::string path) : path_(std::move(path)) {}
+  // `text` is the stamp as written (for the message); `line` is 1-based.
+  bool Next(T stamp, std::string_view text, int line, std::string* error) {
+    if (previous_line_ > 0 && !(stamp > previous_)) {
+      if (error)
+        *error = path_ + ":" + std::to_string(line) + ": time stamp " + std::string(text) +
+                 (stamp == previous_ ? " repeats" : " is before") + " the previous one, " +
+                 previous_text_ + " (line " + std::to_string(previous_line_) +
+                 "); expected strictly increasing time stamps";
+      return false;
+    }
+    previous_ = stamp;
+    previous_text_ = std::string(text);
+    previous_line_ = line;
+    return true;
+  }
+
+ private:
+  std::string path_;
+  T previous_{};
+  std::string previous_text_;
+  int previous_line_ = 0;
+};
 // Unit quaternion of a rotation, sign fixed so that w >= 0 (deterministic output).
 Eigen::Quaterniond CanonicalQuaternion(const Eigen::Matrix3d& R);
 

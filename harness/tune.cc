@@ -15,12 +15,15 @@
 #include <set>
 #include <sstream>
 
+#include "harness/interrupt.h"
 #include "harness/overrides.h"
+#include "harness/path_names.h"
 #include "harness/progress.h"
 #include "harness/render.h"
 #include "harness/trajectory_io.h"
 #include "harness/vo_config.h"
 #include "sim/simulator.h"
+#include "sim/yaml_input.h"
 
 namespace harness {
 namespace {
@@ -570,12 +573,7 @@ std::string ReportMarkdown(const TuneSpec& spec, const TuneSummary& s, const Opt
 bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
                    const std::string& base_dir, TuneSpec* spec, std::string* error) {
   YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::ParserException& ex) {
-    *error = source_name + ":" + std::to_string(ex.mark.line + 1) + ": malformed YAML: " + ex.msg;
-    return false;
-  }
+  if (!sim::LoadYamlDocument(yaml_text, source_name, &root, error)) return false;
   Reader r(source_name, error);
   if (!root.IsMap()) {
     *error = source_name + ": expected a YAML mapping (name, train, validation, parameters, ...)";
@@ -589,8 +587,9 @@ bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
   s.text = yaml_text;
   s.name = fs::path(source_name).stem().string();
   if (root["name"].IsDefined() && !r.String(root["name"], "name", &s.name)) return false;
-  if (s.name.find('/') != std::string::npos || s.name == "." || s.name == "..")
-    return r.Fail(root["name"], "name: '" + s.name + "' cannot name a folder");
+  std::string name_error;
+  if (!CheckPathName(s.name, "tune name", &name_error))
+    return r.Fail(root["name"].IsDefined() ? root["name"] : root, "name: " + name_error);
   if (root["base_config"].IsDefined() && !root["base_config"].IsNull()) {
     std::string path;
     if (!r.String(root["base_config"], "base_config", &path)) return false;
@@ -637,14 +636,9 @@ bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
 }
 
 bool LoadTuneSpec(const std::string& path, TuneSpec* spec, std::string* error) {
-  std::ifstream in(path);
-  if (!in || fs::is_directory(path)) {
-    *error = path + ": cannot open tune file";
-    return false;
-  }
-  std::stringstream text;
-  text << in.rdbuf();
-  if (!ParseTuneSpec(text.str(), path, fs::path(path).parent_path().string(), spec, error))
+  std::string text;
+  if (!sim::ReadInputFile(path, "YAML tune file", &text, error)) return false;
+  if (!ParseTuneSpec(text, path, fs::path(path).parent_path().string(), spec, error))
     return false;
   spec->source_path = path;
   return true;
@@ -684,6 +678,10 @@ bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSeque
     d.depth_m = cv::Mat();  // not needed: the score uses the poses only
     sequence->frames.push_back(d);
     bar.Update(static_cast<int>(sequence->frames.size()));
+    if (InterruptSignal() != 0) {  // RunTune words the message
+      *error = "interrupted";
+      break;
+    }
   }
   if (!error->empty()) {
     *error = scenario.name + ": " + *error;
@@ -736,6 +734,10 @@ bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& opti
   std::vector<Eigen::Isometry3d> est, gt;
   SequenceScore s;
   for (const DatasetFrame& f : sequence.frames) {
+    if (InterruptSignal() != 0) {  // RunTune words the message
+      *error = sequence.name + ": interrupted";
+      return false;
+    }
     const vo::OdometryResult r = odometry->Process(f.left, f.right, f.time_s);
     if (vo::IsLostFrame(r)) ++s.lost_frames;
     // Frames before the first one the VO initialised on have no pose (as in `run`): they are
@@ -771,8 +773,11 @@ double AggregateScores(const std::vector<SequenceScore>& scores, const TuneObjec
   return objective.aggregate == "max" ? max : sum / static_cast<double>(scores.size());
 }
 
-bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summary,
-             std::string* error) {
+namespace {
+
+// RunTune without the interrupt message; *evaluations counts the objective's evaluations.
+bool RunTuneSteps(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summary,
+                  int* evaluations, std::string* error) {
   const auto start = Clock::now();
   const fs::path dir = options.out_dir;
   if (dir.empty()) {
@@ -810,6 +815,7 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
       if (!ScoreSequence(train[i], o, spec.objective, &scores[i], why)) return false;
     *score = AggregateScores(scores, spec.objective);
     eval_scores.push_back(scores);
+    *evaluations = static_cast<int>(eval_scores.size());
     return true;
   };
   auto last = Clock::now();
@@ -888,9 +894,23 @@ bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summ
   }
   if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(spec, s, opt, has_plot), error))
     return false;
+  if (InterruptSignal() != 0) return false;  // nothing published yet
   if (!folder.Publish("summary.json", "tune", error)) return false;
   *summary = s;
   return true;
+}
+
+}  // namespace
+
+bool RunTune(const TuneSpec& spec, const TuneOptions& options, TuneSummary* summary,
+             std::string* error) {
+  int evaluations = 0;
+  if (RunTuneSteps(spec, options, summary, &evaluations, error)) return true;
+  if (InterruptSignal() != 0) {
+    const int max_evals = options.max_evals > 0 ? options.max_evals : spec.optimizer.max_evals;
+    *error = InterruptedMessage(evaluations, max_evals, "evaluations", options.out_dir);
+  }
+  return false;
 }
 
 std::string TuneSummaryTable(const TuneSpec& spec, const TuneSummary& s) {

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "harness/cli.h"
 #include "harness/tune.h"
 
 namespace harness {
@@ -18,7 +19,7 @@ CLI::App* AddTuneCommand(CLI::App& app, TuneCommandArgs* args) {
   tune->add_option(
           "--max-evals", args->max_evals,
           "Evaluations budget, the start included (default: the file's optimizer.max_evals)")
-      ->check(CLI::PositiveNumber);
+      ->check(AtLeast(1));
   tune->add_flag("--no-plots", args->no_plots, "Skip objective.png");
   tune->add_flag("-q,--quiet", args->quiet, "No progress display");
   return tune;

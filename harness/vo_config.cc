@@ -9,6 +9,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sim/yaml_input.h"
+
 namespace harness {
 namespace {
 
@@ -217,19 +219,30 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
 }
 
 // Walks the mapping; leaves (scalars and the wavelength list) are applied by dotted key.
+// `seen` holds the line of every key applied so far: the same option given twice, once dotted
+// and once nested ("matcher.type: a" and "matcher: {type: b}"), is a duplicate too.
 bool Apply(const YAML::Node& node, const std::string& prefix, const std::string& source,
-           std::map<std::string, Entry>& entries, std::string* error) {
+           std::map<std::string, Entry>& entries, std::map<std::string, int>* seen,
+           std::string* error) {
   for (const auto& kv : node) {
     const std::string key = prefix.empty() ? kv.first.Scalar() : prefix + "." + kv.first.Scalar();
     const YAML::Node& v = kv.second;
-    const std::string where = source + ":" + std::to_string(kv.first.Mark().line + 1) + ": key '" + key + "': ";
+    const int line = kv.first.Mark().line + 1;
+    const std::string where = source + ":" + std::to_string(line) + ": key '" + key + "': ";
     auto it = entries.find(key);
+    if (it != entries.end()) {
+      const auto [first, inserted] = seen->emplace(key, line);
+      if (!inserted) {
+        *error = where + "duplicate (first at line " + std::to_string(first->second) + ")";
+        return false;
+      }
+    }
     if (it == entries.end()) {
       if (v.IsMap()) {
         bool any = false;
         for (const auto& e : entries) any |= e.first.rfind(key + ".", 0) == 0;
         if (any) {
-          if (!Apply(v, key, source, entries, error)) return false;
+          if (!Apply(v, key, source, entries, seen, error)) return false;
           continue;
         }
       }
@@ -250,12 +263,7 @@ bool Apply(const YAML::Node& node, const std::string& prefix, const std::string&
 bool ParseVoConfig(const std::string& yaml_text, const std::string& source_name,
                    vo::OdometryOptions* options, std::string* error) {
   YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::ParserException& ex) {
-    *error = source_name + ":" + std::to_string(ex.mark.line + 1) + ": malformed YAML: " + ex.msg;
-    return false;
-  }
+  if (!sim::LoadYamlDocument(yaml_text, source_name, &root, error)) return false;
   if (root.IsNull()) return true;  // an empty file: defaults
   if (!root.IsMap()) {
     *error = source_name + ": expected a YAML mapping of VO options";
@@ -264,7 +272,8 @@ bool ParseVoConfig(const std::string& yaml_text, const std::string& source_name,
   vo::OdometryOptions o = *options;
   std::map<std::string, Entry> entries;
   for (auto& e : Registry(&o)) entries.emplace(e.first, e.second);
-  if (!Apply(root, "", source_name, entries, error)) return false;
+  std::map<std::string, int> seen;
+  if (!Apply(root, "", source_name, entries, &seen, error)) return false;
   std::string why;
   if (!o.IsValid(&why)) {
     *error = source_name + ": invalid VO options: " + why;
@@ -275,14 +284,9 @@ bool ParseVoConfig(const std::string& yaml_text, const std::string& source_name,
 }
 
 bool LoadVoConfig(const std::string& path, vo::OdometryOptions* options, std::string* error) {
-  std::ifstream in(path);
-  if (!in) {
-    *error = path + ": cannot open VO config file";
-    return false;
-  }
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseVoConfig(text.str(), path, options, error);
+  std::string text;
+  if (!sim::ReadInputFile(path, "YAML VO config file", &text, error)) return false;
+  return ParseVoConfig(text, path, options, error);
 }
 
 std::string VoConfigToYaml(const vo::OdometryOptions& options) {

@@ -8,6 +8,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sim/scene_walls.h"
+#include "sim/yaml_input.h"
+
 namespace sim {
 namespace {
 
@@ -115,6 +118,41 @@ std::string Num(double v) {
   return s.str();
 }
 
+// Frames are taken on physics steps: the frame period must be a whole number of steps, to this
+// relative tolerance (10 Hz at 0.002 s is 50 steps up to rounding of the decimal values).
+constexpr double kStepsPerFrameTolerance = 1e-6;
+
+// The physics checks that involve several keys (rate vs step, exposure vs period): "" when
+// fine, else the problem, and *key names the key to blame. Rates and steps out of their own
+// ranges are left to the per-key checks.
+std::string PhysicsProblem(const Scenario& s, std::string* key) {
+  std::ostringstream e;
+  if (!(s.rate_hz > 0) || !(s.physics_dt_s > 0)) return "";
+  *key = "rate_hz";
+  const double steps = 1.0 / (s.rate_hz * s.physics_dt_s);  // physics steps per frame period
+  const double whole = std::round(steps);
+  if (steps < 1.0 - kStepsPerFrameTolerance) {
+    e << s.rate_hz << " Hz is above the physics rate 1/physics_dt_s = "
+      << Num(1.0 / s.physics_dt_s) << " Hz (a frame per physics step at most)";
+  } else if (std::abs(steps - whole) > kStepsPerFrameTolerance * whole) {
+    e << "the frame period 1/" << s.rate_hz << " s is " << Num(steps)
+      << " physics steps of " << s.physics_dt_s
+      << " s; expected a whole number (frames are taken on physics steps), e.g. rate_hz "
+      << Num(1.0 / (std::floor(steps) * s.physics_dt_s)) << " or "
+      << Num(1.0 / (std::ceil(steps) * s.physics_dt_s));
+  } else if (s.noise.motion_blur_exposure_s > 0.0) {
+    // The exposures of consecutive frames must not share a physics step.
+    const double max_exposure_s = (whole - 2.0) * s.physics_dt_s;
+    *key = "noise.motion_blur_exposure_s";
+    if (!(s.noise.motion_blur_exposure_s <= max_exposure_s + 1e-12))
+      e << s.noise.motion_blur_exposure_s
+        << " s does not fit in the frame period: expected at most the period minus 2 physics steps, "
+        << Num(std::max(0.0, max_exposure_s)) << " s at rate_hz " << s.rate_hz << " and physics_dt_s "
+        << s.physics_dt_s;
+  }
+  return e.str();
+}
+
 }  // namespace
 
 bool Scenario::IsValid(std::string* error) const {
@@ -131,8 +169,10 @@ bool Scenario::IsValid(std::string* error) const {
   else if (robot.corner_mode != "in_place" && robot.corner_mode != "arc") e << "robot.corner_mode: expected 'in_place' or 'arc', got '" << robot.corner_mode << "'";
   else if (!(robot.goal_tolerance_m > 0)) e << "robot.goal_tolerance_m: expected > 0";
   else if (camera.width < 16 || camera.width > 4096 || camera.height < 16 || camera.height > 4096) e << "camera.width/height: expected 16..4096, got " << camera.width << "x" << camera.height;
-  else if (!(camera.fovy_deg > 1 && camera.fovy_deg < 170)) e << "camera.fovy_deg: expected in (1, 170), got " << camera.fovy_deg;
-  else if (!(camera.baseline_m > 0)) e << "camera.baseline_m: expected > 0, got " << camera.baseline_m;
+  else if (!(camera.fovy_deg > kMinFovDeg && camera.fovy_deg < kMaxFovDeg)) e << "camera.fovy_deg: expected in (1, 170), got " << camera.fovy_deg;
+  else if (const double fovx_deg = 2.0 * std::atan(std::tan(camera.fovy_deg * M_PI / 360.0) * camera.width / camera.height) * 180.0 / M_PI;
+           !(fovx_deg < kMaxFovDeg)) e << "camera.fovy_deg: " << camera.fovy_deg << " deg at " << camera.width << "x" << camera.height << " gives a horizontal field of view of " << fovx_deg << " deg; expected below " << kMaxFovDeg << " deg";
+  else if (!(camera.baseline_m >= kMinBaselineM && camera.baseline_m <= kMaxBaselineM)) e << "camera.baseline_m: expected " << kMinBaselineM << " .. " << kMaxBaselineM << " m (1 mm to 5 m), got " << camera.baseline_m;
   else if (!(camera.height_m > 0)) e << "camera.height_m: expected > 0, got " << camera.height_m;
   else if (!(camera.pitch_deg > -80 && camera.pitch_deg < 80)) e << "camera.pitch_deg: expected in (-80, 80)";
   else if (!(noise.pixel_sigma >= 0)) e << "noise.pixel_sigma: expected >= 0";
@@ -140,6 +180,8 @@ bool Scenario::IsValid(std::string* error) const {
   else if (!(noise.bias_sigma >= 0)) e << "noise.bias_sigma: expected >= 0";
   else if (!(noise.motion_blur_exposure_s >= 0 && noise.motion_blur_exposure_s < 1.0 / rate_hz)) e << "noise.motion_blur_exposure_s: expected in [0, 1/rate_hz)";
   else if (noise.motion_blur_exposure_s > 0 && noise.motion_blur_samples < 2) e << "noise.motion_blur_samples: expected >= 2 when motion blur is on";
+  else if (noise.motion_blur_samples < 1 || noise.motion_blur_samples > kMaxMotionBlurSamples) e << "noise.motion_blur_samples: expected 1 .. " << kMaxMotionBlurSamples << ", got " << noise.motion_blur_samples;
+  else if (std::string key, physics = PhysicsProblem(*this, &key); !physics.empty()) e << key << ": " << physics;
   else {
     for (size_t i = 0; i < path.size(); ++i) {
       if (!path[i].allFinite()) { e << "path[" << i << "]: expected finite coordinates"; break; }
@@ -154,10 +196,9 @@ bool Scenario::IsValid(std::string* error) const {
 bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
                    const std::string& base_dir, Scenario* scenario, std::string* error) {
   YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::ParserException& ex) {
-    if (error) *error = source_name + ":" + std::to_string(ex.mark.line + 1) + ": malformed YAML: " + ex.msg;
+  std::string yaml_error;
+  if (!LoadYamlDocument(yaml_text, source_name, &root, &yaml_error)) {
+    if (error) *error = yaml_error;
     return false;
   }
   StrictReader r(source_name);
@@ -230,9 +271,10 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     r.Int(n, "camera", "height", &o.height);
     r.Require(o.height >= 16 && o.height <= 4096, n, "camera", "height", "expected 16..4096 pixels, got " + std::to_string(o.height));
     r.Double(n, "camera", "fovy_deg", &o.fovy_deg);
-    r.Require(o.fovy_deg > 1 && o.fovy_deg < 170, n, "camera", "fovy_deg", "expected in (1, 170) degrees, got " + Num(o.fovy_deg));
+    r.Require(o.fovy_deg > kMinFovDeg && o.fovy_deg < kMaxFovDeg, n, "camera", "fovy_deg", "expected in (1, 170) degrees, got " + Num(o.fovy_deg));
     r.Double(n, "camera", "baseline_m", &o.baseline_m);
-    r.Require(o.baseline_m > 0, n, "camera", "baseline_m", "expected a positive baseline (m), got " + Num(o.baseline_m));
+    r.Require(o.baseline_m >= kMinBaselineM && o.baseline_m <= kMaxBaselineM, n, "camera", "baseline_m",
+              "expected a positive baseline of " + Num(kMinBaselineM) + " .. " + Num(kMaxBaselineM) + " m (1 mm to 5 m), got " + Num(o.baseline_m));
     r.Double(n, "camera", "height_m", &o.height_m);
     r.Require(o.height_m > 0, n, "camera", "height_m", "expected > 0 m, got " + Num(o.height_m));
     r.Double(n, "camera", "forward_m", &o.forward_m);
@@ -251,10 +293,24 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     r.Double(n, "noise", "motion_blur_exposure_s", &o.motion_blur_exposure_s);
     r.Require(o.motion_blur_exposure_s >= 0, n, "noise", "motion_blur_exposure_s", "expected >= 0 s");
     r.Int(n, "noise", "motion_blur_samples", &o.motion_blur_samples);
+    r.Require(o.motion_blur_samples >= 1 && o.motion_blur_samples <= kMaxMotionBlurSamples, n, "noise",
+              "motion_blur_samples", "expected 1 .. " + std::to_string(kMaxMotionBlurSamples) +
+              " renders per frame, got " + std::to_string(o.motion_blur_samples));
   }
   if (const YAML::Node n = root["textures"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(n, "textures", {"seed"});
     r.Uint64(n, "textures", "seed", &s.textures.seed);
+  }
+  if (r.ok() && s.physics_dt_s > 0 && s.physics_dt_s <= 0.01) {
+    // Rate vs step, exposure vs period: at the line of the key to change.
+    std::string key;
+    const std::string physics = PhysicsProblem(s, &key);
+    if (!physics.empty()) {
+      const YAML::Node noise = root["noise"];
+      const YAML::Node at = key == "rate_hz" ? root["rate_hz"]
+                            : noise.IsDefined() ? noise["motion_blur_exposure_s"] : YAML::Node();
+      r.Fail(at.IsDefined() ? at : root, key, physics);
+    }
   }
   if (!r.ok()) {
     if (error) *error = r.error();
@@ -275,20 +331,26 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     if (error) *error = source_name + ": " + why;
     return false;
   }
+  // A path through a wall of the scene: at the line of the waypoint the segment ends at.
+  int waypoint = -1;
+  if (const std::string through = PathThroughWallProblem(s, &waypoint); !through.empty()) {
+    const std::string key = "path[" + std::to_string(waypoint) + "]";
+    r.Fail(path[waypoint], key, through);
+    if (error) *error = r.error();
+    return false;
+  }
   *scenario = std::move(s);
   return true;
 }
 
 bool LoadScenario(const std::string& path, Scenario* scenario, std::string* error) {
-  std::ifstream in(path);
-  if (!in) {
-    if (error) *error = path + ": cannot open scenario file (" + (fs::exists(path) ? "not readable" : "no such file") + ")";
+  std::string text, why;
+  if (!ReadInputFile(path, "YAML scenario file", &text, &why)) {
+    if (error) *error = why;
     return false;
   }
-  std::stringstream text;
-  text << in.rdbuf();
   const std::string base = fs::absolute(path).parent_path().string();
-  return ParseScenario(text.str(), path, base, scenario, error);
+  return ParseScenario(text, path, base, scenario, error);
 }
 
 std::string ScenarioToYaml(const Scenario& s) {

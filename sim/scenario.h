@@ -23,12 +23,22 @@ struct RobotOptions {
   double track_m = 0.33;           // distance between the driven wheels (m), as in the MJCF robot
 };
 
+// Plausible ranges, shared by the scenario reader and the dataset readers (harness/dataset.cc):
+// a stereo rig from a phone's 1 mm to a car's or a tower's 5 m, and a field of view a pinhole
+// model describes (the reader also checks the focal length that gives).
+constexpr double kMinBaselineM = 0.001;  // 1 mm
+constexpr double kMaxBaselineM = 5.0;    // 5 m
+constexpr double kMinFovDeg = 1.0;       // exclusive
+constexpr double kMaxFovDeg = 170.0;     // exclusive
+// Renders averaged over a motion-blur exposure, at most (each one is a full stereo render).
+constexpr int kMaxMotionBlurSamples = 1000;
+
 // Rectified stereo pair on the robot (the paper's Videre head by default).
 struct CameraOptions {
   int width = 320;            // image width (pixels), 16..4096
   int height = 240;           // image height (pixels), 16..4096
   double fovy_deg = 55.0;     // vertical field of view (degrees), (1, 170)
-  double baseline_m = 0.09;   // stereo baseline (m), > 0
+  double baseline_m = 0.09;   // stereo baseline (m), [kMinBaselineM, kMaxBaselineM] = 1 mm .. 5 m
   double height_m = 1.0;      // optical centre height above the floor (m), > 0
   double forward_m = 0.15;    // optical centre ahead of the wheel axle (m)
   double pitch_deg = 0.0;     // downward tilt of the optical axis (degrees), (-80, 80)
@@ -39,8 +49,11 @@ struct NoiseOptions {
   double pixel_sigma = 0.0;         // additive Gaussian pixel noise (grey levels, 0..255 scale)
   double gain_sigma = 0.0;          // per-image multiplicative gain: gain ~ N(1, gain_sigma²)
   double bias_sigma = 0.0;          // per-image exposure offset ~ N(0, bias_sigma²) (grey levels)
-  double motion_blur_exposure_s = 0.0;  // exposure time for motion blur (s); 0 = no blur
-  int motion_blur_samples = 5;      // renders averaged over the exposure, >= 2 when blur is on
+  double motion_blur_exposure_s = 0.0;  // exposure time for motion blur (s); 0 = no blur;
+                                        // at most the frame period minus 2 physics steps (the
+                                        // exposures of consecutive frames must not overlap)
+  int motion_blur_samples = 5;      // renders averaged over the exposure, 1..1000
+                                    // (kMaxMotionBlurSamples), >= 2 when blur is on
 };
 
 // Procedural textures of the scene (sim/textures.h).
@@ -53,8 +66,10 @@ struct Scenario {
   std::string source_path;      // the YAML file it was read from (empty if built in code)
   std::string scene_path;       // MJCF scene, resolved to an absolute path
   uint64_t seed = 1;            // noise seed
-  double rate_hz = 10.0;        // camera frame rate (Hz), > 0; independent of the physics step
-  double physics_dt_s = 0.002;  // physics time step (s), > 0
+  double rate_hz = 10.0;        // camera frame rate (Hz), > 0, at most 1 / physics_dt_s, and
+                                // the frame period a whole number of physics steps (frames are
+                                // taken on steps: 10 Hz at 0.002 s = every 50th step)
+  double physics_dt_s = 0.002;  // physics time step (s), (0, 0.01]
   double max_duration_s = 300;  // safety limit on simulated time (s)
   double settle_s = 0.5;        // robot stands still this long before frame 0 (s), >= 0
   std::vector<Eigen::Vector2d> path;  // waypoints (x, y) in the world frame (m), >= 2

@@ -12,6 +12,7 @@
 #include "sim/path_follower.h"
 #include "sim/random.h"
 #include "sim/renderer.h"
+#include "sim/scene_walls.h"
 #include "sim/textures.h"
 
 namespace sim {
@@ -178,6 +179,13 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
     return nullptr;
   }
   m->opt.timestep = scenario.physics_dt_s;
+  // A path through a wall (scenarios built in code; files are checked when read).
+  int waypoint = -1;
+  if (const std::string through = PathThroughWallProblem(scenario, &waypoint); !through.empty()) {
+    *error = (scenario.source_path.empty() ? "scenario" : scenario.source_path) + ": key 'path[" +
+             std::to_string(waypoint) + "]': " + through;
+    return nullptr;
+  }
 
   // Stereo rig: place both cameras from the scenario (body frame: x forward, y left, z up,
   // origin at the wheel axle, which rests at wheel-radius height).

@@ -526,6 +526,32 @@ TEST_F(KittiMalformedTest, MissingOrMalformedTimes) {
   EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/times.txt: file not found"));
 }
 
+// Issue #11: `baseline_m: 1e300` in calib.txt ran and gave inf/NaN metrics.
+TEST_F(KittiMalformedTest, ImplausibleBaselineOrFocalLengthIsRefused) {
+  WriteAll(dir_ + "/calib.txt",
+           "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1 0\n"
+           "P1: 52.25 0 31.5 -5.225e301 0 51.75 23.5 0 0 0 1 0\n");
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/calib.txt: baseline 1e+300 m is outside the "
+                                                 "plausible range 0.001 .. 5 m"));
+  WriteAll(dir_ + "/calib.txt",
+           "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1 0\n"
+           "P1: 52.25 0 31.5 -0.0261 0 51.75 23.5 0 0 0 1 0\n");  // 0.5 mm
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/calib.txt: baseline 0.0004995"));
+  // fx = 0.5 px over 64 px: a 178 deg field of view, no pinhole camera.
+  WriteAll(dir_ + "/calib.txt",
+           "P0: 0.5 0 31.5 0 0 51.75 23.5 0 0 0 1 0\n"
+           "P1: 0.5 0 31.5 -0.0625 0 51.75 23.5 0 0 0 1 0\n");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/calib.txt: fx 0.5 px gives a horizontal field of view of"));
+}
+
+// Issue #11: time stamps that went backwards were accepted.
+TEST_F(KittiMalformedTest, TimesThatGoBackwardsAreRefused) {
+  WriteAll(dir_ + "/times.txt", "0.0\n0.2\n0.1\n0.3\n0.4\n");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/times.txt:3: time stamp 0.1 is before the previous one, 0.2"));
+}
+
 TEST_F(KittiMalformedTest, DepthWithWrongType) {
   const std::string dir = WriteSequence("depth", MakeSequence(2, false, true));
   cv::imwrite(dir + "/depth/000001.png", cv::Mat::zeros(48, 64, CV_8UC1));
@@ -591,6 +617,27 @@ TEST_F(EurocMalformedTest, MalformedDataCsvLine) {
   WriteAll(dir_ + "/mav0/cam1/data.csv", "#timestamp [ns],filename\n100000000000\n");
   EXPECT_THAT(OpenAndReadAll(),
               HasSubstr(dir_ + "/mav0/cam1/data.csv:2: expected '<timestamp ns>,"));
+}
+
+// Issue #11: stamps must increase in cam*/data.csv and in the ground truth.
+TEST_F(EurocMalformedTest, StampsThatGoBackwardsOrRepeatAreRefused) {
+  WriteAll(dir_ + "/mav0/cam0/data.csv",
+           "#timestamp [ns],filename\n100000000000,100000000000.png\n"
+           "100066666667,100066666667.png\n100033333333,100033333333.png\n");
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/mav0/cam0/data.csv:4: time stamp 100033333333 "
+                                                 "is before the previous one, 100066666667"));
+  WriteAll(dir_ + "/mav0/cam0/data.csv",
+           "#timestamp [ns],filename\n100000000000,100000000000.png\n"
+           "100000000000,100033333333.png\n");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/mav0/cam0/data.csv:3: time stamp 100000000000 repeats"));
+}
+
+TEST_F(EurocMalformedTest, GroundTruthStampsThatGoBackwardsAreRefused) {
+  WriteAll(dir_ + "/mav0/state_groundtruth_estimate0/data.csv",
+           "#t\n100033333333,0,0,0,1,0,0,0\n100000000000,0,0,0,1,0,0,0\n");
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/mav0/state_groundtruth_estimate0/data.csv:3: "
+                                                 "time stamp 100000000000 is before"));
 }
 
 TEST_F(EurocMalformedTest, MissingSensorYaml) {

@@ -154,4 +154,21 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   EXPECT_NE(error.find("malformed"), std::string::npos);
 }
 
+// Issue #11: a key given twice was read from its first occurrence, silently; a folder given as
+// --config ran the defaults.
+TEST(VoConfigTest, DuplicateKeysAndFoldersAreRefused) {
+  vo::OdometryOptions o;
+  std::string error;
+  EXPECT_FALSE(harness::ParseVoConfig("matcher:\n  type: ncc_mutual\nmatcher:\n  type: kalman\n",
+                                      "cfg.yaml", &o, &error));
+  EXPECT_EQ(error, "cfg.yaml:3: key 'matcher': duplicate (first at line 1)");
+  // The same option dotted and nested.
+  EXPECT_FALSE(harness::ParseVoConfig("matcher.type: kalman\nmatcher:\n  type: ncc_mutual\n",
+                                      "cfg.yaml", &o, &error));
+  EXPECT_EQ(error, "cfg.yaml:3: key 'matcher.type': duplicate (first at line 1)");
+  const std::string folder = ::testing::TempDir();
+  EXPECT_FALSE(harness::LoadVoConfig(folder, &o, &error));
+  EXPECT_EQ(error, folder + ": is a folder, expected a YAML VO config file");
+}
+
 }  // namespace

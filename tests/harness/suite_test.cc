@@ -175,6 +175,18 @@ TEST(SuiteFileTest, BadSuiteFilesNameTheFileLineAndKey) {
       {"name: b\nscenarios: []\nconfigs:\n  - name: a\n", {"bad.yaml:2", "scenarios"}},
       {"name: b\nscenarios:\n  - scenario: l_hallway\n", {"bad.yaml", "configs", "required"}},
       {"name: b\nscenarios: [\n", {"bad.yaml", "malformed YAML"}},
+      // Issue #11: duplicate keys, and names checked by the one path-name rule.
+      {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\nname: c\n",
+       {"bad.yaml:6", "key 'name': duplicate (first at line 1)"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\n    max_frames: 3\n    max_frames: 4\n"
+       "configs:\n  - name: a\n",
+       {"bad.yaml:5", "key 'scenarios[0].max_frames': duplicate (first at line 4)"}},
+      {"name: -b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n",
+       {"bad.yaml:1", "suite name '-b': cannot name a folder: starts with '-'"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\n    name: ..\nconfigs:\n  - name: a\n",
+       {"bad.yaml:4", "scenario name '..': cannot name a folder"}},
+      {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: \"a/b\"\n",
+       {"bad.yaml:5", "configuration name 'a/b': cannot name a folder: contains a path separator"}},
   };
   for (const auto& c : cases) {
     harness::Suite suite;

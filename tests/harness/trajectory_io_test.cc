@@ -207,7 +207,7 @@ TEST_F(TrajectoryIoTest, KittiPosesMalformedRowsNameFileAndLine) {
 }
 
 TEST_F(TrajectoryIoTest, KittiTimesRoundTripAndErrors) {
-  const std::vector<double> times = {0.0, 0.1, 0.2, 1e-5, 123456.789};
+  const std::vector<double> times = {0.0, 1e-5, 0.1, 0.2, 123456.789};
   std::string error;
   ASSERT_TRUE(WriteKittiTimes(Path("times.txt"), times, &error)) << error;
   std::vector<double> back;
@@ -219,6 +219,28 @@ TEST_F(TrajectoryIoTest, KittiTimesRoundTripAndErrors) {
   const std::string bad = WriteFile("bad_times.txt", "0.0\n0.1 0.2\n");
   EXPECT_FALSE(ReadKittiTimes(bad, &back, &error));
   EXPECT_THAT(error, HasSubstr(bad + ":2: expected 1 numbers, got 2"));
+}
+
+// Issue #11: stamps that go backwards or repeat were accepted (the trajectory then got a
+// repeated stamp); every reader refuses them with the file and line of the offending stamp.
+TEST_F(TrajectoryIoTest, TimeStampsThatGoBackwardsOrRepeatAreRefusedWithFileAndLine) {
+  std::vector<double> times;
+  std::string error;
+  const std::string backwards = WriteFile("back_times.txt", "0.0\n0.1\n# note\n0.05\n0.3\n");
+  EXPECT_FALSE(ReadKittiTimes(backwards, &times, &error));
+  EXPECT_THAT(error, HasSubstr(backwards + ":4: time stamp 0.05 is before the previous one, 0.1 "
+                                           "(line 2); expected strictly increasing time stamps"));
+  const std::string repeated = WriteFile("repeat_times.txt", "0.0\n0.1\n0.1\n");
+  EXPECT_FALSE(ReadKittiTimes(repeated, &times, &error));
+  EXPECT_THAT(error, HasSubstr(repeated + ":3: time stamp 0.1 repeats the previous one, 0.1"));
+
+  std::vector<StampedPose> poses;
+  const std::string tum = WriteFile("back_tum.txt",
+                                    "# t tx ty tz qx qy qz qw\n"
+                                    "2.0 0 0 0 0 0 0 1\n"
+                                    "1.5 0 0 0 0 0 0 1\n");
+  EXPECT_FALSE(ReadTum(tum, &poses, &error));
+  EXPECT_THAT(error, HasSubstr(tum + ":3: time stamp 1.5 is before the previous one, 2.0 (line 2)"));
 }
 
 TEST_F(TrajectoryIoTest, WriteRejectsNonFiniteAndUnwritablePaths) {

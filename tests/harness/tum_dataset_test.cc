@@ -253,7 +253,12 @@ TEST_F(TumDatasetTest, MalformedListLines) {
   WriteAll(dir_ + "/left.txt", "nan left/a.png\n");
   EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/left.txt:1: expected 'timestamp filename'"));
   WriteAll(dir_ + "/left.txt", "1 left/a.png\n1 left/b.png\n");
-  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/left.txt:2: duplicate timestamp 1 (line 1)"));
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/left.txt:2: time stamp 1 repeats the previous one, 1 (line 1)"));
+  // Issue #11: stamps that go backwards are refused too (they were accepted).
+  WriteAll(dir_ + "/left.txt", "2 left/a.png\n1 left/b.png\n");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/left.txt:2: time stamp 1 is before the previous one, 2 (line 1)"));
   WriteAll(dir_ + "/left.txt", "# nothing\n");
   EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/left.txt: no images listed"));
 }

@@ -378,6 +378,14 @@ std::vector<BadFile> BadFiles() {
       {"unknown scenario",
        replace("scenario: l_hallway", "scenario: no_such_hallway"),
        {":3:", "no_such_hallway"}},
+      // Issue #11: duplicate keys (the first one won) and names that cannot name a folder.
+      {"duplicate key",
+       replace("name: tiny\n", "name: tiny\nname: other\n"),
+       {":2:", "key 'name': duplicate (first at line 1)"}},
+      {"name with a path in it",
+       replace("name: tiny", "name: ../tiny"),
+       {":1:", "tune name '../tiny': cannot name a folder: contains '..'"}},
+      {"name like an option", replace("name: tiny", "name: -tiny"), {":1:", "starts with '-'"}},
   };
 }
 

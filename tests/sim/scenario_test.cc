@@ -137,6 +137,81 @@ TEST_F(ScenarioFileTest, MissingSceneFile) {
   EXPECT_NE(e2.find("'scene'"), std::string::npos) << e2;
 }
 
+// Issue #11: a key given twice was read from its first occurrence, silently.
+TEST_F(ScenarioFileTest, DuplicateKeysAreRefusedWithBothLines) {
+  EXPECT_NE(Load(Replace("rate_hz: 10", "rate_hz: 10\nrate_hz: 20"))
+                .find("s.yaml:5: key 'rate_hz': duplicate (first at line 4)"),
+            std::string::npos);
+  const std::string e = Load(Replace("  baseline_m: 0.12", "  baseline_m: 0.12\n  baseline_m: 0.5"));
+  EXPECT_NE(e.find("s.yaml:10: key 'camera.baseline_m': duplicate (first at line 9)"),
+            std::string::npos)
+      << e;
+}
+
+// Issue #11: the frame rate is checked against the physics step (1000 Hz at 0.002 s wrote 2
+// frames; 30 Hz is 16.67 steps per frame).
+TEST_F(ScenarioFileTest, FrameRateMustFitThePhysicsStep) {
+  const std::string above = Load(Replace("rate_hz: 10", "rate_hz: 1000"));
+  EXPECT_NE(above.find("s.yaml:4: key 'rate_hz': 1000 Hz is above the physics rate"),
+            std::string::npos)
+      << above;
+  const std::string fraction = Load(Replace("rate_hz: 10", "rate_hz: 30"));
+  EXPECT_NE(fraction.find("key 'rate_hz'"), std::string::npos) << fraction;
+  EXPECT_NE(fraction.find("16.6667 physics steps"), std::string::npos) << fraction;
+  EXPECT_NE(fraction.find("whole number"), std::string::npos) << fraction;
+  EXPECT_EQ(Load(Replace("rate_hz: 10", "rate_hz: 500")), "");  // one step per frame
+  EXPECT_EQ(Load(Replace("rate_hz: 10", "rate_hz: 25\nphysics_dt_s: 0.001")), "");
+}
+
+// Issue #11: an exposure of 0.0999 s at 10 Hz passed, then failed after 300 simulated seconds
+// ("stuck against a wall"); 1e8 blur samples hung the render.
+TEST_F(ScenarioFileTest, MotionBlurMustFitTheFramePeriodWithBoundedSamples) {
+  const std::string e = Load(Replace("  pixel_sigma: 1.0", "  motion_blur_exposure_s: 0.0999"));
+  EXPECT_NE(e.find("key 'noise.motion_blur_exposure_s': 0.0999 s does not fit in the frame period"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("0.096 s"), std::string::npos) << e;  // 100 ms - 2 steps of 2 ms
+  EXPECT_EQ(Load(Replace("  pixel_sigma: 1.0", "  motion_blur_exposure_s: 0.096")), "");
+  const std::string samples = Load(Replace(
+      "  pixel_sigma: 1.0", "  motion_blur_exposure_s: 0.03\n  motion_blur_samples: 100000000"));
+  EXPECT_NE(samples.find("key 'noise.motion_blur_samples': expected 1 .. 1000"),
+            std::string::npos)
+      << samples;
+}
+
+// Issue #11: `baseline_m: 1e300` ran and gave inf/NaN metrics. Bounds: 1 mm .. 5 m.
+TEST_F(ScenarioFileTest, BaselineAndFieldOfViewInPlausibleRanges) {
+  for (const char* bad : {"1e300", "0.0005", "5.5"}) {
+    const std::string e = Load(Replace("baseline_m: 0.12", std::string("baseline_m: ") + bad));
+    EXPECT_NE(e.find("key 'camera.baseline_m': expected a positive baseline of 0.001 .. 5 m"),
+              std::string::npos)
+        << e;
+  }
+  EXPECT_EQ(Load(Replace("baseline_m: 0.12", "baseline_m: 0.001")), "");
+  EXPECT_EQ(Load(Replace("baseline_m: 0.12", "baseline_m: 5")), "");
+  // 55 deg vertically over 4096x16 pixels is a horizontal field of view of ~180 deg.
+  const std::string wide =
+      Load(Replace("  baseline_m: 0.12", "  baseline_m: 0.12\n  width: 4096\n  height: 16"));
+  EXPECT_NE(wide.find("horizontal field of view"), std::string::npos) << wide;
+}
+
+// Issue #11: a path through a wall was accepted (walls are visual only), so the camera
+// rendered from outside the hallway. The waypoint is named with its line.
+TEST_F(ScenarioFileTest, PathThroughAWallIsRefusedNamingTheWaypoint) {
+  const std::string scene = std::string(VOBENCH_SOURCE_DIR) + "/scenes/hallway_l.xml";
+  const std::string through = Load("scene: " + scene + "\npath:\n  - [0, 0]\n  - [0, 3]\n");
+  EXPECT_NE(through.find("s.yaml:4: key 'path[1]': the segment from path[0] (0, 0) to path[1] "
+                         "(0, 3) crosses wall 'wall_north' of hallway_l.xml at (0, 1)"),
+            std::string::npos)
+      << through;
+  // The paper's L path stays inside.
+  EXPECT_EQ(Load("scene: " + scene + "\npath: [[0, 0], [8, 0], [8, 8]]\n"), "");
+  // Past the end of the east wall's leg: the third segment leaves through wall_end (y = 12).
+  const std::string end = Load("scene: " + scene + "\npath: [[0, 0], [8, 0], [8, 13]]\n");
+  EXPECT_NE(end.find("key 'path[2]'"), std::string::npos) << end;
+  EXPECT_NE(end.find("wall 'wall_end'"), std::string::npos) << end;
+}
+
 TEST_F(ScenarioFileTest, OutOfRangeValues) {
   EXPECT_NE(Load(Replace("rate_hz: 10", "rate_hz: 0")), "");
   EXPECT_NE(Load(Replace("  baseline_m: 0.12", "  width: 8")).find("'camera.width'"), std::string::npos);

@@ -222,6 +222,24 @@ TEST(SimulatorTest, SceneErrorsNameTheFile) {
   EXPECT_NE(error.find("robot"), std::string::npos) << error;
 }
 
+// Issue #11: walls are visual only, so a path through one was simulated with the camera
+// outside the scene. Scenarios built in code are checked by Create (files when read).
+TEST(SimulatorTest, PathThroughAWallIsRefusedBeforeSimulating) {
+  TempDir dir("wall");
+  // A 2 m wide, 2.5 m high wall across the x axis at x = 0.5 (normal along -x).
+  const std::string scene = WriteScene(
+      dir, "    <geom name='blocker' type='plane' size='1 1.25 0.1' pos='0.5 0 1.25' "
+           "xyaxes='0 1 0 0 0 1' contype='0' conaffinity='0'/>\n");
+  std::string error;
+  EXPECT_EQ(sim::Simulator::Create(MakeScenario(scene, 1.0), &error), nullptr);
+  EXPECT_NE(error.find("key 'path[1]'"), std::string::npos) << error;
+  EXPECT_NE(error.find("crosses wall 'blocker'"), std::string::npos) << error;
+  EXPECT_NE(error.find("at (0.5, 0)"), std::string::npos) << error;
+  // Stopping short of it is fine.
+  error.clear();
+  EXPECT_NE(sim::Simulator::Create(MakeScenario(scene, 0.4), &error), nullptr) << error;
+}
+
 TEST(SimulatorTest, IntrinsicsFromFovy) {
   double fx, fy, cx, cy;
   sim::IntrinsicsFromFovy(90.0, 640, 480, &fx, &fy, &cx, &cy);

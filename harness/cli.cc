@@ -1,0 +1,52 @@
+#include "harness/cli.h"
+
+#include <cstdio>
+#include <string>
+
+namespace harness {
+
+CLI::Validator AtLeast(long min) {
+  const std::string bound = std::to_string(min);
+  return CLI::Validator(
+      [min, bound](std::string& text) -> std::string {
+        long value = 0;
+        size_t used = 0;
+        try {
+          value = std::stol(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != text.size())
+          return "expected an integer >= " + bound + ", got '" + text + "'";
+        if (value < min) return "must be >= " + bound + ", got " + text;
+        return std::string();
+      },
+      "INT>=" + bound);
+}
+
+int ParseCommandLine(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+    return -1;
+  } catch (const CLI::Success& e) {  // --help
+    return app.exit(e);
+  } catch (const CLI::RuntimeError& e) {  // a subcommand callback's result; already reported
+    return e.get_exit_code();
+  } catch (const CLI::ParseError& e) {
+    // The subcommands parsed so far name the command in the message ("vobench suite merge").
+    std::string command = "vobench";
+    for (const CLI::App* a = &app; !a->get_subcommands().empty();) {
+      a = a->get_subcommands().front();
+      command += " " + a->get_name();
+    }
+    std::string message = e.what();
+    for (char& c : message)
+      if (c == '\n' || c == '\r') c = ' ';
+    while (!message.empty() && message.back() == ' ') message.pop_back();
+    std::fprintf(stderr, "%s: %s (see %s --help)\n", command.c_str(), message.c_str(),
+                 command.c_str());
+    return kExitBadInput;
+  }
+}
+
+}  // namespace harness
