@@ -59,9 +59,11 @@ Eigen::Isometry3d Root(const Eigen::Isometry3d& T, int64_t n) {
 // Smallest multiple of 16 >= fx · b / min_depth, clamped (see OdometryOptions).
 int DerivedNumDisparities(const StereoCamera& camera, const OdometryOptions& options) {
   const double needed = camera.fx_px * camera.baseline_m / options.disparity_min_depth_m;
-  int n = static_cast<int>(std::ceil(needed / 16.0)) * 16;
   const int width_cap = std::max(16, (camera.width - 1) / 16 * 16);
-  n = std::min({n, options.max_num_disparities, width_cap});
+  const int cap = std::min(options.max_num_disparities, width_cap);
+  // Clamped in floating point first: an absurd camera (huge fx · baseline) must not overflow.
+  const double blocks = std::ceil(std::min(needed, static_cast<double>(cap)) / 16.0);
+  const int n = std::min(static_cast<int>(blocks) * 16, cap);
   return std::max(16, n);
 }
 
