@@ -82,6 +82,20 @@ Entry DisparityModeEntry(vo::DisparityMode* field) {
           [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
 }
 
+Entry BaSolverEntry(vo::BaSolver* field) {
+  return {[field](const YAML::Node& n, std::string* why) {
+            for (vo::BaSolver a : {vo::BaSolver::kCeres, vo::BaSolver::kSchurLm}) {
+              if (n.Scalar() == vo::ToString(a)) {
+                *field = a;
+                return true;
+              }
+            }
+            *why = "expected ceres or schur_lm; got '" + n.Scalar() + "'";
+            return false;
+          },
+          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
+}
+
 Entry DisparityAlgorithmEntry(vo::DisparityAlgorithm* field) {
   return {[field](const YAML::Node& n, std::string* why) {
             for (vo::DisparityAlgorithm a :
@@ -188,6 +202,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"ba_window_frames", Number(&o->ba_window_frames, 3, 10)},
       {"ba.max_num_iterations", Number(&o->ba.max_num_iterations, 1, 1000)},
       {"ba.loss_scale_px", Number(&o->ba.loss_scale_px, 0.01, 100.0)},
+      {"ba.solver", BaSolverEntry(&o->ba.solver)},
       {"ba_max_points", Number(&o->ba_max_points, 0, 100000)},
       {"prior_weight", Number(&o->prior_weight, 0.0, 1.0)},
       {"estimate_initial_orientation", Bool(&o->estimate_initial_orientation)},

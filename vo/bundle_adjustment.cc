@@ -6,8 +6,10 @@
 #include <array>
 #include <cmath>
 #include <memory>
-#include <set>
 #include <sstream>
+#include <utility>
+
+#include "vo/schur_lm.h"
 
 namespace vo {
 
@@ -31,6 +33,16 @@ const char* ToString(BaLinearSolver solver) {
       return "sparse_schur";
     case BaLinearSolver::kDenseSchur:
       return "dense_schur";
+  }
+  return "unknown";
+}
+
+const char* ToString(BaSolver solver) {
+  switch (solver) {
+    case BaSolver::kCeres:
+      return "ceres";
+    case BaSolver::kSchurLm:
+      return "schur_lm";
   }
   return "unknown";
 }
@@ -74,7 +86,7 @@ bool BundleAdjustmentOptions::IsValid(std::string* error) const {
 
 namespace {
 
-using PoseBlock = std::array<double, 7>;  // [qx qy qz qw tx ty tz] of T_world_cam0
+using PoseBlock = PoseBlock7;  // [qx qy qz qw tx ty tz] of T_world_cam0
 using PoseManifold =
     ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>;
 
@@ -151,7 +163,7 @@ struct MonoCost {
 //   ∂p/∂v = I − 2w [u]× + 2 (u uᵀ − |u|² I)  (= Rᵀ for a unit q),  ∂p/∂P = ∂p/∂v = −∂p/∂t.
 // These are the derivatives of exactly what the autodiff functors compute (tests compare them).
 struct CameraPointJacobian {
-  Eigen::Vector3d p;           // point in cam0
+  Eigen::Vector3d p;                     // point in cam0
   Eigen::Matrix<double, 3, 7> dp_dpose;  // columns: qx qy qz qw tx ty tz
   Eigen::Matrix3d dp_dpoint;
 };
@@ -170,8 +182,8 @@ void WorldToCam0WithJacobian(const double* pose, const double* point, CameraPoin
   const Eigen::Vector3d uxv = u.cross(v);
   j->p = v - 2.0 * w * uxv + 2.0 * u.cross(uxv);
   j->dp_dpose.block<3, 3>(0, 0) =
-      2.0 * w * Skew(v) + 2.0 * (u.dot(v) * Eigen::Matrix3d::Identity() + u * v.transpose() -
-                                 2.0 * v * u.transpose());
+      2.0 * w * Skew(v) +
+      2.0 * (u.dot(v) * Eigen::Matrix3d::Identity() + u * v.transpose() - 2.0 * v * u.transpose());
   j->dp_dpose.col(3) = -2.0 * uxv;
   j->dp_dpoint = Eigen::Matrix3d::Identity() - 2.0 * w * Skew(u) +
                  2.0 * (u * u.transpose() - u.squaredNorm() * Eigen::Matrix3d::Identity());
@@ -223,11 +235,15 @@ class ReprojectionCostAnalytic : public ceres::SizedCostFunction<kResiduals, 7, 
   Eigen::Vector2d uv_l_, uv_r_;
 };
 
-// Plain reprojection errors of one observation (pixels); false when behind the camera.
-bool ObservationErrors(const StereoCamera& cam, const Eigen::Isometry3d& T_world_cam0,
+// Plain reprojection errors of one observation (pixels), the point mapped into cam0 by
+// T_cam0_world; false when its depth is <= min_depth_m (metres). *depth_m (optional) receives
+// the depth whenever the function returns.
+bool ObservationErrors(const StereoCamera& cam, const Eigen::Isometry3d& T_cam0_world,
                        const Eigen::Vector3d& p_world, const BaObservation& obs, double min_depth_m,
-                       Eigen::Vector2d* e_left, Eigen::Vector2d* e_right) {
-  const Eigen::Vector3d p_cam0 = T_world_cam0.inverse() * p_world;
+                       Eigen::Vector2d* e_left, Eigen::Vector2d* e_right,
+                       double* depth_m = nullptr) {
+  const Eigen::Vector3d p_cam0 = T_cam0_world * p_world;
+  if (depth_m) *depth_m = p_cam0.z();
   Eigen::Vector2d uv;
   if (!cam.ProjectLeft(p_cam0, &uv, min_depth_m)) return false;
   *e_left = uv - obs.uv_left_px;
@@ -237,6 +253,14 @@ bool ObservationErrors(const StereoCamera& cam, const Eigen::Isometry3d& T_world
     *e_right = uv - obs.uv_right_px;
   }
   return true;
+}
+
+// T_cam0_world of every frame.
+std::vector<Eigen::Isometry3d> Inverses(const std::vector<Eigen::Isometry3d>& T_world_cam0) {
+  std::vector<Eigen::Isometry3d> inverses;
+  inverses.reserve(T_world_cam0.size());
+  for (const Eigen::Isometry3d& T : T_world_cam0) inverses.push_back(T.inverse());
+  return inverses;
 }
 
 ceres::LossFunction* MakeLoss(const BundleAdjustmentOptions& options) {
@@ -249,6 +273,140 @@ ceres::LossFunction* MakeLoss(const BundleAdjustmentOptions& options) {
       return new ceres::CauchyLoss(options.loss_scale_px);
   }
   return nullptr;
+}
+
+// What a backend returns.
+struct BackendResult {
+  bool usable = false;     // a solution to use (converged or hit the iteration limit)
+  bool converged = false;  // a tolerance was met
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int num_iterations = 0;  // successful + unsuccessful steps, the start counted as one
+  std::string message;     // on failure
+};
+
+// The problem both backends solve: pose blocks (all frames), points (all, the optimised ones
+// changed in place), the observations used, and which poses take part and are free.
+struct BackendProblem {
+  std::vector<PoseBlock7> poses;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> observations;  // indices into the input's observations
+  std::vector<bool> pose_in_problem;
+};
+
+// Ceres' linear solver for BundleAdjustmentOptions::linear_solver (see BaLinearSolver).
+struct CeresLinearSolver {
+  ceres::LinearSolverType type = ceres::DENSE_SCHUR;
+  ceres::SparseLinearAlgebraLibraryType library = ceres::SUITE_SPARSE;  // SPARSE_SCHUR only
+  std::string name;  // for BundleAdjustmentSummary::linear_solver
+};
+
+// False when SPARSE_SCHUR is asked for and this Ceres has no sparse library.
+bool ChooseCeresLinearSolver(BaLinearSolver wanted, CeresLinearSolver* choice) {
+  const bool has_suitesparse =
+      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
+  const bool has_sparse =
+      has_suitesparse || ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE);
+  if (wanted == BaLinearSolver::kSparseSchur && !has_sparse) return false;
+  if (wanted == BaLinearSolver::kDenseSchur || !has_sparse) {
+    choice->type = ceres::DENSE_SCHUR;
+    choice->name = "DENSE_SCHUR";
+  } else {
+    choice->type = ceres::SPARSE_SCHUR;
+    choice->library = has_suitesparse ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
+    choice->name = has_suitesparse ? "SPARSE_SCHUR (SUITE_SPARSE)" : "SPARSE_SCHUR (EIGEN_SPARSE)";
+  }
+  return true;
+}
+
+BackendResult SolveWithCeres(const StereoCamera& cam, const BundleAdjustmentProblem& input,
+                             const BundleAdjustmentOptions& options,
+                             const CeresLinearSolver& linear_solver,
+                             const std::vector<bool>& point_optimized, BackendProblem* bp) {
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = linear_solver.type;
+  if (linear_solver.type == ceres::SPARSE_SCHUR)
+    solver_options.sparse_linear_algebra_library_type = linear_solver.library;
+  ceres::Problem problem;
+  ceres::LossFunction* loss = MakeLoss(options);  // shared; the problem deletes it once
+  const Intrinsics intrinsics(cam);
+  for (int k : bp->observations) {
+    const BaObservation& o = input.observations[k];
+    ceres::CostFunction* cost = nullptr;
+    if (options.analytic_jacobians) {
+      cost = o.has_right ? static_cast<ceres::CostFunction*>(new ReprojectionCostAnalytic<4>(
+                               intrinsics, o.uv_left_px, o.uv_right_px))
+                         : new ReprojectionCostAnalytic<2>(intrinsics, o.uv_left_px);
+    } else {
+      cost = o.has_right ? static_cast<ceres::CostFunction*>(
+                               new ceres::AutoDiffCostFunction<StereoCost, 4, 7, 3>(
+                                   new StereoCost(intrinsics, o.uv_left_px, o.uv_right_px)))
+                         : new ceres::AutoDiffCostFunction<MonoCost, 2, 7, 3>(
+                               new MonoCost(intrinsics, o.uv_left_px));
+    }
+    problem.AddResidualBlock(cost, loss, bp->poses[o.frame_index].data(),
+                             bp->points[o.point_index].data());
+  }
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (size_t i = 0; i < bp->poses.size(); ++i) {
+    if (!bp->pose_in_problem[i]) continue;
+    problem.SetManifold(bp->poses[i].data(), new PoseManifold());
+    if (static_cast<int>(i) < options.num_fixed_poses)
+      problem.SetParameterBlockConstant(bp->poses[i].data());
+    ordering->AddElementToGroup(bp->poses[i].data(), 1);
+  }
+  for (size_t j = 0; j < bp->points.size(); ++j)
+    if (point_optimized[j]) ordering->AddElementToGroup(bp->points[j].data(), 0);
+
+  solver_options.linear_solver_ordering = ordering;
+  solver_options.minimizer_type = ceres::TRUST_REGION;
+  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver_options.max_num_iterations = options.max_num_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.gradient_tolerance = options.gradient_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver_options, &problem, &ceres_summary);
+
+  BackendResult r;
+  r.initial_cost = ceres_summary.initial_cost;
+  r.num_iterations = ceres_summary.num_successful_steps + ceres_summary.num_unsuccessful_steps;
+  r.usable = ceres_summary.IsSolutionUsable();
+  r.final_cost = r.usable ? ceres_summary.final_cost : ceres_summary.initial_cost;
+  r.converged = ceres_summary.termination_type == ceres::CONVERGENCE;
+  if (!r.usable) r.message = "ceres: " + ceres_summary.message;
+  return r;
+}
+
+BackendResult SolveWithSchurLm(const StereoCamera& cam, const BundleAdjustmentProblem& input,
+                               const BundleAdjustmentOptions& options, BackendProblem* bp) {
+  std::vector<SchurLmResidual> residuals;
+  residuals.reserve(bp->observations.size());
+  for (int k : bp->observations) {
+    const BaObservation& o = input.observations[k];
+    SchurLmResidual res;
+    res.pose = o.frame_index;
+    res.point = o.point_index;
+    res.uv_left_px = o.uv_left_px;
+    res.has_right = o.has_right;
+    res.uv_right_px = o.uv_right_px;
+    residuals.push_back(res);
+  }
+  std::vector<bool> pose_is_free(bp->poses.size(), false);
+  for (size_t i = 0; i < bp->poses.size(); ++i)
+    pose_is_free[i] = static_cast<int>(i) >= options.num_fixed_poses;
+  const SchurLmSummary lm =
+      SolveSchurLm(cam, options, residuals, pose_is_free, &bp->poses, &bp->points);
+  BackendResult r;
+  r.initial_cost = lm.initial_cost;
+  r.num_iterations = lm.num_successful_steps + lm.num_unsuccessful_steps;
+  r.usable = lm.usable();
+  r.final_cost = r.usable ? lm.final_cost : lm.initial_cost;
+  r.converged = lm.termination == SchurLmSummary::Termination::kConvergence;
+  if (!r.usable) r.message = "schur_lm: " + lm.message;
+  return r;
 }
 
 }  // namespace
@@ -307,157 +465,136 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
     }
   }
 
-  // --- linear solver choice ---
-  ceres::Solver::Options solver_options;
-  const bool has_suitesparse =
-      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
-  const bool has_eigen_sparse =
-      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE);
-  const bool has_sparse = has_suitesparse || has_eigen_sparse;
-  if (options.linear_solver == BaLinearSolver::kSparseSchur && !has_sparse) {
-    msg << "SPARSE_SCHUR asked for, but this Ceres has no sparse linear algebra library";
-    return fail(Status::kInvalidInput);
-  }
-  if (options.linear_solver == BaLinearSolver::kDenseSchur || !has_sparse) {
-    solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-    s.linear_solver = "DENSE_SCHUR";
+  // --- backend and (Ceres) linear solver ---
+  CeresLinearSolver ceres_linear_solver;
+  if (options.solver == BaSolver::kCeres) {
+    if (!ChooseCeresLinearSolver(options.linear_solver, &ceres_linear_solver)) {
+      msg << "SPARSE_SCHUR asked for, but this Ceres has no sparse linear algebra library";
+      return fail(Status::kInvalidInput);
+    }
+    s.linear_solver = ceres_linear_solver.name;
   } else {
-    solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
-    solver_options.sparse_linear_algebra_library_type =
-        has_suitesparse ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
-    s.linear_solver =
-        has_suitesparse ? "SPARSE_SCHUR (SUITE_SPARSE)" : "SPARSE_SCHUR (EIGEN_SPARSE)";
+    s.linear_solver = "SCHUR_LM (dense Cholesky)";
   }
 
   // --- which observations and points take part ---
   // An observation is used when its point lies in front of the camera initially; a point is
   // used when its used observations span at least min_frames_per_point frames.
   std::vector<bool> obs_used(input.observations.size(), false);
-  std::vector<std::set<int>> point_frames(num_points);
-  for (size_t k = 0; k < input.observations.size(); ++k) {
-    const BaObservation& o = input.observations[k];
-    Eigen::Vector2d e_l, e_r;
-    if (!ObservationErrors(cam, input.T_world_cam0[o.frame_index],
-                           input.points_world[o.point_index], o, options.min_depth_m, &e_l, &e_r)) {
-      s.observation_is_outlier[k] = true;  // behind the camera: left out
-      continue;
+  std::vector<double> sq_error(input.observations.size(), 0.0);  // |e_l|² + |e_r|² (pixels²)
+  std::vector<std::pair<int, int>> point_frame;  // (point, frame) of each used observation
+  point_frame.reserve(input.observations.size());
+  {
+    const std::vector<Eigen::Isometry3d> T_cam0_world = Inverses(input.T_world_cam0);
+    for (size_t k = 0; k < input.observations.size(); ++k) {
+      const BaObservation& o = input.observations[k];
+      Eigen::Vector2d e_l, e_r;
+      if (!ObservationErrors(cam, T_cam0_world[o.frame_index], input.points_world[o.point_index], o,
+                             options.min_depth_m, &e_l, &e_r)) {
+        s.observation_is_outlier[k] = true;  // behind the camera: left out
+        continue;
+      }
+      obs_used[k] = true;
+      sq_error[k] = e_l.squaredNorm() + e_r.squaredNorm();
+      point_frame.emplace_back(o.point_index, o.frame_index);
     }
-    obs_used[k] = true;
-    point_frames[o.point_index].insert(o.frame_index);
   }
+  // Distinct frames per point.
+  std::sort(point_frame.begin(), point_frame.end());
+  std::vector<int> num_point_frames(num_points, 0);
+  for (size_t n = 0; n < point_frame.size(); ++n)
+    if (n == 0 || point_frame[n] != point_frame[n - 1]) ++num_point_frames[point_frame[n].first];
   for (int j = 0; j < num_points; ++j) {
-    s.point_optimized[j] = static_cast<int>(point_frames[j].size()) >= options.min_frames_per_point;
+    s.point_optimized[j] = num_point_frames[j] >= options.min_frames_per_point;
     if (s.point_optimized[j]) ++s.num_points_optimized;
   }
-  for (size_t k = 0; k < input.observations.size(); ++k)
+  BackendProblem bp;
+  bp.pose_in_problem.assign(num_frames, false);
+  for (size_t k = 0; k < input.observations.size(); ++k) {
     if (obs_used[k] && !s.point_optimized[input.observations[k].point_index]) obs_used[k] = false;
+    if (!obs_used[k]) continue;
+    bp.observations.push_back(static_cast<int>(k));
+    bp.pose_in_problem[input.observations[k].frame_index] = true;
+  }
+  s.num_residual_blocks = static_cast<int>(bp.observations.size());
 
   // --- plain rms of the used observations (before) ---
-  auto rms = [&](const std::vector<Eigen::Isometry3d>& poses,
-                 const std::vector<Eigen::Vector3d>& points, bool skip_outliers) {
+  // sqrt(Σ |e|² / #image observations) over the used observations (and, with
+  // skip_outliers, not flagged), from the squared errors of the pass that computed them.
+  auto rms = [&](bool skip_outliers) {
     double sq = 0.0;
     int count = 0;
     for (size_t k = 0; k < input.observations.size(); ++k) {
       if (!obs_used[k] || (skip_outliers && s.observation_is_outlier[k])) continue;
-      const BaObservation& o = input.observations[k];
-      Eigen::Vector2d e_l, e_r;
-      if (!ObservationErrors(cam, poses[o.frame_index], points[o.point_index], o, 0.0, &e_l, &e_r))
-        continue;
-      sq += e_l.squaredNorm() + e_r.squaredNorm();
-      count += o.has_right ? 2 : 1;
+      sq += sq_error[k];
+      count += input.observations[k].has_right ? 2 : 1;
     }
     return count > 0 ? std::sqrt(sq / count) : 0.0;
   };
-  s.rms_reprojection_before_px = rms(input.T_world_cam0, input.points_world, false);
+  s.rms_reprojection_before_px = rms(false);
 
-  // --- the Ceres problem ---
-  std::vector<PoseBlock> poses(num_frames);
-  for (int i = 0; i < num_frames; ++i) poses[i] = ToBlock(input.T_world_cam0[i]);
-  std::vector<std::array<double, 3>> points(num_points);
-  for (int j = 0; j < num_points; ++j)
-    points[j] = {input.points_world[j].x(), input.points_world[j].y(), input.points_world[j].z()};
-
-  ceres::Problem problem;
-  ceres::LossFunction* loss = MakeLoss(options);  // shared; the problem deletes it once
-  const Intrinsics intrinsics(cam);
-  std::vector<bool> pose_in_problem(num_frames, false);
-  for (size_t k = 0; k < input.observations.size(); ++k) {
-    if (!obs_used[k]) continue;
-    const BaObservation& o = input.observations[k];
-    ceres::CostFunction* cost = nullptr;
-    if (options.analytic_jacobians) {
-      cost = o.has_right ? static_cast<ceres::CostFunction*>(new ReprojectionCostAnalytic<4>(
-                               intrinsics, o.uv_left_px, o.uv_right_px))
-                         : new ReprojectionCostAnalytic<2>(intrinsics, o.uv_left_px);
-    } else {
-      cost = o.has_right ? static_cast<ceres::CostFunction*>(
-                               new ceres::AutoDiffCostFunction<StereoCost, 4, 7, 3>(
-                                   new StereoCost(intrinsics, o.uv_left_px, o.uv_right_px)))
-                         : new ceres::AutoDiffCostFunction<MonoCost, 2, 7, 3>(
-                               new MonoCost(intrinsics, o.uv_left_px));
-    }
-    problem.AddResidualBlock(cost, loss, poses[o.frame_index].data(), points[o.point_index].data());
-    pose_in_problem[o.frame_index] = true;
-    ++s.num_residual_blocks;
-  }
   if (s.num_residual_blocks == 0) {
-    delete loss;  // never handed to the problem
     msg << "no usable observation";
     return fail(Status::kInvalidInput);
   }
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (int i = 0; i < num_frames; ++i) {
-    if (!pose_in_problem[i]) continue;
-    problem.SetManifold(poses[i].data(), new PoseManifold());
-    if (i < options.num_fixed_poses) problem.SetParameterBlockConstant(poses[i].data());
-    ordering->AddElementToGroup(poses[i].data(), 1);
+
+  // --- the solve ---
+  bp.poses.resize(num_frames);
+  for (int i = 0; i < num_frames; ++i) bp.poses[i] = ToBlock(input.T_world_cam0[i]);
+  bp.points = input.points_world;
+  BackendResult result;
+  switch (options.solver) {
+    case BaSolver::kCeres:
+      result = SolveWithCeres(cam, input, options, ceres_linear_solver, s.point_optimized, &bp);
+      break;
+    case BaSolver::kSchurLm:
+      result = SolveWithSchurLm(cam, input, options, &bp);
+      break;
   }
-  for (int j = 0; j < num_points; ++j)
-    if (s.point_optimized[j]) ordering->AddElementToGroup(points[j].data(), 0);
-
-  solver_options.linear_solver_ordering = ordering;
-  solver_options.minimizer_type = ceres::TRUST_REGION;
-  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver_options.max_num_iterations = options.max_num_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = options.gradient_tolerance;
-  solver_options.parameter_tolerance = options.parameter_tolerance;
-  solver_options.num_threads = 1;
-  solver_options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary ceres_summary;
-  ceres::Solve(solver_options, &problem, &ceres_summary);
-
-  s.initial_cost = ceres_summary.initial_cost;
-  s.num_iterations = ceres_summary.num_successful_steps + ceres_summary.num_unsuccessful_steps;
-  if (!ceres_summary.IsSolutionUsable()) {
-    msg << "ceres: " << ceres_summary.message;
-    s.final_cost = ceres_summary.initial_cost;
+  s.initial_cost = result.initial_cost;
+  s.num_iterations = result.num_iterations;
+  if (!result.usable) {
+    msg << result.message;
+    s.final_cost = result.initial_cost;
     s.rms_reprojection_after_px = s.rms_reprojection_before_px;
     return fail(Status::kSolverFailed);
   }
-  s.final_cost = ceres_summary.final_cost;
-  s.converged = ceres_summary.termination_type == ceres::CONVERGENCE;
+  s.final_cost = result.final_cost;
+  s.converged = result.converged;
 
   // --- outputs: fixed poses copied bit for bit, the others from their blocks ---
   for (int i = options.num_fixed_poses; i < num_frames; ++i)
-    if (pose_in_problem[i]) s.T_world_cam0[i] = FromBlock(poses[i]);
+    if (bp.pose_in_problem[i]) s.T_world_cam0[i] = FromBlock(bp.poses[i]);
   for (int j = 0; j < num_points; ++j)
-    if (s.point_optimized[j])
-      s.points_world[j] = Eigen::Vector3d(points[j][0], points[j][1], points[j][2]);
+    if (s.point_optimized[j]) s.points_world[j] = bp.points[j];
 
-  s.rms_reprojection_after_px = rms(s.T_world_cam0, s.points_world, false);
-  for (size_t k = 0; k < input.observations.size(); ++k) {
-    if (!obs_used[k]) continue;
-    const BaObservation& o = input.observations[k];
-    Eigen::Vector2d e_l, e_r;
-    const bool in_front =
-        ObservationErrors(cam, s.T_world_cam0[o.frame_index], s.points_world[o.point_index], o,
-                          options.min_depth_m, &e_l, &e_r);
-    s.observation_is_outlier[k] = !in_front || e_l.norm() > options.outlier_threshold_px ||
-                                  e_r.norm() > options.outlier_threshold_px;
+  // Errors at the refined values: rms over the points in front of the camera; an observation
+  // is an outlier when its depth is <= min_depth_m or its left or right error is too large.
+  double sq_after = 0.0;
+  int count_after = 0;
+  {
+    const std::vector<Eigen::Isometry3d> T_cam0_world = Inverses(s.T_world_cam0);
+    for (size_t k = 0; k < input.observations.size(); ++k) {
+      if (!obs_used[k]) continue;
+      const BaObservation& o = input.observations[k];
+      Eigen::Vector2d e_l, e_r;
+      double depth_m = 0.0;
+      const bool in_front =
+          ObservationErrors(cam, T_cam0_world[o.frame_index], s.points_world[o.point_index], o, 0.0,
+                            &e_l, &e_r, &depth_m);
+      sq_error[k] = in_front ? e_l.squaredNorm() + e_r.squaredNorm() : 0.0;
+      if (in_front) {
+        sq_after += sq_error[k];
+        count_after += o.has_right ? 2 : 1;
+      }
+      s.observation_is_outlier[k] = !(depth_m > options.min_depth_m) ||
+                                    e_l.norm() > options.outlier_threshold_px ||
+                                    e_r.norm() > options.outlier_threshold_px;
+    }
   }
+  s.rms_reprojection_after_px = count_after > 0 ? std::sqrt(sq_after / count_after) : 0.0;
   for (bool outlier : s.observation_is_outlier) s.num_outliers += outlier ? 1 : 0;
-  s.rms_inlier_reprojection_after_px = rms(s.T_world_cam0, s.points_world, true);
+  s.rms_inlier_reprojection_after_px = rms(true);
   s.status = Status::kOk;
   return s;
 }

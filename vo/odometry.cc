@@ -121,7 +121,8 @@ BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions() {
   BundleAdjustmentOptions options;
   options.min_frames_per_point = 2;
   options.max_num_iterations = 10;
-  options.linear_solver = BaLinearSolver::kDenseSchur;
+  options.solver = BaSolver::kSchurLm;
+  options.linear_solver = BaLinearSolver::kDenseSchur;  // when solver = kCeres
   return options;
 }
 

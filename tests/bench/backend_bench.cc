@@ -1,6 +1,8 @@
 // Back-end timings, single thread: Horn's closed form on 100 points, RANSAC on 300 stereo
 // matches with 30% outliers, windowed bundle adjustment over 5 frames x 150 tracks (and the
-// paper's 3 frames x 16 features). Paper (Pentium IV 2.4 GHz): SBA 0.07 s for 3 frames x 16
+// paper's 3 frames x 16 features, and the pipeline's 5 frames x 100 points with its BA
+// settings), with Ceres (SPARSE_SCHUR, DENSE_SCHUR) and the hand-written Schur-complement
+// Levenberg-Marquardt (schur_lm.h). Paper (Pentium IV 2.4 GHz): SBA 0.07 s for 3 frames x 16
 // features (69 parameters).
 //
 // Synthetic data with exact ground truth (no files needed): a rectified stereo head
@@ -14,6 +16,7 @@
 
 #include "vo/bundle_adjustment.h"
 #include "vo/horn.h"
+#include "vo/odometry.h"  // DefaultOdometryBundleAdjustmentOptions
 #include "vo/ransac.h"
 
 namespace {
@@ -163,11 +166,16 @@ vo::BundleAdjustmentProblem BaData(int num_frames, int num_points) {
   return p;
 }
 
-// Args: frames, points, solver (0 = SPARSE_SCHUR, 1 = DENSE_SCHUR).
+// Args: frames, points, solver (0 = Ceres SPARSE_SCHUR, 1 = Ceres DENSE_SCHUR, 2 = schur_lm),
+// settings (0 = BundleAdjustmentOptions defaults, 1 = the pipeline's,
+// DefaultOdometryBundleAdjustmentOptions: two-frame points, 10 iterations).
 void BM_BundleAdjustment(benchmark::State& state) {
   const vo::BundleAdjustmentProblem problem =
       BaData(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  vo::BundleAdjustmentOptions options;
+  vo::BundleAdjustmentOptions options = state.range(3) == 1
+                                            ? vo::DefaultOdometryBundleAdjustmentOptions()
+                                            : vo::BundleAdjustmentOptions();
+  options.solver = state.range(2) == 2 ? vo::BaSolver::kSchurLm : vo::BaSolver::kCeres;
   options.linear_solver =
       state.range(2) == 0 ? vo::BaLinearSolver::kSparseSchur : vo::BaLinearSolver::kDenseSchur;
   vo::BundleAdjustmentSummary s;
@@ -183,18 +191,26 @@ void BM_BundleAdjustment(benchmark::State& state) {
   state.SetLabel(s.linear_solver);
 }
 BENCHMARK(BM_BundleAdjustment)
-    ->Args({5, 150, 0})
-    ->Args({5, 150, 1})
-    ->Args({3, 16, 0})
-    ->Args({3, 16, 1})
-    ->Args({10, 300, 0})
-    ->Args({10, 300, 1})
+    ->ArgNames({"frames", "points", "solver", "pipeline"})
+    ->Args({5, 150, 0, 0})
+    ->Args({5, 150, 1, 0})
+    ->Args({5, 150, 2, 0})
+    ->Args({3, 16, 0, 0})
+    ->Args({3, 16, 1, 0})
+    ->Args({3, 16, 2, 0})
+    ->Args({10, 300, 0, 0})
+    ->Args({10, 300, 1, 0})
+    ->Args({10, 300, 2, 0})
+    ->Args({5, 100, 1, 1})
+    ->Args({5, 100, 2, 1})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::printf("backend_bench: synthetic stereo data, single thread (Ceres num_threads = 1)\n");
+  std::printf(
+      "backend_bench: synthetic stereo data, single thread (Ceres num_threads = 1; schur_lm is "
+      "single-threaded)\n");
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -119,9 +119,25 @@ double Rms(const StereoCamera& cam, const BundleAdjustmentProblem& obs_from,
   return std::sqrt(sq / count);
 }
 
-TEST(BundleAdjustmentTest, NoiseFreeRecoversGroundTruth) {
+// The tests below run with both backends (BundleAdjustmentOptions::solver).
+class BundleAdjustmentTest : public ::testing::TestWithParam<BaSolver> {
+ protected:
+  BundleAdjustmentOptions Options() const {
+    BundleAdjustmentOptions options;
+    options.solver = GetParam();
+    return options;
+  }
+};
+
+INSTANTIATE_TEST_SUITE_P(Backends, BundleAdjustmentTest,
+                         ::testing::Values(BaSolver::kCeres, BaSolver::kSchurLm),
+                         [](const ::testing::TestParamInfo<BaSolver>& info) {
+                           return std::string(ToString(info.param));
+                         });
+
+TEST_P(BundleAdjustmentTest, NoiseFreeRecoversGroundTruth) {
   const Scene s = MakeScene(1, 0.0);
-  BundleAdjustmentOptions options;
+  BundleAdjustmentOptions options = Options();
   options.max_num_iterations = 50;
   options.function_tolerance = 1e-14;
   options.parameter_tolerance = 1e-14;
@@ -139,10 +155,10 @@ TEST(BundleAdjustmentTest, NoiseFreeRecoversGroundTruth) {
   EXPECT_EQ(r.num_points_optimized, kNumPoints);
 }
 
-TEST(BundleAdjustmentTest, NoisyReducesErrorToTheNoiseLevel) {
+TEST_P(BundleAdjustmentTest, NoisyReducesErrorToTheNoiseLevel) {
   const StereoCamera cam = TestCamera();
   const Scene s = MakeScene(2, kPixelSigma);
-  const BundleAdjustmentSummary r = RunBundleAdjustment(cam, s.start);
+  const BundleAdjustmentSummary r = RunBundleAdjustment(cam, s.start, Options());
   ASSERT_TRUE(r.ok()) << r.message;
   // Residual-level checks: the optimum is at least as good as the truth, and near the noise
   // level (slightly below it: 3 of every ~4·frames residuals per point are absorbed by it).
@@ -159,14 +175,14 @@ TEST(BundleAdjustmentTest, NoisyReducesErrorToTheNoiseLevel) {
   EXPECT_EQ(r.num_outliers, 0);  // 3 px threshold is 6σ per coordinate
 }
 
-TEST(BundleAdjustmentTest, FixedOldestPoseStaysBitIdentical) {
+TEST_P(BundleAdjustmentTest, FixedOldestPoseStaysBitIdentical) {
   Scene s = MakeScene(3, kPixelSigma);
   // A pose that does not survive a matrix → quaternion → matrix round trip bit for bit.
   s.start.T_world_cam0[0].linear() =
       Eigen::AngleAxisd(1e-3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   s.start.T_world_cam0[0].translation() = Eigen::Vector3d(0.1, 1.0 / 3.0, -0.7);
   for (int fixed = 1; fixed <= 2; ++fixed) {
-    BundleAdjustmentOptions options;
+    BundleAdjustmentOptions options = Options();
     options.num_fixed_poses = fixed;
     const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start, options);
     ASSERT_TRUE(r.ok()) << r.message;
@@ -176,7 +192,7 @@ TEST(BundleAdjustmentTest, FixedOldestPoseStaysBitIdentical) {
   }
 }
 
-TEST(BundleAdjustmentTest, HuberIgnoresGrossOutliers) {
+TEST_P(BundleAdjustmentTest, HuberIgnoresGrossOutliers) {
   const StereoCamera cam = TestCamera();
   Scene s = MakeScene(4, kPixelSigma);
   // Corrupt 5% of the observations by 20–50 px (a wrong match in a track).
@@ -191,8 +207,8 @@ TEST(BundleAdjustmentTest, HuberIgnoresGrossOutliers) {
     s.start.observations[k].uv_right_px += shift;
     corrupted[k] = true;
   }
-  const BundleAdjustmentSummary huber = RunBundleAdjustment(cam, s.start);
-  BundleAdjustmentOptions plain;
+  const BundleAdjustmentSummary huber = RunBundleAdjustment(cam, s.start, Options());
+  BundleAdjustmentOptions plain = Options();
   plain.loss = RobustLoss::kNone;
   const BundleAdjustmentSummary squared = RunBundleAdjustment(cam, s.start, plain);
   ASSERT_TRUE(huber.ok() && squared.ok());
@@ -218,11 +234,12 @@ TEST(BundleAdjustmentTest, HuberIgnoresGrossOutliers) {
   EXPECT_LT(huber.rms_inlier_reprojection_after_px, 1.1 * kNoiseRmsPx);
 }
 
-TEST(BundleAdjustmentTest, DenseAndSparseSchurAgree) {
+TEST(BundleAdjustmentCeresTest, DenseAndSparseSchurAgree) {
   const Scene s = MakeScene(5, kPixelSigma);
   BundleAdjustmentOptions dense;
+  dense.solver = BaSolver::kCeres;
   dense.linear_solver = BaLinearSolver::kDenseSchur;
-  BundleAdjustmentOptions sparse;
+  BundleAdjustmentOptions sparse = dense;
   sparse.linear_solver = BaLinearSolver::kSparseSchur;
   const BundleAdjustmentSummary a = RunBundleAdjustment(TestCamera(), s.start, dense);
   const BundleAdjustmentSummary b = RunBundleAdjustment(TestCamera(), s.start, sparse);
@@ -238,11 +255,12 @@ TEST(BundleAdjustmentTest, DenseAndSparseSchurAgree) {
 
 // The hand-derived Jacobians (default) against Ceres' automatic differentiation of the same
 // residuals: the same iterations, hence the same solution to rounding.
-TEST(BundleAdjustmentTest, AnalyticJacobiansAgreeWithAutomaticDifferentiation) {
+TEST(BundleAdjustmentCeresTest, AnalyticJacobiansAgreeWithAutomaticDifferentiation) {
   Scene s = MakeScene(9, kPixelSigma);
   for (size_t k = 0; k < s.start.observations.size(); k += 4)
     s.start.observations[k].has_right = false;  // left-only blocks too
   BundleAdjustmentOptions analytic;
+  analytic.solver = BaSolver::kCeres;
   analytic.analytic_jacobians = true;
   BundleAdjustmentOptions automatic = analytic;
   automatic.analytic_jacobians = false;
@@ -258,18 +276,19 @@ TEST(BundleAdjustmentTest, AnalyticJacobiansAgreeWithAutomaticDifferentiation) {
     EXPECT_LT((a.points_world[j] - b.points_world[j]).norm(), 1e-8) << "point " << j;
 }
 
-TEST(BundleAdjustmentTest, Deterministic) {
+TEST_P(BundleAdjustmentTest, Deterministic) {
   const Scene s = MakeScene(6, kPixelSigma);
-  const BundleAdjustmentSummary a = RunBundleAdjustment(TestCamera(), s.start);
-  const BundleAdjustmentSummary b = RunBundleAdjustment(TestCamera(), s.start);
+  const BundleAdjustmentSummary a = RunBundleAdjustment(TestCamera(), s.start, Options());
+  const BundleAdjustmentSummary b = RunBundleAdjustment(TestCamera(), s.start, Options());
   ASSERT_TRUE(a.ok());
   EXPECT_EQ(a.final_cost, b.final_cost);
+  EXPECT_EQ(a.num_iterations, b.num_iterations);
   for (int i = 0; i < kNumFrames; ++i)
     EXPECT_TRUE(a.T_world_cam0[i].matrix() == b.T_world_cam0[i].matrix());
   EXPECT_EQ(a.points_world, b.points_world);
 }
 
-TEST(BundleAdjustmentTest, SingleFramePointsAreKeptByDefault) {
+TEST_P(BundleAdjustmentTest, SingleFramePointsAreKeptByDefault) {
   const StereoCamera cam = TestCamera();
   Scene s = MakeScene(7, 0.0);
   // A point seen in the last frame only, started 10 cm off.
@@ -283,11 +302,11 @@ TEST(BundleAdjustmentTest, SingleFramePointsAreKeptByDefault) {
   o.has_right = true;
   s.start.points_world.push_back(p_world + Eigen::Vector3d(0.1, 0.0, 0.0));
   s.start.observations.push_back(o);
-  const BundleAdjustmentSummary kept = RunBundleAdjustment(cam, s.start);
+  const BundleAdjustmentSummary kept = RunBundleAdjustment(cam, s.start, Options());
   ASSERT_TRUE(kept.ok());
   EXPECT_TRUE(kept.point_optimized.back());
   EXPECT_LT((kept.points_world.back() - p_world).norm(), 1e-4);
-  BundleAdjustmentOptions two_frames;
+  BundleAdjustmentOptions two_frames = Options();
   two_frames.min_frames_per_point = 2;
   const BundleAdjustmentSummary left_out = RunBundleAdjustment(cam, s.start, two_frames);
   ASSERT_TRUE(left_out.ok());
@@ -296,48 +315,48 @@ TEST(BundleAdjustmentTest, SingleFramePointsAreKeptByDefault) {
   EXPECT_EQ(left_out.num_points_optimized, kNumPoints);
 }
 
-TEST(BundleAdjustmentTest, LeftOnlyObservationsAreUsed) {
+TEST_P(BundleAdjustmentTest, LeftOnlyObservationsAreUsed) {
   Scene s = MakeScene(8, 0.0);
   for (size_t k = 0; k < s.start.observations.size(); k += 3)
     s.start.observations[k].has_right = false;
-  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start);
+  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start, Options());
   ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_LT(r.rms_reprojection_after_px, 1e-4);
   for (int i = 0; i < kNumFrames; ++i)
     EXPECT_THAT(r.T_world_cam0[i], IsNearPose(s.truth.T_world_cam0[i], 1e-5, 1e-5));
 }
 
-TEST(BundleAdjustmentTest, PointBehindTheCameraIsLeftOutAndFlagged) {
+TEST_P(BundleAdjustmentTest, PointBehindTheCameraIsLeftOutAndFlagged) {
   Scene s = MakeScene(9, 0.0);
   const int j = s.start.observations[0].point_index;
   s.start.points_world[j] = s.start.T_world_cam0[0] * Eigen::Vector3d(0.0, 0.0, -2.0);
-  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start);
+  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start, Options());
   ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_TRUE(r.observation_is_outlier[0]);
 }
 
-TEST(BundleAdjustmentTest, InvalidInputs) {
+TEST_P(BundleAdjustmentTest, InvalidInputs) {
   const Scene s = MakeScene(10, 0.0);
   BundleAdjustmentProblem bad = s.start;
   bad.observations[0].point_index = kNumPoints;
-  EXPECT_EQ(RunBundleAdjustment(TestCamera(), bad).status,
+  EXPECT_EQ(RunBundleAdjustment(TestCamera(), bad, Options()).status,
             BundleAdjustmentSummary::Status::kInvalidInput);
-  BundleAdjustmentOptions options;
+  BundleAdjustmentOptions options = Options();
   options.num_fixed_poses = kNumFrames + 1;
   EXPECT_EQ(RunBundleAdjustment(TestCamera(), s.start, options).status,
             BundleAdjustmentSummary::Status::kInvalidInput);
-  options = BundleAdjustmentOptions();
+  options = Options();
   options.loss_scale_px = 0.0;
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
   EXPECT_THAT(error, ::testing::HasSubstr("loss_scale_px"));
   BundleAdjustmentProblem empty = s.start;
   empty.observations.clear();
-  EXPECT_EQ(RunBundleAdjustment(TestCamera(), empty).status,
+  EXPECT_EQ(RunBundleAdjustment(TestCamera(), empty, Options()).status,
             BundleAdjustmentSummary::Status::kInvalidInput);
 }
 
-TEST(BundleAdjustmentTest, MakeWindowProblemFromTracks) {
+TEST_P(BundleAdjustmentTest, MakeWindowProblemFromTracks) {
   const StereoCamera cam = TestCamera();
   const Scene s = MakeScene(11, 0.0);
   // Feed the scene's frames to a TrackManager: feature k of frame i = the k-th point visible
@@ -374,9 +393,120 @@ TEST(BundleAdjustmentTest, MakeWindowProblemFromTracks) {
   // keeps points seen in >= 2 frames; a point that leaves and re-enters would split).
   EXPECT_GE(p.points_world.size(), static_cast<size_t>(kNumPoints));
   EXPECT_EQ(p.observations.size(), s.truth.observations.size());
-  const BundleAdjustmentSummary r = RunBundleAdjustment(cam, p);
+  const BundleAdjustmentSummary r = RunBundleAdjustment(cam, p, Options());
   ASSERT_TRUE(r.ok());
   EXPECT_LT(r.rms_reprojection_before_px, 1e-6);  // exact observations, true poses
+}
+
+// --- the hand-written backend against Ceres ---
+// Same problem, same trust-region rules: the iterates differ by rounding only, so the
+// optimum, the iteration count, the termination and the outlier flags are the same.
+constexpr double kBackendCostRelTol = 1e-10;  // relative final-cost difference
+constexpr double kBackendTolRad = 1e-9;       // pose rotation difference
+constexpr double kBackendTolM = 1e-9;         // pose translation difference (metres)
+// Point difference (metres): points up to 10 m, whose depth the 0.12 m baseline conditions
+// poorly, amplify the rounding differences most (1.2e-8 m seen without a robust loss).
+constexpr double kBackendPointTolM = 1e-7;
+
+void ExpectSameSolution(const BundleAdjustmentSummary& ceres, const BundleAdjustmentSummary& lm) {
+  ASSERT_TRUE(ceres.ok()) << ceres.message;
+  ASSERT_TRUE(lm.ok()) << lm.message;
+  EXPECT_NEAR(lm.initial_cost, ceres.initial_cost, kBackendCostRelTol * ceres.initial_cost);
+  EXPECT_NEAR(lm.final_cost, ceres.final_cost, kBackendCostRelTol * ceres.final_cost + 1e-20);
+  EXPECT_EQ(lm.num_iterations, ceres.num_iterations);
+  EXPECT_EQ(lm.converged, ceres.converged);
+  EXPECT_EQ(lm.num_residual_blocks, ceres.num_residual_blocks);
+  EXPECT_EQ(lm.point_optimized, ceres.point_optimized);
+  EXPECT_EQ(lm.observation_is_outlier, ceres.observation_is_outlier);
+  ASSERT_EQ(lm.T_world_cam0.size(), ceres.T_world_cam0.size());
+  for (size_t i = 0; i < lm.T_world_cam0.size(); ++i)
+    EXPECT_THAT(lm.T_world_cam0[i], IsNearPose(ceres.T_world_cam0[i], kBackendTolRad, kBackendTolM))
+        << "frame " << i;
+  ASSERT_EQ(lm.points_world.size(), ceres.points_world.size());
+  for (size_t j = 0; j < lm.points_world.size(); ++j)
+    EXPECT_LT((lm.points_world[j] - ceres.points_world[j]).norm(), kBackendPointTolM)
+        << "point " << j;
+  EXPECT_NEAR(lm.rms_inlier_reprojection_after_px, ceres.rms_inlier_reprojection_after_px, 1e-9);
+}
+
+// Corrupts about `fraction` of the observations by 20–50 px (a wrong match in a track).
+void Corrupt(double fraction, uint64_t seed, BundleAdjustmentProblem* p) {
+  SplitMix64 rng(seed);
+  for (BaObservation& o : p->observations) {
+    if (rng.Uniform() >= fraction) continue;
+    const double angle = 2.0 * M_PI * rng.Uniform();
+    const Eigen::Vector2d shift =
+        (20.0 + 30.0 * rng.Uniform()) * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    o.uv_left_px += shift;
+    o.uv_right_px += shift;
+  }
+}
+
+BundleAdjustmentSummary Solve(const BundleAdjustmentProblem& p, BundleAdjustmentOptions options,
+                              BaSolver solver) {
+  options.solver = solver;
+  return RunBundleAdjustment(TestCamera(), p, options);
+}
+
+TEST(BundleAdjustmentBackendTest, SchurLmMatchesCeresOnExactData) {
+  const Scene s = MakeScene(21, 0.0);
+  BundleAdjustmentOptions options;
+  options.max_num_iterations = 50;
+  options.function_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-14;
+  const BundleAdjustmentSummary ceres = Solve(s.start, options, BaSolver::kCeres);
+  const BundleAdjustmentSummary lm = Solve(s.start, options, BaSolver::kSchurLm);
+  ExpectSameSolution(ceres, lm);
+  EXPECT_EQ(lm.linear_solver, "SCHUR_LM (dense Cholesky)");
+  // Both at the exact ground truth.
+  for (int i = 0; i < kNumFrames; ++i)
+    EXPECT_THAT(lm.T_world_cam0[i], IsNearPose(s.truth.T_world_cam0[i], kExactTolRad, kExactTolM))
+        << "frame " << i;
+  for (int j = 0; j < kNumPoints; ++j)
+    EXPECT_LT((lm.points_world[j] - s.truth.points_world[j]).norm(), 1e-5) << "point " << j;
+}
+
+TEST(BundleAdjustmentBackendTest, SchurLmMatchesCeresWithNoiseAndOutliers) {
+  Scene s = MakeScene(22, kPixelSigma);
+  Corrupt(0.05, 23, &s.start);
+  for (RobustLoss loss : {RobustLoss::kHuber, RobustLoss::kCauchy, RobustLoss::kNone}) {
+    SCOPED_TRACE(ToString(loss));
+    BundleAdjustmentOptions options;
+    options.loss = loss;
+    const BundleAdjustmentSummary ceres = Solve(s.start, options, BaSolver::kCeres);
+    ExpectSameSolution(ceres, Solve(s.start, options, BaSolver::kSchurLm));
+    if (loss != RobustLoss::kNone) {
+      EXPECT_GT(ceres.num_outliers, 0);
+    }
+  }
+}
+
+// Two-frame points and an iteration limit that is reached, left-only observations, two
+// constant poses, a frame no point is seen in.
+TEST(BundleAdjustmentBackendTest, SchurLmMatchesCeresInOtherConfigurations) {
+  Scene s = MakeScene(24, kPixelSigma);
+  for (size_t k = 0; k < s.start.observations.size(); k += 5)
+    s.start.observations[k].has_right = false;
+  BundleAdjustmentOptions options;
+  options.min_frames_per_point = 2;
+  options.max_num_iterations = 3;  // stops at the limit
+  BundleAdjustmentSummary ceres = Solve(s.start, options, BaSolver::kCeres);
+  EXPECT_FALSE(ceres.converged);
+  ExpectSameSolution(ceres, Solve(s.start, options, BaSolver::kSchurLm));
+
+  options = BundleAdjustmentOptions();
+  options.num_fixed_poses = 2;
+  BundleAdjustmentProblem unseen = s.start;
+  unseen.T_world_cam0.push_back(unseen.T_world_cam0.back());  // no observation
+  ceres = Solve(unseen, options, BaSolver::kCeres);
+  ExpectSameSolution(ceres, Solve(unseen, options, BaSolver::kSchurLm));
+  EXPECT_TRUE(ceres.T_world_cam0.back().matrix() == unseen.T_world_cam0.back().matrix());
+}
+
+TEST(BundleAdjustmentBackendTest, SolverNames) {
+  EXPECT_STREQ(ToString(BaSolver::kCeres), "ceres");
+  EXPECT_STREQ(ToString(BaSolver::kSchurLm), "schur_lm");
+  EXPECT_EQ(BundleAdjustmentOptions().solver, BaSolver::kSchurLm);
 }
 
 }  // namespace
