@@ -8,7 +8,6 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "sim/scene_walls.h"
 #include "sim/yaml_input.h"
 
 namespace sim {
@@ -331,14 +330,8 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     if (error) *error = source_name + ": " + why;
     return false;
   }
-  // A path through a wall of the scene: at the line of the waypoint the segment ends at.
-  int waypoint = -1;
-  if (const std::string through = PathThroughWallProblem(s, &waypoint); !through.empty()) {
-    const std::string key = "path[" + std::to_string(waypoint) + "]";
-    r.Fail(path[waypoint], key, through);
-    if (error) *error = r.error();
-    return false;
-  }
+  // A path through a wall of the scene is refused by Simulator::Create, from the model it
+  // loads anyway (loading the scene here as well raised the peak memory of a run by ~4.5 MB).
   *scenario = std::move(s);
   return true;
 }

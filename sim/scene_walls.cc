@@ -5,10 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
-#include <map>
-#include <mutex>
 #include <sstream>
-#include <tuple>
 
 namespace sim {
 namespace {
@@ -18,15 +15,6 @@ namespace fs = std::filesystem;
 // |z| of a unit axis below this: horizontal; above 1 - this: vertical.
 constexpr double kAxisTolerance = 1e-3;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-struct CacheKey {
-  std::string path;
-  uintmax_t size;
-  fs::file_time_type mtime;
-  bool operator<(const CacheKey& o) const {
-    return std::tie(path, size, mtime) < std::tie(o.path, o.size, o.mtime);
-  }
-};
 
 // 2-D cross product.
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
@@ -39,13 +27,9 @@ std::string Point(const Eigen::Vector2d& p) {
   return s.str();
 }
 
-bool LoadWalls(const std::string& scene_path, std::vector<SceneWall>* walls, std::string* error) {
-  char load_error[1024] = "";
-  mjModel* m = mj_loadXML(scene_path.c_str(), nullptr, load_error, sizeof(load_error));
-  if (!m) {
-    *error = scene_path + ": cannot load MJCF scene: " + load_error;
-    return false;
-  }
+}  // namespace
+
+void WallsOfModel(const mjModel* m, std::vector<SceneWall>* walls) {
   mjData* d = mj_makeData(m);
   mj_kinematics(m, d);  // geom_xpos, geom_xmat
   walls->clear();
@@ -73,37 +57,10 @@ bool LoadWalls(const std::string& scene_path, std::vector<SceneWall>* walls, std
     walls->push_back(w);
   }
   mj_deleteData(d);
-  mj_deleteModel(m);
-  return true;
 }
 
-}  // namespace
-
-bool ReadSceneWalls(const std::string& scene_path, std::vector<SceneWall>* walls,
-                    std::string* error) {
-  static std::mutex mutex;
-  static std::map<CacheKey, std::vector<SceneWall>> cache;
-  std::error_code ec;
-  const CacheKey key{scene_path, fs::file_size(scene_path, ec),
-                     fs::last_write_time(scene_path, ec)};
-  if (ec) {
-    *error = scene_path + ": cannot read the scene: " + ec.message();
-    return false;
-  }
-  std::lock_guard<std::mutex> lock(mutex);
-  if (const auto it = cache.find(key); it != cache.end()) {
-    *walls = it->second;
-    return true;
-  }
-  if (!LoadWalls(scene_path, walls, error)) return false;
-  cache[key] = *walls;
-  return true;
-}
-
-std::string PathThroughWallProblem(const Scenario& s, int* waypoint) {
-  std::vector<SceneWall> walls;
-  std::string error;
-  if (s.scene_path.empty() || !ReadSceneWalls(s.scene_path, &walls, &error)) return "";
+std::string PathThroughWallProblem(const Scenario& s, const std::vector<SceneWall>& walls,
+                                   int* waypoint) {
   const double camera_z = s.camera.height_m;
   for (size_t i = 1; i < s.path.size(); ++i) {
     const Eigen::Vector2d p = s.path[i - 1], r = s.path[i] - s.path[i - 1];

@@ -14,6 +14,9 @@
 
 #include "sim/scenario.h"
 
+struct mjModel_;
+typedef struct mjModel_ mjModel;
+
 namespace sim {
 
 struct SceneWall {
@@ -25,14 +28,12 @@ struct SceneWall {
   double z_max_m = 0;
 };
 
-// The walls of the MJCF scene at `scene_path` (cached by path, size and modification time).
-// False (with *error) when the scene does not load.
-bool ReadSceneWalls(const std::string& scene_path, std::vector<SceneWall>* walls,
-                    std::string* error);
+// The first path segment that crosses one of `walls` spanning the camera height: returns ""
+// when none crosses, else the problem, and *waypoint = i for the segment path[i-1] -> path[i].
+std::string PathThroughWallProblem(const Scenario& scenario, const std::vector<SceneWall>& walls,
+                                   int* waypoint);
 
-// The first path segment that crosses a wall spanning the camera height: returns "" when none
-// crosses (or the scene does not load: the simulator reports that), else the problem, and
-// *waypoint = i for the segment path[i-1] -> path[i].
-std::string PathThroughWallProblem(const Scenario& scenario, int* waypoint);
+// The walls of a loaded model (Simulator::Create checks the path against its own model's).
+void WallsOfModel(const mjModel* m, std::vector<SceneWall>* walls);
 
 }  // namespace sim

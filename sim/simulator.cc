@@ -181,7 +181,10 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   m->opt.timestep = scenario.physics_dt_s;
   // A path through a wall (scenarios built in code; files are checked when read).
   int waypoint = -1;
-  if (const std::string through = PathThroughWallProblem(scenario, &waypoint); !through.empty()) {
+  std::vector<SceneWall> walls;
+  WallsOfModel(m, &walls);  // from the model just loaded: no second load of the scene
+  if (const std::string through = PathThroughWallProblem(scenario, walls, &waypoint);
+      !through.empty()) {
     *error = (scenario.source_path.empty() ? "scenario" : scenario.source_path) + ": key 'path[" +
              std::to_string(waypoint) + "]': " + through;
     return nullptr;
