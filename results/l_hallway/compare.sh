@@ -8,7 +8,7 @@ vobench="${1:-build/vobench}"
 out="${OUT:-out/compare}"
 csv="$here/comparison.csv"
 echo "config,end_pose_error_m,end_pose_error_pct,ate_rmse_m,drift_pct,lost_frames,vo_ms_median,vo_ms_p95" > "$csv"
-for cfg in paper no_ba ba3 ba10 matcher_svd_ncc matcher_ncc_mutual matcher_lucas_kanade fast_no_lr_check stereobm_two_pass range_0_5m; do
+for cfg in paper no_ba ba3 ba10 matcher_svd_ncc matcher_ncc_mutual matcher_lucas_kanade fast_no_lr_check stereobm_two_pass range_0_5m dense_disparity ba_ceres; do
   "$vobench" run l_hallway --config "$here/configs/$cfg.yaml" --out "$out/$cfg" -q --no-plots > /dev/null
   /usr/bin/python3 - "$out/$cfg/metrics.json" "$cfg" >> "$csv" <<'PY'
 import json, sys

@@ -21,13 +21,7 @@ using vobench_test::WriteText;
 
 // Runs `vobench ARGS` with `dir` as the working folder.
 CommandResult RunVobenchIn(const std::string& dir, const std::string& args) {
-  const std::string cmd = "cd '" + dir + "' && " + VOBENCH_BINARY + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (pipe && fgets(buf, sizeof(buf), pipe)) out += buf;
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+  return vobench_test::RunVobench(args, dir);
 }
 
 int Lines(const std::string& text) {

@@ -15,9 +15,11 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs `vobench ARGS` (the build's binary, VOBENCH_BINARY) through the shell.
-inline CommandResult RunVobench(const std::string& args) {
-  const std::string cmd = std::string(VOBENCH_BINARY) + " " + args + " 2>&1";
+// Runs `vobench ARGS` (the build's binary, VOBENCH_BINARY) through the shell, in the folder
+// `dir` when one is given.
+inline CommandResult RunVobench(const std::string& args, const std::string& dir = "") {
+  const std::string cmd = (dir.empty() ? std::string() : "cd '" + dir + "' && ") +
+                          VOBENCH_BINARY + " " + args + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   std::string out;
   char buf[4096];

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "tests/test_util.h"
+#include "tests/vo/vo_test_util.h"
 #include "vo/ransac.h"  // vo::SplitMix64
 
 namespace vo {
@@ -29,22 +30,9 @@ constexpr double kExactRmsPx = 1e-6;
 constexpr double kNoisyTolRad = 2e-3;
 constexpr double kNoisyTolM = 1e-2;
 
-double Normal(SplitMix64* rng) {
-  const double u1 = 1.0 - rng->Uniform();
-  const double u2 = rng->Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
+using test::Normal;
 
-StereoCamera TestCamera() {
-  StereoCamera cam;
-  cam.width = 320;
-  cam.height = 240;
-  cam.fx_px = cam.fy_px = 300.0;
-  cam.cx_px = 159.5;
-  cam.cy_px = 119.5;
-  cam.baseline_m = 0.12;
-  return cam;
-}
+using test::TestCamera;
 
 bool InImage(const StereoCamera& cam, const Eigen::Vector2d& uv) {
   return uv.x() >= 0.0 && uv.y() >= 0.0 && uv.x() <= cam.width - 1.0 && uv.y() <= cam.height - 1.0;

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "tests/test_util.h"
+#include "tests/vo/vo_test_util.h"
 #include "vo/ransac.h"  // vo::SplitMix64
 
 namespace vo {
@@ -30,11 +31,7 @@ constexpr double kSameSolutionTolM = 1e-9;
 constexpr double kSameSolutionMatrixTol = 1e-10;
 constexpr int kNumSeeds = 200;
 
-double Normal(SplitMix64* rng) {
-  const double u1 = 1.0 - rng->Uniform();
-  const double u2 = rng->Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
+using test::Normal;
 
 Eigen::Isometry3d RandomPose(SplitMix64* rng) {
   Eigen::Quaterniond q(Normal(rng), Normal(rng), Normal(rng), Normal(rng));

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "tests/test_util.h"
+#include "tests/vo/vo_test_util.h"
 #include "vo/camera.h"
 #include "vo/ransac.h"  // vo::SplitMix64
 
@@ -38,11 +39,7 @@ Eigen::Matrix3d CameraOrientation(double yaw_deg, double pitch_deg, double roll_
   return R * R_base;  // R_hall_cam0
 }
 
-double Normal(SplitMix64* rng) {
-  const double u1 = 1.0 - rng->Uniform();
-  const double u2 = rng->Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
+using test::Normal;
 
 struct HallwaySpec {
   bool floor = true;

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "tests/test_util.h"
+#include "tests/vo/vo_test_util.h"
 
 namespace vo {
 namespace {
@@ -27,22 +28,9 @@ constexpr double kPixelSigma = 0.5;
 // previous disparity noise (σ ≈ 0.5–0.9 px per coordinate): 3 px keeps nearly all inliers.
 constexpr double kNoisyThresholdPx = 3.0;
 
-double Normal(SplitMix64* rng) {
-  const double u1 = 1.0 - rng->Uniform();
-  const double u2 = rng->Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
+using test::Normal;
 
-StereoCamera TestCamera() {
-  StereoCamera cam;
-  cam.width = 320;
-  cam.height = 240;
-  cam.fx_px = cam.fy_px = 300.0;
-  cam.cx_px = 159.5;
-  cam.cy_px = 119.5;
-  cam.baseline_m = 0.12;
-  return cam;
-}
+using test::TestCamera;
 
 // Camera motion between the frames: a bit of yaw, pitch, roll and 25 cm mostly forward.
 Eigen::Isometry3d TrueMotion() {

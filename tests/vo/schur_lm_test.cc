@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "tests/test_util.h"
+#include "tests/vo/vo_test_util.h"
 #include "vo/ransac.h"  // vo::SplitMix64
 
 namespace vo {
@@ -16,22 +17,9 @@ namespace {
 constexpr double kNumericStep = 1e-6;
 constexpr double kJacobianRelTol = 1e-6;  // relative to the largest entry of the Jacobian
 
-StereoCamera TestCamera() {
-  StereoCamera cam;
-  cam.width = 320;
-  cam.height = 240;
-  cam.fx_px = cam.fy_px = 300.0;
-  cam.cx_px = 159.5;
-  cam.cy_px = 119.5;
-  cam.baseline_m = 0.12;
-  return cam;
-}
+using test::TestCamera;
 
-double Normal(SplitMix64* rng) {
-  const double u1 = 1.0 - rng->Uniform();
-  const double u2 = rng->Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
+using test::Normal;
 
 using vobench_test::IsNearPose;
 

@@ -1,0 +1,33 @@
+// Helpers shared by the vo/ tests: the synthetic stereo head and Gaussian noise.
+#pragma once
+
+#include <cmath>
+
+#include "vo/camera.h"
+#include "vo/ransac.h"
+
+namespace vo {
+namespace test {
+
+// The tests' rectified stereo head: 320x240, f = 300 px, principal point at the centre,
+// baseline 0.12 m.
+inline StereoCamera TestCamera() {
+  StereoCamera cam;
+  cam.width = 320;
+  cam.height = 240;
+  cam.fx_px = cam.fy_px = 300.0;
+  cam.cx_px = 159.5;
+  cam.cy_px = 119.5;
+  cam.baseline_m = 0.12;
+  return cam;
+}
+
+// A standard normal sample (Box-Muller) from the seeded generator.
+inline double Normal(SplitMix64* rng) {
+  const double u1 = 1.0 - rng->Uniform();
+  const double u2 = rng->Uniform();
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+}  // namespace test
+}  // namespace vo
