@@ -3,10 +3,12 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <map>
 #include <sstream>
 #include <vector>
 
+#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
 #include "sim/yaml_input.h"
@@ -18,6 +20,7 @@ namespace {
 struct Entry {
   std::function<bool(const YAML::Node&, std::string*)> read;  // false + what was expected
   std::function<void(YAML::Emitter&)> write;
+  bool sequence = false;  // the value is a YAML list (else a scalar)
 };
 
 template <typename T>
@@ -55,79 +58,53 @@ Entry Bool(bool* field) {
           [field](YAML::Emitter& e) { e << *field; }};
 }
 
-Entry Matcher(vo::MatcherType* field) {
-  return {[field](const YAML::Node& n, std::string* why) {
-            if (vo::ParseMatcherType(n.Scalar(), field)) return true;
-            *why = "expected one of svd_proximity, svd_ncc, svd_ncc_gabor, ncc_mutual, lucas_kanade, kalman, sift_ratio; got '" + n.Scalar() + "'";
-            return false;
-          },
-          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
-}
-
-Entry Prediction(vo::PredictionMode* field) {
-  return {[field](const YAML::Node& n, std::string* why) {
-            if (vo::ParsePredictionMode(n.Scalar(), field)) return true;
-            *why = "expected none or motion_prior, got '" + n.Scalar() + "'";
-            return false;
-          },
-          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
-}
-
-Entry DisparityModeEntry(vo::DisparityMode* field) {
-  return {[field](const YAML::Node& n, std::string* why) {
-            if (vo::ParseDisparityMode(n.Scalar(), field)) return true;
-            *why = "expected dense or at_features, got '" + n.Scalar() + "'";
-            return false;
-          },
-          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
-}
-
-Entry BaSolverEntry(vo::BaSolver* field) {
-  return {[field](const YAML::Node& n, std::string* why) {
-            for (vo::BaSolver a : {vo::BaSolver::kCeres, vo::BaSolver::kSchurLm}) {
-              if (n.Scalar() == vo::ToString(a)) {
-                *field = a;
+// An enum by its vo::ToString names (the name tables live in vo/).
+template <typename E>
+Entry Enum(E* field, std::initializer_list<E> values) {
+  const std::vector<E> all(values);
+  return {[field, all](const YAML::Node& n, std::string* why) {
+            std::string names;
+            for (E v : all) {
+              if (n.Scalar() == vo::ToString(v)) {
+                *field = v;
                 return true;
               }
+              names += (names.empty() ? "" : ", ") + std::string(vo::ToString(v));
             }
-            *why = "expected ceres or schur_lm; got '" + n.Scalar() + "'";
+            *why = "expected one of " + names + "; got '" + n.Scalar() + "'";
             return false;
           },
           [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
 }
 
-Entry DisparityAlgorithmEntry(vo::DisparityAlgorithm* field) {
-  return {[field](const YAML::Node& n, std::string* why) {
-            for (vo::DisparityAlgorithm a :
-                 {vo::DisparityAlgorithm::kBlockMatching, vo::DisparityAlgorithm::kSemiGlobal,
-                  vo::DisparityAlgorithm::kBlockMatchingOneVolume}) {
-              if (n.Scalar() == vo::ToString(a)) {
-                *field = a;
+// A 3-vector as a list [x, y, z] of finite numbers.
+Entry Vector3(Eigen::Vector3d* field) {
+  Entry entry{[field](const YAML::Node& n, std::string* why) {
+                Eigen::Vector3d v;
+                try {
+                  if (!n.IsSequence() || n.size() != 3) throw YAML::Exception(n.Mark(), "");
+                  for (int i = 0; i < 3; ++i) v[i] = n[i].as<double>();
+                } catch (const YAML::Exception&) {
+                  *why = "expected a list of 3 numbers [x, y, z]";
+                  return false;
+                }
+                if (!v.allFinite()) {
+                  *why = "expected finite numbers";
+                  return false;
+                }
+                *field = v;
                 return true;
-              }
-            }
-            *why = "expected block_matching, block_matching_one_volume or semi_global; got '" +
-                   n.Scalar() + "'";
-            return false;
-          },
-          [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
-}
-
-Entry Detector(vo::DetectorType* field) {
-  return {[field](const YAML::Node& n, std::string* why) {
-            if (n.Scalar() == "harris") *field = vo::DetectorType::kHarris;
-            else if (n.Scalar() == "sift") *field = vo::DetectorType::kSift;
-            else {
-              *why = "expected harris or sift, got '" + n.Scalar() + "'";
-              return false;
-            }
-            return true;
-          },
-          [field](YAML::Emitter& e) { e << (*field == vo::DetectorType::kHarris ? "harris" : "sift"); }};
+              },
+              [field](YAML::Emitter& e) {
+                e << YAML::Flow << YAML::BeginSeq << field->x() << field->y() << field->z()
+                  << YAML::EndSeq;
+              }};
+  entry.sequence = true;
+  return entry;
 }
 
 Entry Wavelengths(std::vector<double>* field) {
-  return {[field](const YAML::Node& n, std::string* why) {
+  Entry entry{[field](const YAML::Node& n, std::string* why) {
             std::vector<double> v;
             try {
               if (!n.IsSequence()) throw YAML::Exception(n.Mark(), "");
@@ -153,83 +130,218 @@ Entry Wavelengths(std::vector<double>* field) {
             for (double x : *field) e << x;
             e << YAML::EndSeq;
           }};
+  entry.sequence = true;
+  return entry;
 }
 
-// The supported keys, in output order, bound to `o`'s fields.
+// The supported keys, in output order, bound to `o`'s fields: every field of
+// vo::OdometryOptions and its nested Options structs (tests/harness/vo_config_test.cc fails
+// when a struct grows a field that is not listed here). Ranges are what YAML may hold; each
+// Options::IsValid checks the finer rules after reading.
 std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
   const double kInf = 1e12;
+  const int kBig = 100000000;
+  vo::DetectorOptions& d = o->detector;
+  vo::DisparityOptions& disp = o->disparity;
+  vo::MatcherOptions& m = o->matcher;
+  vo::RansacOptions& r = o->ransac;
+  vo::BundleAdjustmentOptions& ba = o->ba;
+  vo::PlaneOrientationOptions& po = o->orientation;
+  vo::RobustTrackingOptions& t = o->tracking;
+  using vo::BaLinearSolver;
+  using vo::BaSolver;
+  using vo::DisparityAlgorithm;
+  using vo::RobustLoss;
   return {
-      {"detector.type", Detector(&o->detector.type)},
-      {"detector.max_features", Number(&o->detector.max_features, 0, 100000)},
-      {"detector.border_margin_px", Number(&o->detector.border_margin_px, 0, 1000)},
-      {"detector.bucket_cols", Number(&o->detector.bucket_cols, 0, 1000)},
-      {"detector.bucket_rows", Number(&o->detector.bucket_rows, 0, 1000)},
-      {"detector.max_per_bucket", Number(&o->detector.max_per_bucket, 1, 100000)},
-      {"detector.harris.quality_level", Number(&o->detector.harris.quality_level, 0.0, 0.999)},
-      {"detector.harris.nms_radius_px", Number(&o->detector.harris.nms_radius_px, 1.0, 100.0)},
-      {"detector.harris.k", Number(&o->detector.harris.k, 1e-6, 0.25)},
-      {"disparity.algorithm", DisparityAlgorithmEntry(&o->disparity.algorithm)},
-      {"disparity.block_size", Number(&o->disparity.block_size, 5, 255)},
-      {"disparity.uniqueness_ratio", Number(&o->disparity.uniqueness_ratio, 0, 100)},
-      {"disparity.left_right_max_diff_px", Number(&o->disparity.left_right_max_diff_px, -1.0, 1000.0)},
-      {"disparity.min_texture", Number(&o->disparity.min_texture, 0.0, 1000.0)},
-      {"disparity.speckle_window_size", Number(&o->disparity.speckle_window_size, 0, 100000)},
-      {"disparity_min_depth_m", Number(&o->disparity_min_depth_m, 0.01, kInf)},
-      {"disparity_mode", DisparityModeEntry(&o->disparity_mode)},
+      {"detector.type", Enum(&d.type, {vo::DetectorType::kHarris, vo::DetectorType::kSift})},
+      {"detector.max_features", Number(&d.max_features, 0, 100000)},
+      {"detector.border_margin_px", Number(&d.border_margin_px, 0, 1000)},
+      {"detector.bucket_cols", Number(&d.bucket_cols, 0, 1000)},
+      {"detector.bucket_rows", Number(&d.bucket_rows, 0, 1000)},
+      {"detector.max_per_bucket", Number(&d.max_per_bucket, 1, 100000)},
+      {"detector.harris.block_size", Number(&d.harris.block_size, 1, 255)},
+      {"detector.harris.aperture_size", Number(&d.harris.aperture_size, 1, 31)},
+      {"detector.harris.k", Number(&d.harris.k, 1e-6, 0.25)},
+      {"detector.harris.quality_level", Number(&d.harris.quality_level, 0.0, 0.999)},
+      {"detector.harris.min_response", Number(&d.harris.min_response, 0.0, kInf)},
+      {"detector.harris.nms_radius_px", Number(&d.harris.nms_radius_px, 1.0, 100.0)},
+      {"detector.harris.subpixel", Bool(&d.harris.subpixel)},
+      {"detector.harris.subpixel_half_window_px", Number(&d.harris.subpixel_half_window_px, 1, 100)},
+      {"detector.harris.subpixel_max_iterations", Number(&d.harris.subpixel_max_iterations, 1, 10000)},
+      {"detector.harris.subpixel_epsilon_px", Number(&d.harris.subpixel_epsilon_px, 0.0, 10.0)},
+      {"detector.sift.octave_layers", Number(&d.sift.octave_layers, 1, 20)},
+      {"detector.sift.contrast_threshold", Number(&d.sift.contrast_threshold, 0.0, 1.0)},
+      {"detector.sift.edge_threshold", Number(&d.sift.edge_threshold, 0.0, 1000.0)},
+      {"detector.sift.sigma", Number(&d.sift.sigma, 0.01, 100.0)},
+      {"detector.sift.unique_positions", Bool(&d.sift.unique_positions)},
+      {"disparity.algorithm",
+       Enum(&disp.algorithm, {DisparityAlgorithm::kBlockMatching, DisparityAlgorithm::kSemiGlobal,
+                              DisparityAlgorithm::kBlockMatchingOneVolume})},
+      {"disparity.min_disparity_px", Number(&disp.min_disparity_px, 0, 10000)},
+      {"disparity.num_disparities", Number(&disp.num_disparities, 16, 10000)},
+      {"disparity.block_size", Number(&disp.block_size, 1, 255)},
+      {"disparity.prefilter_cap", Number(&disp.prefilter_cap, 1, 63)},
+      {"disparity.uniqueness_ratio", Number(&disp.uniqueness_ratio, 0, 100)},
+      {"disparity.min_texture", Number(&disp.min_texture, 0.0, 1000.0)},
+      {"disparity.left_right_max_diff_px", Number(&disp.left_right_max_diff_px, -1.0, 1000.0)},
+      {"disparity.full_width", Bool(&disp.full_width)},
+      {"disparity.speckle_window_size", Number(&disp.speckle_window_size, 0, 100000)},
+      {"disparity.speckle_range_px", Number(&disp.speckle_range_px, 0.0, 1000.0)},
+      {"disparity.sgbm_p1", Number(&disp.sgbm_p1, 0, kBig)},
+      {"disparity.sgbm_p2", Number(&disp.sgbm_p2, 0, kBig)},
+      {"disparity.sgbm_full_dp", Bool(&disp.sgbm_full_dp)},
+      {"disparity_mode",
+       Enum(&o->disparity_mode, {vo::DisparityMode::kDense, vo::DisparityMode::kAtFeatures})},
       {"disparity_range_from_scene", Bool(&o->disparity_range_from_scene)},
       {"disparity_range_margin", Number(&o->disparity_range_margin, 0.0, 100.0)},
       {"disparity_range_margin_px", Number(&o->disparity_range_margin_px, 0.0, 1000.0)},
-
-      {"matcher.type", Matcher(&o->matcher.type)},
-      {"matcher.prediction", Prediction(&o->matcher.prediction)},
-      {"matcher.ncc.window_px", Number(&o->matcher.ncc.window_px, 3, 63)},
-      {"matcher.gabor.wavelengths_px", Wavelengths(&o->matcher.gabor.wavelengths_px)},
-      {"matcher.gabor.phase_exponent", Number(&o->matcher.gabor.phase_exponent, 0.0, 100.0)},
-      {"matcher.svd.sigma_px", Number(&o->matcher.svd.sigma_px, 0.1, 1000.0)},
-      {"matcher.svd.min_weight", Number(&o->matcher.svd.min_weight, 0.0, 1.0)},
-      {"matcher.svd.min_pairing", Number(&o->matcher.svd.min_pairing, 0.0, 1.0)},
-      {"matcher.svd.dense", Bool(&o->matcher.svd.dense)},
-      {"matcher.ncc_mutual.search_radius_px", Number(&o->matcher.ncc_mutual.search_radius_px, 0.1, 10000.0)},
-      {"matcher.ncc_mutual.min_score", Number(&o->matcher.ncc_mutual.min_score, 0.0, 1.0)},
-      {"matcher.lucas_kanade.window_px", Number(&o->matcher.lucas_kanade.window_px, 5, 101)},
-      {"matcher.lucas_kanade.max_level", Number(&o->matcher.lucas_kanade.max_level, 0, 8)},
-      {"matcher.sift_ratio.ratio", Number(&o->matcher.sift_ratio.ratio, 0.01, 1.0)},
-      {"ransac.inlier_threshold_px", Number(&o->ransac.inlier_threshold_px, 0.01, 1000.0)},
-      {"ransac.confidence", Number(&o->ransac.confidence, 0.5, 0.999999)},
-      {"ransac.max_iterations", Number(&o->ransac.max_iterations, 1, 100000)},
-      {"ransac.seed", Number<uint64_t>(&o->ransac.seed, 0, UINT64_MAX)},
+      {"derive_num_disparities", Bool(&o->derive_num_disparities)},
+      {"disparity_min_depth_m", Number(&o->disparity_min_depth_m, 0.01, kInf)},
+      {"max_num_disparities", Number(&o->max_num_disparities, 16, 10000)},
+      {"depth.sampling",
+       Enum(&o->depth.sampling, {vo::DisparitySampling::kNearest, vo::DisparitySampling::kBilinear})},
+      {"depth.search_radius_px", Number(&o->depth.search_radius_px, 0, 100)},
+      {"depth.max_spread_px", Number(&o->depth.max_spread_px, 0.0, 1000.0)},
+      {"depth.min_depth_m", Number(&o->depth.min_depth_m, 1e-6, kInf)},
+      {"depth.max_depth_m", Number(&o->depth.max_depth_m, 1e-6, kInf)},
+      {"matcher.type",
+       Enum(&m.type, {vo::MatcherType::kSvdProximity, vo::MatcherType::kSvdNcc,
+                      vo::MatcherType::kSvdNccGabor, vo::MatcherType::kNccMutual,
+                      vo::MatcherType::kLucasKanade, vo::MatcherType::kKalman,
+                      vo::MatcherType::kSiftRatio})},
+      {"matcher.prediction",
+       Enum(&m.prediction, {vo::PredictionMode::kNone, vo::PredictionMode::kMotionPrior})},
+      {"matcher.ncc.window_px", Number(&m.ncc.window_px, 3, 63)},
+      {"matcher.ncc.min_stddev", Number(&m.ncc.min_stddev, 0.0, 255.0)},
+      {"matcher.gabor.num_orientations", Number(&m.gabor.num_orientations, 1, 16)},
+      {"matcher.gabor.wavelengths_px", Wavelengths(&m.gabor.wavelengths_px)},
+      {"matcher.gabor.sigma_per_wavelength", Number(&m.gabor.sigma_per_wavelength, 0.01, 10.0)},
+      {"matcher.gabor.aspect", Number(&m.gabor.aspect, 0.01, 100.0)},
+      {"matcher.gabor.truncate_sigmas", Number(&m.gabor.truncate_sigmas, 0.1, 100.0)},
+      {"matcher.gabor.half_res_min_wavelength_px",
+       Number(&m.gabor.half_res_min_wavelength_px, 0.0, 1000.0)},
+      {"matcher.gabor.subpixel_phase_correction", Bool(&m.gabor.subpixel_phase_correction)},
+      {"matcher.gabor.weighting",
+       Enum(&m.gabor.weighting, {vo::PhaseWeighting::kUniform, vo::PhaseWeighting::kAmplitude})},
+      {"matcher.gabor.min_amplitude", Number(&m.gabor.min_amplitude, 0.0, kInf)},
+      {"matcher.gabor.phase_exponent", Number(&m.gabor.phase_exponent, 0.0, 100.0)},
+      {"matcher.gabor.unknown_phase_diff_rad", Number(&m.gabor.unknown_phase_diff_rad, 0.0, 4.0)},
+      {"matcher.svd.sigma_px", Number(&m.svd.sigma_px, 0.1, 1000.0)},
+      {"matcher.svd.cutoff_sigmas", Number(&m.svd.cutoff_sigmas, 0.1, 100.0)},
+      {"matcher.svd.min_entry", Number(&m.svd.min_entry, 0.0, 1.0)},
+      {"matcher.svd.min_weight", Number(&m.svd.min_weight, 0.0, 1.0)},
+      {"matcher.svd.min_pairing", Number(&m.svd.min_pairing, 0.0, 1.0)},
+      {"matcher.svd.min_ncc", Number(&m.svd.min_ncc, -1.0, 1.0)},
+      {"matcher.svd.max_phase_diff_rad", Number(&m.svd.max_phase_diff_rad, 0.0, 4.0)},
+      {"matcher.svd.dense", Bool(&m.svd.dense)},
+      {"matcher.svd.max_component_size", Number(&m.svd.max_component_size, 1, kBig)},
+      {"matcher.svd.guard_growth", Number(&m.svd.guard_growth, 0.0, kInf)},
+      {"matcher.svd.guard_max_entry", Number(&m.svd.guard_max_entry, 0.0, 1.0)},
+      {"matcher.svd.jacobi_max_size", Number(&m.svd.jacobi_max_size, 0, kBig)},
+      {"matcher.ncc_mutual.search_radius_px", Number(&m.ncc_mutual.search_radius_px, 0.1, 10000.0)},
+      {"matcher.ncc_mutual.min_score", Number(&m.ncc_mutual.min_score, 0.0, 1.0)},
+      {"matcher.lucas_kanade.window_px", Number(&m.lucas_kanade.window_px, 5, 101)},
+      {"matcher.lucas_kanade.max_level", Number(&m.lucas_kanade.max_level, 0, 8)},
+      {"matcher.lucas_kanade.max_iterations", Number(&m.lucas_kanade.max_iterations, 1, 10000)},
+      {"matcher.lucas_kanade.epsilon_px", Number(&m.lucas_kanade.epsilon_px, 0.0, 100.0)},
+      {"matcher.lucas_kanade.min_eig_threshold", Number(&m.lucas_kanade.min_eig_threshold, 0.0, 1.0)},
+      {"matcher.lucas_kanade.max_fb_error_px", Number(&m.lucas_kanade.max_fb_error_px, -1.0, 1000.0)},
+      {"matcher.lucas_kanade.association_radius_px",
+       Number(&m.lucas_kanade.association_radius_px, 0.0, 1000.0)},
+      {"matcher.kalman.measurement_noise_px", Number(&m.kalman.measurement_noise_px, 0.0, 1000.0)},
+      {"matcher.kalman.process_noise_px", Number(&m.kalman.process_noise_px, 0.0, 1000.0)},
+      {"matcher.kalman.initial_velocity_std_px",
+       Number(&m.kalman.initial_velocity_std_px, 0.0, 10000.0)},
+      {"matcher.kalman.gate_chi2", Number(&m.kalman.gate_chi2, 0.0, kInf)},
+      {"matcher.kalman.max_search_radius_px", Number(&m.kalman.max_search_radius_px, 0.0, 10000.0)},
+      {"matcher.kalman.gradient_window_px", Number(&m.kalman.gradient_window_px, 1, 101)},
+      {"matcher.kalman.gradient_noise", Number(&m.kalman.gradient_noise, 0.0, kInf)},
+      {"matcher.kalman.gradient_process_noise", Number(&m.kalman.gradient_process_noise, 0.0, kInf)},
+      {"matcher.kalman.min_ncc", Number(&m.kalman.min_ncc, -1.0, 1.0)},
+      {"matcher.kalman.ncc_scale", Number(&m.kalman.ncc_scale, 0.0, kInf)},
+      {"matcher.kalman.max_cost", Number(&m.kalman.max_cost, 0.0, kInf)},
+      {"matcher.sift_ratio.ratio", Number(&m.sift_ratio.ratio, 0.01, 1.0)},
+      {"matcher.sift_ratio.mutual", Bool(&m.sift_ratio.mutual)},
+      {"matcher.sift_ratio.search_radius_px", Number(&m.sift_ratio.search_radius_px, -1.0, kInf)},
+      {"ransac.inlier_threshold_px", Number(&r.inlier_threshold_px, 0.01, 1000.0)},
+      {"ransac.confidence", Number(&r.confidence, 0.5, 0.999999)},
+      {"ransac.min_iterations", Number(&r.min_iterations, 0, kBig)},
+      {"ransac.max_iterations", Number(&r.max_iterations, 1, kBig)},
+      {"ransac.min_inliers", Number(&r.min_inliers, 3, kBig)},
+      {"ransac.num_seeded_iterations", Number(&r.num_seeded_iterations, 0, kBig)},
+      {"ransac.stable_pool_fraction", Number(&r.stable_pool_fraction, 0.0, 1.0)},
+      {"ransac.min_stable_pool_size", Number(&r.min_stable_pool_size, 0, kBig)},
+      {"ransac.seed", Number<uint64_t>(&r.seed, 0, UINT64_MAX)},
+      {"ransac.sample_collinear_tolerance", Number(&r.sample_collinear_tolerance, 0.0, 1.0)},
+      {"ransac.refit_iterations", Number(&r.refit_iterations, 0, 1000)},
+      {"ransac.refit_depth_weighted", Bool(&r.refit_depth_weighted)},
+      {"ransac.local_optimization_iterations", Number(&r.local_optimization_iterations, 0, 1000)},
+      {"ransac.refine_nonlinear", Bool(&r.refine_nonlinear)},
+      {"ransac.refine_max_iterations", Number(&r.refine_max_iterations, 0, 10000)},
+      {"ransac.refine_points", Bool(&r.refine_points)},
+      {"ransac.min_depth_m", Number(&r.min_depth_m, 0.0, kInf)},
+      {"ba.max_num_iterations", Number(&ba.max_num_iterations, 1, 1000)},
+      {"ba.function_tolerance", Number(&ba.function_tolerance, 0.0, 1.0)},
+      {"ba.gradient_tolerance", Number(&ba.gradient_tolerance, 0.0, 1.0)},
+      {"ba.parameter_tolerance", Number(&ba.parameter_tolerance, 0.0, 1.0)},
+      {"ba.loss", Enum(&ba.loss, {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy})},
+      {"ba.loss_scale_px", Number(&ba.loss_scale_px, 0.01, 100.0)},
+      {"ba.outlier_threshold_px", Number(&ba.outlier_threshold_px, 1e-6, 1e6)},
+      {"ba.num_fixed_poses", Number(&ba.num_fixed_poses, 1, 10)},
+      {"ba.min_frames_per_point", Number(&ba.min_frames_per_point, 1, 10)},
+      {"ba.solver", Enum(&ba.solver, {BaSolver::kCeres, BaSolver::kSchurLm})},
+      {"ba.linear_solver", Enum(&ba.linear_solver, {BaLinearSolver::kAuto, BaLinearSolver::kSparseSchur,
+                                                    BaLinearSolver::kDenseSchur})},
+      {"ba.analytic_jacobians", Bool(&ba.analytic_jacobians)},
+      {"ba.min_depth_m", Number(&ba.min_depth_m, 1e-9, kInf)},
       {"use_bundle_adjustment", Bool(&o->use_bundle_adjustment)},
       {"ba_window_frames", Number(&o->ba_window_frames, 3, 10)},
-      {"ba.max_num_iterations", Number(&o->ba.max_num_iterations, 1, 1000)},
-      {"ba.loss_scale_px", Number(&o->ba.loss_scale_px, 0.01, 100.0)},
-      {"ba.solver", BaSolverEntry(&o->ba.solver)},
       {"ba_max_points", Number(&o->ba_max_points, 0, 100000)},
+      {"ba_max_correction_m", Number(&o->ba_max_correction_m, 1e-9, kInf)},
+      {"ba_max_correction_deg", Number(&o->ba_max_correction_deg, 1e-9, 360.0)},
+      {"ransac_refine_with_ba", Bool(&o->ransac_refine_with_ba)},
       {"prior_weight", Number(&o->prior_weight, 0.0, 1.0)},
       {"estimate_initial_orientation", Bool(&o->estimate_initial_orientation)},
+      {"orientation.max_planes", Number(&po.max_planes, 1, 100)},
+      {"orientation.min_plane_inliers", Number(&po.min_plane_inliers, 3, kBig)},
+      {"orientation.distance_threshold_m", Number(&po.distance_threshold_m, 0.0, 100.0)},
+      {"orientation.distance_threshold_per_m", Number(&po.distance_threshold_per_m, 0.0, 100.0)},
+      {"orientation.ransac_iterations", Number(&po.ransac_iterations, 1, kBig)},
+      {"orientation.seed", Number<uint64_t>(&po.seed, 0, UINT64_MAX)},
+      {"orientation.expected_up_cam0", Vector3(&po.expected_up_cam0)},
+      {"orientation.max_normal_deviation_deg", Number(&po.max_normal_deviation_deg, 0.0, 180.0)},
+      {"orientation.manhattan_refinement", Bool(&po.manhattan_refinement)},
+      {"orientation_sample_step_px", Number(&o->orientation_sample_step_px, 1, 1000)},
+      {"orientation_requires_wall", Bool(&o->orientation_requires_wall)},
       {"adaptive_min_features", Number(&o->adaptive_min_features, 0, 100000)},
       {"adaptive_quality_level", Number(&o->adaptive_quality_level, 0.0, 0.999)},
       {"min_features", Number(&o->min_features, 0, 100000)},
       {"min_inliers", Number(&o->min_inliers, 3, 100000)},
       {"reinit_after_lost_frames", Number(&o->reinit_after_lost_frames, 1, 100000)},
-      {"tracking.coarse_to_fine", Bool(&o->tracking.coarse_to_fine)},
-      {"tracking.image_shift.min_score", Number(&o->tracking.image_shift.min_score, -1.0, 1.0)},
+      {"tracking.coarse_to_fine", Bool(&t.coarse_to_fine)},
+      {"tracking.image_shift.coarsest_max_width_px",
+       Number(&t.image_shift.coarsest_max_width_px, 8, 100000)},
       {"tracking.image_shift.max_shift_fraction_x",
-       Number(&o->tracking.image_shift.max_shift_fraction_x, 0.01, 0.9)},
-      {"tracking.prior_radius_scale", Number(&o->tracking.prior_radius_scale, 0.05, 20.0)},
-      {"tracking.shift_radius_scale", Number(&o->tracking.shift_radius_scale, 0.05, 20.0)},
-      {"tracking.confident_min_inliers", Number(&o->tracking.confident_min_inliers, 0, 100000)},
-      {"tracking.confident_inlier_fraction",
-       Number(&o->tracking.confident_inlier_fraction, 0.0, 1.0)},
-      {"tracking.guided_rematch", Bool(&o->tracking.guided_rematch)},
-      {"tracking.guided_radius_scale", Number(&o->tracking.guided_radius_scale, 0.05, 20.0)},
-      {"tracking.rotation_from_shift", Bool(&o->tracking.rotation_from_shift)},
-      {"tracking.rotation_min_shift_score",
-       Number(&o->tracking.rotation_min_shift_score, -1.0, 1.0)},
-      {"tracking.rotation_min_peak_ratio",
-       Number(&o->tracking.rotation_min_peak_ratio, 1.0, 1000.0)},
-      {"tracking.rotation_min_residual_px",
-       Number(&o->tracking.rotation_min_residual_px, 0.0, 1000.0)},
-      {"tracking.reliable_min_inliers", Number(&o->tracking.reliable_min_inliers, 3, 100000)},
+       Number(&t.image_shift.max_shift_fraction_x, 0.01, 0.9)},
+      {"tracking.image_shift.max_shift_fraction_y",
+       Number(&t.image_shift.max_shift_fraction_y, 0.01, 0.9)},
+      {"tracking.image_shift.refine_radius_px", Number(&t.image_shift.refine_radius_px, 1, 100)},
+      {"tracking.image_shift.finest_level", Number(&t.image_shift.finest_level, 0, 10)},
+      {"tracking.image_shift.min_overlap_fraction",
+       Number(&t.image_shift.min_overlap_fraction, 0.01, 1.0)},
+      {"tracking.image_shift.min_score", Number(&t.image_shift.min_score, -1.0, 1.0)},
+      {"tracking.image_shift.subpixel", Bool(&t.image_shift.subpixel)},
+      {"tracking.prior_radius_scale", Number(&t.prior_radius_scale, 0.05, 20.0)},
+      {"tracking.shift_radius_scale", Number(&t.shift_radius_scale, 0.05, 20.0)},
+      {"tracking.confident_min_inliers", Number(&t.confident_min_inliers, 0, 100000)},
+      {"tracking.confident_inlier_fraction", Number(&t.confident_inlier_fraction, 0.0, 1.0)},
+      {"tracking.guided_rematch", Bool(&t.guided_rematch)},
+      {"tracking.guided_radius_scale", Number(&t.guided_radius_scale, 0.05, 20.0)},
+      {"tracking.rotation_from_shift", Bool(&t.rotation_from_shift)},
+      {"tracking.rotation_min_shift_score", Number(&t.rotation_min_shift_score, -1.0, 1.0)},
+      {"tracking.rotation_min_peak_ratio", Number(&t.rotation_min_peak_ratio, 1.0, 1000.0)},
+      {"tracking.rotation_min_residual_px", Number(&t.rotation_min_residual_px, 0.0, 1000.0)},
+      {"tracking.reliable_min_inliers", Number(&t.reliable_min_inliers, 3, 100000)},
   };
 }
 
@@ -265,7 +377,7 @@ bool Apply(const YAML::Node& node, const std::string& prefix, const std::string&
       return false;
     }
     std::string why;
-    if (!(v.IsScalar() || (v.IsSequence() && key == "matcher.gabor.wavelengths_px")) || !it->second.read(v, &why)) {
+    if (!(it->second.sequence ? v.IsSequence() : v.IsScalar()) || !it->second.read(v, &why)) {
       *error = where + (why.empty() ? "expected a single value" : why);
       return false;
     }

@@ -113,6 +113,16 @@ int TextureSum(const cv::Mat& image, int x, int y, int half) {
 
 }  // namespace
 
+const char* ToString(DisparitySampling sampling) {
+  switch (sampling) {
+    case DisparitySampling::kNearest:
+      return "nearest";
+    case DisparitySampling::kBilinear:
+      return "bilinear";
+  }
+  return "unknown";
+}
+
 const char* ToString(DisparityAlgorithm algorithm) {
   switch (algorithm) {
     case DisparityAlgorithm::kBlockMatching:

@@ -145,6 +145,8 @@ enum class DisparitySampling {
               // when the valid ones straddle a depth edge (spread > max_spread_px) or none is
               // valid, falls back to kNearest
 };
+// "nearest", "bilinear".
+const char* ToString(DisparitySampling sampling);
 
 struct DepthSamplingOptions {
   DisparitySampling sampling = DisparitySampling::kBilinear;  // see DisparitySampling

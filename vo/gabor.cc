@@ -8,6 +8,16 @@
 #include <sstream>
 
 namespace vo {
+
+const char* ToString(PhaseWeighting weighting) {
+  switch (weighting) {
+    case PhaseWeighting::kUniform:
+      return "uniform";
+    case PhaseWeighting::kAmplitude:
+      return "amplitude";
+  }
+  return "unknown";
+}
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;

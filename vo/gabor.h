@@ -53,6 +53,8 @@ enum class PhaseWeighting {
   kUniform,    // every usable filter counts the same (the paper's product)
   kAmplitude,  // weight w_k = sqrt(amplitude_i · amplitude_j)
 };
+// "uniform", "amplitude".
+const char* ToString(PhaseWeighting weighting);
 
 struct GaborOptions {
   int num_orientations = 4;  // n: θ_k = π (k−1) / n; paper: 4; in [1, 16]
