@@ -80,39 +80,20 @@ OdometryOptions EffectiveOptions(const StereoCamera& camera, const OdometryOptio
   return effective;
 }
 
-// Keeps at most max_points points of the window problem (0 = all): those seen in the most
-// frames (at least min_frames), ties by index (= ascending track id, the older tracks first).
-// Points left out are dropped with their observations; the others are re-indexed.
-BundleAdjustmentProblem SelectBaPoints(BundleAdjustmentProblem problem, int max_points,
-                                       int min_frames) {
-  const int num_points = static_cast<int>(problem.points_world.size());
-  std::vector<int> frames_seen(num_points, 0);
-  for (const BaObservation& o : problem.observations) ++frames_seen[o.point_index];
-  std::vector<int> order;
-  for (int j = 0; j < num_points; ++j) {
-    if (frames_seen[j] >= min_frames) order.push_back(j);
-  }
-  if (max_points <= 0 || static_cast<int>(order.size()) <= max_points) {
-    if (static_cast<int>(order.size()) == num_points) return problem;
-  } else {
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return frames_seen[a] > frames_seen[b]; });
-    order.resize(max_points);
-    std::sort(order.begin(), order.end());
-  }
-  std::vector<int> new_index(num_points, -1);
-  BundleAdjustmentProblem selected;
-  selected.T_world_cam0 = std::move(problem.T_world_cam0);
-  for (int j : order) {
-    new_index[j] = static_cast<int>(selected.points_world.size());
-    selected.points_world.push_back(problem.points_world[j]);
-  }
-  for (BaObservation o : problem.observations) {
-    if (new_index[o.point_index] < 0) continue;
-    o.point_index = new_index[o.point_index];
-    selected.observations.push_back(o);
-  }
-  return selected;
+}  // namespace
+
+namespace {
+
+// The back end's options from the pipeline's.
+SlidingWindowOptions WindowOptions(const OdometryOptions& o) {
+  SlidingWindowOptions w;
+  w.window_frames = o.ba_window_frames;
+  w.use_bundle_adjustment = o.use_bundle_adjustment;
+  w.max_points = o.ba_max_points;
+  w.max_correction_m = o.ba_max_correction_m;
+  w.max_correction_deg = o.ba_max_correction_deg;
+  w.ba = o.ba;
+  return w;
 }
 
 }  // namespace
@@ -311,7 +292,7 @@ std::unique_ptr<StereoOdometry> StereoOdometry::Create(const StereoCamera& camer
 StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions& options)
     : camera_(camera),
       options_(EffectiveOptions(camera, options)),
-      tracks_(TrackManagerOptions{options.ba_window_frames}) {
+      window_(WindowOptions(options_)) {
   std::string why;
   if (!camera_.IsValid(&why)) {
     std::fprintf(stderr, "vo::StereoOdometry: invalid camera: %s\n", why.c_str());
@@ -339,13 +320,12 @@ StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions
 StereoOdometry::~StereoOdometry() = default;
 
 void StereoOdometry::Reset() {
-  tracks_.Reset();
+  window_.Reset();
   matcher_->Reset();
   frame_index_ = 0;
   initialised_ = false;
   consecutive_lost_ = 0;
   reference_ = Reference();
-  T_world_cam0_by_frame_.clear();
   T_world_prev_ = Eigen::Isometry3d::Identity();
   velocity_ = Eigen::Isometry3d::Identity();
   has_velocity_ = false;
@@ -509,15 +489,12 @@ OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame fram
     result.reinitialised = true;
     result.message = reason.empty() ? "re-initialised at the predicted pose" : reason;
   }
-  tracks_.Reset();
   matcher_->Reset();
-  const TrackUpdateResult update = tracks_.AddFrame(result.frame_index, &frame.features, {});
-  if (!update.ok()) {  // cannot happen after Reset(); keep going without tracks
+  const TrackUpdateResult update = window_.Start(result.frame_index, &frame.features, T_world_cam0);
+  if (!update.ok()) {  // cannot happen on a new window; keep going without tracks
     result.message +=
         (result.message.empty() ? "" : "; ") + std::string("tracks: ") + update.message;
   }
-  T_world_cam0_by_frame_.clear();
-  T_world_cam0_by_frame_[result.frame_index] = T_world_cam0;
   initialised_ = true;
   consecutive_lost_ = 0;
   last_features_ = frame.features;
@@ -705,83 +682,44 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
                                                    ? Blend(ransac.T_prev_curr, *T_ref_curr_prior, w)
                                                    : ransac.T_prev_curr;
 
-  // Tracks from the inlier matches (track ids and ages written into the features).
+  // Tracks from the inlier matches (track ids and ages written into the features), the
+  // frame's initial pose into the window.
+  const Eigen::Isometry3d* T_world_ref = window_.Pose(reference_.frame_index);
+  if (T_world_ref == nullptr) {  // cannot happen: the reference is the window's newest frame
+    result.times.motion_ms += MsSince(motion_start);
+    return Lost(std::move(result), "the reference frame has no pose in the window", start, prior);
+  }
+  Eigen::Isometry3d T_world_curr = *T_world_ref * T_ref_curr_initial;
   const TrackUpdateResult update =
-      tracks_.AddFrame(result.frame_index, &frame.features, inlier_matches);
+      window_.Add(result.frame_index, &frame.features, inlier_matches, T_world_curr);
   if (!update.ok()) {
     result.times.motion_ms += MsSince(motion_start);
     return Lost(std::move(result), "tracks: " + update.message, start, prior);
   }
-  const Eigen::Isometry3d T_world_ref = T_world_cam0_by_frame_.at(reference_.frame_index);
-  Eigen::Isometry3d T_world_curr = T_world_ref * T_ref_curr_initial;
-  T_world_cam0_by_frame_[result.frame_index] = T_world_curr;
-  // Keep the poses of the window's frames only.
-  for (auto it = T_world_cam0_by_frame_.begin(); it != T_world_cam0_by_frame_.end();) {
-    const auto& window = tracks_.window_frame_ids();
-    if (std::find(window.begin(), window.end(), it->first) == window.end()) {
-      it = T_world_cam0_by_frame_.erase(it);
-    } else {
-      ++it;
-    }
-  }
   result.times.motion_ms += MsSince(motion_start);
   result.rms_reprojection_px = ransac.rms_reprojection_px;
 
-  // Windowed bundle adjustment, the oldest pose(s) fixed.
-  bool ba_rejected = false;
-  if (options_.use_bundle_adjustment && T_world_cam0_by_frame_.size() >= 2) {
-    const Clock::time_point ba_start = Clock::now();
-    std::vector<int64_t> frame_ids;
-    const BundleAdjustmentProblem problem =
-        SelectBaPoints(MakeWindowProblem(tracks_, T_world_cam0_by_frame_, &frame_ids),
-                       options_.ba_max_points, options_.ba.min_frames_per_point);
-    if (static_cast<int>(problem.T_world_cam0.size()) > options_.ba.num_fixed_poses) {
-      const BundleAdjustmentSummary ba = RunBundleAdjustment(camera_, problem, options_.ba);
-      bool usable = ba.ok() && ba.T_world_cam0.size() == frame_ids.size();
-      for (size_t i = 0; usable && i < ba.T_world_cam0.size(); ++i) {
-        usable = IsFinite(ba.T_world_cam0[i]);
-      }
-      // Divergence guard: the newest pose may move only so far from its initial value.
-      const size_t newest = static_cast<size_t>(
-          std::find(frame_ids.begin(), frame_ids.end(), result.frame_index) - frame_ids.begin());
-      usable = usable && newest < frame_ids.size();
-      if (usable) {
-        const Eigen::Isometry3d& T_new = ba.T_world_cam0[newest];
-        const double moved_m = (T_new.translation() - T_world_curr.translation()).norm();
-        const double turned_deg =
-            Eigen::AngleAxisd(T_new.linear().transpose() * T_world_curr.linear()).angle() * 180.0 /
-            M_PI;
-        if (moved_m > options_.ba_max_correction_m || turned_deg > options_.ba_max_correction_deg) {
-          std::ostringstream msg;
-          msg << "bundle adjustment rejected: it moved the pose by " << moved_m << " m and "
-              << turned_deg << " deg";
-          result.message = msg.str();
-          usable = false;
-          ba_rejected = true;
-        }
-      }
-      if (usable) {
-        for (size_t i = 0; i < frame_ids.size(); ++i) {
-          T_world_cam0_by_frame_[frame_ids[i]] = ba.T_world_cam0[i];
-        }
-        T_world_curr = T_world_cam0_by_frame_.at(result.frame_index);
-        result.ba_ran = true;
-        result.ba_num_frames = static_cast<int>(frame_ids.size());
-        result.ba_num_points = ba.num_points_optimized;
-        result.rms_reprojection_px = ba.rms_inlier_reprojection_after_px;
-      }
-    }
-    result.times.ba_ms = MsSince(ba_start);
+  // Windowed bundle adjustment, the oldest pose(s) fixed (sliding_window.h).
+  const Clock::time_point ba_start = Clock::now();
+  const WindowRefinement refinement = window_.Refine(camera_, result.frame_index);
+  if (refinement.attempted) result.times.ba_ms = MsSince(ba_start);
+  const bool ba_rejected = refinement.rejected;
+  if (ba_rejected) result.message = refinement.message;
+  if (refinement.ran) {
+    T_world_curr = *window_.Pose(result.frame_index);
+    result.ba_ran = true;
+    result.ba_num_frames = refinement.num_frames;
+    result.ba_num_points = refinement.num_points;
+    result.rms_reprojection_px = refinement.rms_reprojection_px;
   }
 
   // Constant-velocity model: the (refined) motion from the reference, per frame, blended into
   // the prior by its support, so one weak estimate before a loss is not extrapolated over the
   // gap.
+  const Eigen::Isometry3d* T_world_ref_now = window_.Pose(reference_.frame_index);
   const Eigen::Isometry3d T_ref_curr =
-      T_world_cam0_by_frame_.count(reference_.frame_index)
-          ? Eigen::Isometry3d(T_world_cam0_by_frame_.at(reference_.frame_index).inverse() *
-                              T_world_curr)
-          : T_ref_curr_initial;
+      T_world_ref_now != nullptr ? Eigen::Isometry3d(T_world_ref_now->inverse() * T_world_curr)
+                                 : T_ref_curr_initial;
   const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
   // Weight of this motion in the prior: 1 from reliable_min_inliers inliers up, less below
   // (a weak motion moves the prior only part of the way), 0 when the BA was rejected.
@@ -936,9 +874,8 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
 
   // Match against the reference frame (its cues are cached in reference_.frame), with the
   // search predicted from the motion prior (see the header comment).
-  const auto ref_pose = T_world_cam0_by_frame_.find(reference_.frame_index);
-  const Eigen::Isometry3d T_world_ref =
-      ref_pose != T_world_cam0_by_frame_.end() ? ref_pose->second : T_world_prev_;
+  const Eigen::Isometry3d* ref_pose = window_.Pose(reference_.frame_index);
+  const Eigen::Isometry3d T_world_ref = ref_pose != nullptr ? *ref_pose : T_world_prev_;
   const Eigen::Isometry3d T_ref_curr_prior = T_world_ref.inverse() * PredictedPose(prior);
   const bool has_prior = (prior != nullptr || has_velocity_) && IsFinite(T_ref_curr_prior);
   std::string matcher_error;

@@ -90,6 +90,7 @@
 #include <vector>
 
 #include "vo/bundle_adjustment.h"
+#include "vo/sliding_window.h"
 #include "vo/camera.h"
 #include "vo/disparity.h"
 #include "vo/features.h"
@@ -501,13 +502,12 @@ class StereoOdometry {
   std::unique_ptr<FeatureDetector> detector_;
   std::unique_ptr<FeatureDetector> weak_detector_;  // adaptive_min_features fallback (or null)
   std::unique_ptr<FrameMatcher> matcher_;
-  TrackManager tracks_;
+  SlidingWindow window_;  // tracks, window poses and the bundle adjustment (sliding_window.h)
 
   int64_t frame_index_ = 0;   // index of the next call
   bool initialised_ = false;  // a reference was set at least once since Reset
   int consecutive_lost_ = 0;  // lost frames since the last good one
   Reference reference_;
-  std::map<int64_t, Eigen::Isometry3d> T_world_cam0_by_frame_;      // window poses (frame index)
   Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();  // previous call's output
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();      // constant-velocity model: last
                                                                 // estimated per-frame T_prev_curr
