@@ -10,10 +10,11 @@
 //                  whole map), features without depth dropped                   disparity.h
 //                → match to the reference frame (SVD · NCC · Gabor by default)  matcher.h
 //                → RANSAC + Horn (T_ref_curr), seeded by track ages             ransac.h
-//                → tracks (inlier matches only)                                 tracks.h
 //                → initial pose = blend of the RANSAC estimate and the constant-velocity
 //                  prediction (slerp on the rotation, linear on the translation)
-//                → windowed bundle adjustment, oldest pose fixed                bundle_adjustment.h
+//                → tracks (inlier matches only) and the window's poses          sliding_window.h
+//                → windowed bundle adjustment, oldest pose fixed, divergence
+//                  guard                                  sliding_window.h, bundle_adjustment.h
 //                → T_world_cam0
 //
 // The reference frame is the last frame that was tracked (or initialised): normally the
