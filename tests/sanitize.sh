@@ -27,7 +27,8 @@ if command -v clang++ > /dev/null; then
 else
   echo "sanitize: clang++ not found: building with the default compiler, no fuzz targets"
 fi
-cmake -S . -B "$build" "${cfg[@]}" > "$build.cmake.log" 2>&1 || { cat "$build.cmake.log"; exit 1; }
+mkdir -p "$build"
+cmake -S . -B "$build" "${cfg[@]}" > "$build/configure.log" 2>&1 || { cat "$build/configure.log"; exit 1; }
 
 # Bad-input tests of the harness and sim suites (refused files, malformed datasets, CLI errors).
 bad_input='^(CliTest|EurocMalformedTest|EvalBadInputTest|KittiMalformedTest|RenderBadInputTest|ScenarioFileTest|VoConfigTest|YamlInputTest)\.'
