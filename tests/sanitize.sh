@@ -57,7 +57,7 @@ test -s "$scratch/run/metrics.json"
 echo "sanitize: vobench run l_hallway (30 frames) ok"
 
 if ((fuzz)); then
-  tests/fuzz/smoke.sh "$build" 8
+  tests/fuzz/smoke.sh "$build" 6
 else
   echo "sanitize: fuzz smoke skipped (needs clang++)"
 fi

@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 build="${1:?usage: tests/fuzz/smoke.sh BUILD_DIR [SECONDS]}"
-seconds="${2:-8}"
+seconds="${2:-6}"
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}"
