@@ -57,8 +57,11 @@ class StrictReader {
 
   void Double(const YAML::Node& map, const std::string& prefix, const std::string& key,
               double* out) {
+    // A scalar or sequence where a mapping belongs was refused by CheckKeys; operator[] on it
+    // would throw (YAML::BadSubscript), so stop here.
+    if (!ok() || !map.IsMap()) return;
     const YAML::Node n = map[key];
-    if (!n.IsDefined() || !ok()) return;
+    if (!n.IsDefined()) return;
     if (!n.IsScalar()) return Fail(n, Join(prefix, key), "expected a number");
     try {
       const double v = n.as<double>();
@@ -70,8 +73,11 @@ class StrictReader {
   }
 
   void Int(const YAML::Node& map, const std::string& prefix, const std::string& key, int* out) {
+    // A scalar or sequence where a mapping belongs was refused by CheckKeys; operator[] on it
+    // would throw (YAML::BadSubscript), so stop here.
+    if (!ok() || !map.IsMap()) return;
     const YAML::Node n = map[key];
-    if (!n.IsDefined() || !ok()) return;
+    if (!n.IsDefined()) return;
     try {
       if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
       *out = n.as<int>();
@@ -82,8 +88,11 @@ class StrictReader {
 
   void Uint64(const YAML::Node& map, const std::string& prefix, const std::string& key,
               uint64_t* out) {
+    // A scalar or sequence where a mapping belongs was refused by CheckKeys; operator[] on it
+    // would throw (YAML::BadSubscript), so stop here.
+    if (!ok() || !map.IsMap()) return;
     const YAML::Node n = map[key];
-    if (!n.IsDefined() || !ok()) return;
+    if (!n.IsDefined()) return;
     try {
       if (!n.IsScalar() || n.Scalar().empty() || n.Scalar()[0] == '-') throw YAML::Exception(n.Mark(), "");
       *out = n.as<uint64_t>();
@@ -94,8 +103,11 @@ class StrictReader {
 
   void String(const YAML::Node& map, const std::string& prefix, const std::string& key,
               std::string* out) {
+    // A scalar or sequence where a mapping belongs was refused by CheckKeys; operator[] on it
+    // would throw (YAML::BadSubscript), so stop here.
+    if (!ok() || !map.IsMap()) return;
     const YAML::Node n = map[key];
-    if (!n.IsDefined() || !ok()) return;
+    if (!n.IsDefined()) return;
     if (!n.IsScalar()) return Fail(n, Join(prefix, key), "expected a string");
     *out = n.Scalar();
   }
@@ -103,7 +115,7 @@ class StrictReader {
   // Range checks on already-read values; `node` gives the line.
   void Require(bool condition, const YAML::Node& map, const std::string& prefix,
                const std::string& key, const std::string& what) {
-    if (!condition && ok()) Fail(map[key].IsDefined() ? map[key] : map, Join(prefix, key), what);
+    if (!condition && ok()) Fail(map.IsMap() && map[key].IsDefined() ? map[key] : map, Join(prefix, key), what);
   }
 
  private:

@@ -108,6 +108,22 @@ TEST_F(ScenarioFileTest, WrongType) {
   EXPECT_NE(e2.find("'seed'"), std::string::npos) << e2;
 }
 
+// Found by fuzz_scenario: a section that is a scalar or a list instead of a mapping
+// ("robot:\n  speed_mps:lookahead 0.4" is the scalar "speed_mps:lookahead 0.4") threw
+// YAML::BadSubscript out of ParseScenario (std::terminate in vobench).
+TEST_F(ScenarioFileTest, SectionThatIsNotAMappingIsRefused) {
+  for (const char* section : {"robot", "camera", "noise", "textures"}) {
+    for (const char* value : {"\n  speed_mps:lookahead 0.4", " [1, 2]", " 3"}) {
+      SCOPED_TRACE(std::string(section) + ":" + value);
+      std::string e;
+      const std::string yaml = std::string("scene: scene.xml\npath: [[0, 0], [2, 0]]\n") + section + ":" + value + "\n";
+      EXPECT_NO_THROW(e = Load(yaml));
+      EXPECT_NE(e.find(std::string("'") + section + "'"), std::string::npos) << e;
+      EXPECT_NE(e.find("expected a mapping"), std::string::npos) << e;
+    }
+  }
+}
+
 TEST_F(ScenarioFileTest, NegativeBaseline) {
   const std::string e = Load(Replace("baseline_m: 0.12", "baseline_m: -0.09"));
   EXPECT_NE(e.find("'camera.baseline_m'"), std::string::npos) << e;

@@ -1,0 +1,14 @@
+// libFuzzer target: the scenario YAML reader (sim::ParseScenario).
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "sim/scenario.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  sim::Scenario scenario;
+  std::string error;
+  sim::ParseScenario(text, "fuzz.yaml", VOBENCH_SCENES_DIR, &scenario, &error);
+  return 0;
+}
