@@ -21,6 +21,14 @@ export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppress
 cfg=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1"
      -DVOBENCH_SANITIZE=address,undefined -DVOBENCH_BUILD_BENCHMARKS=OFF)
 fuzz=0
+# clang and its libFuzzer runtime (Debian 12: clang 14), installed when missing and we can.
+if ! command -v clang++ > /dev/null || ! dpkg-query -W -f='${Status}' libclang-rt-14-dev 2>/dev/null | grep -q "install ok installed"; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && command -v sudo > /dev/null && SUDO=sudo
+  if [ "$(id -u)" -eq 0 ] || [ -n "$SUDO" ]; then
+    $SUDO apt-get update -q && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q \
+      --no-install-recommends clang libclang-rt-14-dev || echo "sanitize: could not install clang"
+  fi
+fi
 if command -v clang++ > /dev/null; then
   cfg+=(-DCMAKE_CXX_COMPILER=clang++ -DVOBENCH_FUZZ=ON)
   fuzz=1
