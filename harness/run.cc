@@ -279,28 +279,29 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
          "translation_error_m,rotation_error_deg,motion_measured,reinitialised,prediction,"
          "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_disparities,"
          "disparity_pixels\n";
-  for (size_t i = 0; i < not_initialised.size(); ++i) {  // no pose, no error
-    const auto& r = not_initialised[i];
-    csv << i << "," << FormatDouble(r.time_s) << ",not_initialised," << r.num_features << ","
-        << r.num_features_with_depth << ",0,0,0.0000,0," << Fmt(r.times.disparity_ms, 3) << ","
-        << Fmt(r.times.detect_ms, 3) << "," << Fmt(r.times.depth_ms, 3) << ",0.000,0.000,0.000,"
-        << Fmt(r.times.total_ms, 3) << ",nan,nan,nan,nan,nan,nan,0,0,none,0,0.00,0.00,0.000,0.000,"
-        << r.num_disparities << "," << r.disparity_pixels << "\n";
-  }
-  for (size_t i = 0; i < results.size(); ++i) {
-    const auto& r = results[i];
-    const Eigen::Vector3d t = est[i].translation();
-    csv << i + first << "," << FormatDouble(times[i]) << "," << vo::ToString(r.status) << "," << r.num_features << ","
+  // One row per frame; frames before the first initialised one have no pose and no error.
+  const double kNan = std::nan("");
+  auto row = [&](size_t frame, double time_s, const std::string& status, const vo::OdometryResult& r,
+                 const Eigen::Vector3d& t, double dist_m, double te, double re) {
+    csv << frame << "," << FormatDouble(time_s) << "," << status << "," << r.num_features << ","
         << r.num_features_with_depth << "," << r.num_matches << "," << r.num_inliers << "," << Fmt(r.rms_reprojection_px)
         << "," << (r.ba_ran ? 1 : 0) << "," << Fmt(r.times.disparity_ms, 3) << "," << Fmt(r.times.detect_ms, 3) << ","
         << Fmt(r.times.depth_ms, 3) << "," << Fmt(r.times.match_ms, 3) << "," << Fmt(r.times.motion_ms, 3) << ","
         << Fmt(r.times.ba_ms, 3) << "," << Fmt(r.times.total_ms, 3) << "," << FormatDouble(t.x()) << ","
-        << FormatDouble(t.y()) << "," << FormatDouble(t.z()) << "," << Fmt(dist[i]) << ","
-        << Fmt(te_m[i], 6) << "," << Fmt(re_deg[i], 5) << "," << (r.motion_measured ? 1 : 0) << ","
+        << FormatDouble(t.y()) << "," << FormatDouble(t.z()) << "," << Fmt(dist_m) << ","
+        << Fmt(te, 6) << "," << Fmt(re, 5) << "," << (r.motion_measured ? 1 : 0) << ","
         << (r.reinitialised ? 1 : 0) << "," << vo::ToString(r.prediction) << "," << r.num_first_pass_inliers
         << "," << Fmt(r.image_shift_px.x(), 2) << "," << Fmt(r.image_shift_px.y(), 2) << ","
         << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << "," << r.num_disparities << ","
         << r.disparity_pixels << "\n";
+  };
+  for (size_t i = 0; i < not_initialised.size(); ++i) {
+    const vo::OdometryResult& r = not_initialised[i];
+    row(i, r.time_s, "not_initialised", r, Eigen::Vector3d::Constant(kNan), kNan, kNan, kNan);
+  }
+  for (size_t i = 0; i < results.size(); ++i) {
+    row(i + first, times[i], vo::ToString(results[i].status), results[i], est[i].translation(), dist[i],
+        te_m[i], re_deg[i]);
   }
   const std::string options_yaml = VoConfigToYaml(odometry->options());
   if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(times, est), error) ||

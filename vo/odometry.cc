@@ -80,10 +80,6 @@ OdometryOptions EffectiveOptions(const StereoCamera& camera, const OdometryOptio
   return effective;
 }
 
-}  // namespace
-
-namespace {
-
 // The back end's options from the pipeline's.
 SlidingWindowOptions WindowOptions(const OdometryOptions& o) {
   SlidingWindowOptions w;
@@ -234,16 +230,6 @@ const char* ToString(DisparityMode mode) {
       return "at_features";
   }
   return "unknown";
-}
-
-bool ParseDisparityMode(const std::string& name, DisparityMode* mode) {
-  for (DisparityMode m : {DisparityMode::kDense, DisparityMode::kAtFeatures}) {
-    if (name == ToString(m)) {
-      *mode = m;
-      return true;
-    }
-  }
-  return false;
 }
 
 const char* ToString(PredictionSource source) {

@@ -197,7 +197,6 @@ enum class DisparityMode {
 };
 // "dense", "at_features".
 const char* ToString(DisparityMode mode);
-bool ParseDisparityMode(const std::string& name, DisparityMode* mode);
 
 struct OdometryOptions {
   DetectorOptions detector = DefaultOdometryDetectorOptions();  // feature detection (left)
