@@ -10,18 +10,14 @@
 
 namespace harness {
 
-const char* const kCheckedMetrics[6] = {"end_pose_error_m", "end_rotation_error_deg",
-                                        "ate_rmse_m",       "rpe_trans_rmse_m",
-                                        "drift_pct",        "lost_frames"};
-
 namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
 bool IsCheckedMetric(const std::string& name) {
-  return std::find(std::begin(kCheckedMetrics), std::end(kCheckedMetrics), name) !=
-         std::end(kCheckedMetrics);
+  const MetricInfo* m = FindMetric(name);
+  return m != nullptr && m->check_tolerance >= 0;
 }
 
 // NaN is written as null (JSON has no NaN).
@@ -55,9 +51,8 @@ Baseline DefaultBaselineRule() {
       "keeps near-zero metrics (a few mm on a short path) from failing on sub-millimetre changes. "
       "Improvements never fail; re-record with `vobench check --update`.";
   b.relative_tolerance = 0.25;
-  b.absolute_tolerance = {{"end_pose_error_m", 0.01}, {"end_rotation_error_deg", 0.25},
-                          {"ate_rmse_m", 0.005},      {"rpe_trans_rmse_m", 0.0005},
-                          {"drift_pct", 0.25},        {"lost_frames", 2.0}};
+  for (const std::string& name : CheckedMetrics())
+    b.absolute_tolerance[name] = FindMetric(name)->check_tolerance;
   return b;
 }
 
@@ -155,7 +150,7 @@ std::string BaselineJson(const Baseline& b) {
   j["tolerance_rule"] = b.tolerance_rule;
   j["relative_tolerance"] = b.relative_tolerance;
   j["absolute_tolerance"] = json::object();
-  for (const char* m : kCheckedMetrics)
+  for (const std::string& m : CheckedMetrics())
     if (b.absolute_tolerance.count(m)) j["absolute_tolerance"][m] = b.absolute_tolerance.at(m);
   j["runs"] = json::object();
   for (const auto& run : b.runs) {
@@ -183,11 +178,12 @@ bool MakeBaseline(const SuiteResult& result, const Baseline& rule, Baseline* bas
     }
     BaselineRun run;
     run.id = row.run.id;
-    for (const char* name : kCheckedMetrics) {
+    for (const std::string& name : CheckedMetrics()) {
       BaselineMetric m;
       m.name = name;
-      const auto& v = row.metrics.contains(name) ? row.metrics[name] : nlohmann::json();
-      m.value = v.is_number() ? v.get<double>() : std::nan("");
+      m.lower_is_better = FindMetric(name)->better != Better::kHigher;
+      const auto* v = FindMetricValue(row.metrics, name);
+      m.value = v != nullptr && v->is_number() ? v->get<double>() : std::nan("");
       const double abs_tol =
           rule.absolute_tolerance.count(name) ? rule.absolute_tolerance.at(name) : 0.0;
       m.tolerance = std::isfinite(m.value)

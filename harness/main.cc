@@ -122,33 +122,21 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
   }
 
   // Simulate the scenario into memory: images, ground-truth depth and poses.
-  auto simulator = sim::Simulator::Create(scenario, &error);
-  if (!simulator) {
+  harness::StereoSequence sequence;
+  std::vector<harness::DatasetFrame> simulated;
+  if (!harness::OpenScenarioSequence(scenario, &sequence, &error) ||
+      !harness::ReadAllFrames(sequence.next, max_frames, sequence.expected_frames,
+                              "simulate " + scenario.name, !quiet, out, &simulated, &error)) {
     std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
     return 1;
   }
   std::vector<harness::GroundTruthFrame> frames;
-  {
-    harness::Progress progress("simulate " + scenario.name, simulator->EstimatedFrames(), !quiet);
-    sim::StereoFrame f;
-    while ((max_frames <= 0 || static_cast<int>(frames.size()) < max_frames) && simulator->Next(&f, &error)) {
-      frames.push_back({f.left, f.right, f.depth_m, f.T_world_cam0});
-      progress.Update(static_cast<int>(frames.size()));
-      if (harness::InterruptSignal() != 0) {
-        error = harness::InterruptedMessage(static_cast<int>(frames.size()),
-                                            simulator->EstimatedFrames(), "frames", out);
-        break;
-      }
-    }
-    if (!error.empty()) {
-      std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
-      return 1;
-    }
-    progress.Finish(static_cast<int>(frames.size()));
-  }
+  for (const harness::DatasetFrame& f : simulated)
+    frames.push_back({f.left, f.right, f.depth_m, f.T_world_cam0});
+  simulated.clear();
   std::vector<harness::MatchEvalRow> rows;
   harness::Progress progress("match-eval", 1, !quiet);
-  if (!harness::EvaluateMatchers(frames, harness::ToStereoCamera(simulator->calibration()), options, &rows, &error,
+  if (!harness::EvaluateMatchers(frames, sequence.camera, options, &rows, &error,
                                  [&](int done, int total) {
                                    progress.set_total(total);
                                    progress.Update(done);

@@ -27,6 +27,7 @@
 #include <thread>
 
 #include "harness/interrupt.h"
+#include "harness/metric_registry.h"
 #include "harness/overrides.h"
 #include "harness/path_names.h"
 #include "harness/progress.h"
@@ -35,8 +36,6 @@
 #include "sim/yaml_input.h"
 
 namespace harness {
-
-const char* const kSuiteTimingColumns[3] = {"vo_ms_median", "vo_ms_p95", "wall_s"};
 
 namespace {
 
@@ -759,8 +758,8 @@ std::string CsvCell(const json& v) {
 }
 
 double Number(const json& metrics, const std::string& key) {
-  if (!metrics.contains(key) || !metrics[key].is_number()) return std::nan("");
-  return metrics[key].get<double>();
+  const json* v = FindMetricValue(metrics, key);
+  return v != nullptr && v->is_number() ? v->get<double>() : std::nan("");
 }
 
 std::string Fixed(double v, int prec) {
@@ -825,8 +824,8 @@ std::string SummaryCsv(const std::vector<SuiteRow>& rows) {
       if (row.status != "ok") continue;
       if (cols[i] == "wall_s")
         csv << Fixed(row.wall_s, 1);
-      else if (row.metrics.contains(cols[i]))
-        csv << CsvCell(row.metrics[cols[i]]);
+      else if (const nlohmann::json* v = FindMetricValue(row.metrics, cols[i]))
+        csv << CsvCell(*v);
     }
     csv << "\n";
   }
@@ -947,7 +946,11 @@ std::string SummaryMarkdown(const std::string& name, const SuiteResult& result, 
 
 // harness/suite_plot.py SUMMARY_CSV PNG (Debian's python3 with matplotlib).
 bool RunSuitePlot(const std::string& csv, const std::string& png, std::string* error) {
-  return RunPythonScript("suite_plot.py", {csv, png}, error);
+  std::vector<std::string> args = {csv, png};
+  for (const char* key : {"end_pose_error_pct", "ate_rmse_m"}) {  // the two panels
+    args.insert(args.end(), {"--panel", key, PlotLabel(*FindMetric(key))});
+  }
+  return RunPythonScript("suite_plot.py", args, error);
 }
 
 bool WriteSummary(const fs::path& out, const std::string& name, const SuiteResult& result,
@@ -985,32 +988,26 @@ std::string SelfExecutable() {
 
 }  // namespace
 
+const std::vector<std::string>& SuiteTimingColumns() {
+  static const std::vector<std::string> kColumns = [] {
+    std::vector<std::string> c;
+    for (const MetricInfo& m : RunMetrics())
+      if (m.csv && m.group == MetricGroup::kTiming) c.push_back(m.key);
+    c.push_back("wall_s");
+    return c;
+  }();
+  return kColumns;
+}
+
 const std::vector<std::string>& SuiteSummaryColumns() {
-  static const std::vector<std::string> kColumns = {"id",
-                                                    "scenario",
-                                                    "config",
-                                                    "seed",
-                                                    "stride",
-                                                    "max_frames",
-                                                    "status",
-                                                    "frames",
-                                                    "path_length_m",
-                                                    "end_pose_error_m",
-                                                    "end_pose_error_pct",
-                                                    "end_rotation_error_deg",
-                                                    "ate_rmse_m",
-                                                    "ate_rmse_unaligned_m",
-                                                    "rpe_trans_rmse_m",
-                                                    "rpe_rot_rmse_deg",
-                                                    "drift_pct",
-                                                    "drift_deg_per_m",
-                                                    "lost_frames",
-                                                    "features_median",
-                                                    "inliers_median",
-                                                    "initial_orientation_error_deg",
-                                                    "vo_ms_median",
-                                                    "vo_ms_p95",
-                                                    "wall_s"};
+  static const std::vector<std::string> kColumns = [] {
+    std::vector<std::string> c = {"id",     "scenario",   "config", "seed",
+                                  "stride", "max_frames", "status"};
+    for (const MetricInfo& m : RunMetrics())
+      if (m.csv && m.group != MetricGroup::kTiming) c.push_back(m.key);
+    for (const std::string& t : SuiteTimingColumns()) c.push_back(t);
+    return c;
+  }();
   return kColumns;
 }
 

@@ -146,10 +146,12 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
 bool MergeSuiteShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir,
                       SuiteResult* result, std::string* error);
 
-// The summary's columns: axes and status, then metrics.json keys; timing columns
-// (kSuiteTimingColumns) are the last ones and are the only ones that vary between identical runs.
+// The summary's columns: axes and status, then the metric registry's metrics (csv ones, in
+// metrics.json order; dotted keys as they are); the timing columns (SuiteTimingColumns: the
+// registry's timing metrics and the run's wall_s) are the last ones and the only ones that
+// vary between identical runs.
 const std::vector<std::string>& SuiteSummaryColumns();
-extern const char* const kSuiteTimingColumns[3];  // vo_ms_median, vo_ms_p95, wall_s
+const std::vector<std::string>& SuiteTimingColumns();
 
 // The printed table (one line per run, then the per-configuration medians).
 std::string SuiteTableText(const SuiteResult& result);

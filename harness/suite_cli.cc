@@ -178,7 +178,7 @@ void RunCheckCommand(const CheckArgs& a) {
       Fail("check", kExitRunFailed, error);
     std::printf("%s", SuiteTableText(result).c_str());
     std::printf("\nwrote %s: %zu runs x %zu metrics (suite %s, %.1f s)\n", a.baseline.c_str(),
-                fresh.runs.size(), std::size(kCheckedMetrics), suite_path.c_str(), result.wall_s);
+                fresh.runs.size(), CheckedMetrics().size(), suite_path.c_str(), result.wall_s);
     return;
   }
   const CheckReport report = CompareToBaseline(baseline, result);

@@ -1,10 +1,11 @@
 #!/usr/bin/python3
 """Summary plot of a vobench suite (matplotlib, Agg backend, PNG).
 
-  suite_plot.py SUMMARY_CSV PNG
+  suite_plot.py SUMMARY_CSV PNG [--panel COLUMN LABEL]...
 
-Two panels: end-pose error (% of the path) and ATE RMSE (m) per run variant (scenario, seed,
-stride), one bar per VO configuration; failed or missing runs are marked with an x.
+One panel per --panel (a summary.csv column and its axis label, from vobench's metric
+registry; default: end-pose error (% of the path) and ATE RMSE (m)) per run variant (scenario,
+seed, stride), one bar per VO configuration; failed or missing runs are marked with an x.
 """
 import csv
 import math
@@ -25,9 +26,16 @@ def number(text):
 
 
 def main(argv):
-    if len(argv) != 3:
+    panels = []
+    rest = argv[3:]
+    while len(rest) >= 3 and rest[0] == "--panel":
+        panels.append((rest[1], rest[2]))
+        rest = rest[3:]
+    if len(argv) < 3 or rest:
         print(__doc__)
         return 2
+    if not panels:
+        panels = [("end_pose_error_pct", "end-pose error (% of path)"), ("ate_rmse_m", "ATE RMSE (m)")]
     with open(argv[1]) as f:
         rows = list(csv.DictReader(f))
     if not rows:
@@ -42,8 +50,9 @@ def main(argv):
         if v not in variants:
             variants.append(v)
     width = 0.8 / len(configs)
-    fig, axes = plt.subplots(2, 1, figsize=(max(7.0, 1.1 * len(variants) + 2), 7.5), sharex=True)
-    panels = (("end_pose_error_pct", "end-pose error (% of path)"), ("ate_rmse_m", "ATE RMSE (m)"))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(max(7.0, 1.1 * len(variants) + 2), 3.75 * len(panels)),
+                             sharex=True, squeeze=False)
+    axes = axes[:, 0]
     for ax, (key, label) in zip(axes, panels):
         top = 0.0
         for k, c in enumerate(configs):

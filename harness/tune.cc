@@ -16,8 +16,10 @@
 #include <sstream>
 
 #include "harness/interrupt.h"
+#include "harness/metric_registry.h"
 #include "harness/overrides.h"
 #include "harness/path_names.h"
+#include "harness/pipeline.h"
 #include "harness/progress.h"
 #include "harness/render.h"
 #include "harness/trajectory_io.h"
@@ -317,13 +319,10 @@ bool ReadObjective(Reader& r, const YAML::Node& root, TuneObjective* objective) 
   if (!r.Keys(n, "objective", {"metric", "lost_frame_penalty", "aggregate"})) return false;
   if (n["metric"].IsDefined()) {
     if (!r.String(n["metric"], "objective.metric", &objective->metric)) return false;
-    double unused;
-    if (!MetricByName(TrajectoryMetrics(), objective->metric, &unused))
+    const MetricInfo* metric = FindMetric(objective->metric);
+    if (metric == nullptr || !metric->tune_objective)
       return r.Fail(n["metric"], "objective.metric: unknown metric '" + objective->metric +
-                                     "' (expected ate_rmse_m, ate_rmse_unaligned_m, "
-                                     "end_pose_error_m, end_pose_error_pct, "
-                                     "end_rotation_error_deg, rpe_trans_rmse_m, rpe_rot_rmse_deg, "
-                                     "drift_pct or drift_deg_per_m)");
+                                     "' (expected " + ListOfNames(TuneObjectiveMetrics()) + ")");
   }
   if (n["lost_frame_penalty"].IsDefined()) {
     if (!r.Double(n["lost_frame_penalty"], "objective.lost_frame_penalty",
@@ -658,62 +657,28 @@ bool ApplyParameters(const TuneSpec& spec, const std::vector<double>& values,
 
 bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSequence* sequence,
                           std::string* error) {
-  std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario.scenario, error);
-  if (!simulator) {
+  StereoSequence simulated;
+  if (!OpenScenarioSequence(scenario.scenario, &simulated, error)) {
     *error = scenario.name + ": " + *error;
     return false;
   }
   sequence->name = scenario.name;
-  sequence->camera = ToStereoCamera(simulator->calibration());
-  sequence->frames.clear();
-  const int expected = scenario.max_frames > 0
-                           ? std::min(scenario.max_frames, simulator->EstimatedFrames())
-                           : simulator->EstimatedFrames();
-  Progress bar("simulate " + scenario.name, expected, progress);
-  sim::StereoFrame f;
-  while ((scenario.max_frames <= 0 ||
-          static_cast<int>(sequence->frames.size()) < scenario.max_frames) &&
-         simulator->Next(&f, error)) {
-    DatasetFrame d = ToDatasetFrame(f);
-    d.depth_m = cv::Mat();  // not needed: the score uses the poses only
-    sequence->frames.push_back(d);
-    bar.Update(static_cast<int>(sequence->frames.size()));
-    if (InterruptSignal() != 0) {  // RunTune words the message
-      *error = "interrupted";
-      break;
-    }
-  }
-  if (!error->empty()) {
-    *error = scenario.name + ": " + *error;
+  sequence->camera = simulated.camera;
+  const FrameSource without_depth = [&](DatasetFrame* frame, std::string* err) {
+    if (!simulated.next(frame, err)) return false;
+    frame->depth_m = cv::Mat();  // not needed: the score uses the poses only
+    return true;
+  };
+  if (!ReadAllFrames(without_depth, scenario.max_frames, simulated.expected_frames,
+                     "simulate " + scenario.name, progress, "", &sequence->frames, error)) {
+    *error = scenario.name + ": " + *error;  // RunTune words the message of an interrupt
     return false;
   }
-  bar.Finish(static_cast<int>(sequence->frames.size()));
   if (sequence->frames.size() < 2) {
     *error = scenario.name + ": the simulation gave fewer than 2 frames";
     return false;
   }
   return true;
-}
-
-bool MetricByName(const TrajectoryMetrics& m, const std::string& name, double* value) {
-  const std::pair<const char*, double> table[] = {
-      {"ate_rmse_m", m.ate_rmse_m},
-      {"ate_rmse_unaligned_m", m.ate_rmse_unaligned_m},
-      {"end_pose_error_m", m.end_pose_error_m},
-      {"end_pose_error_pct", m.end_pose_error_pct},
-      {"end_rotation_error_deg", m.end_rotation_error_deg},
-      {"rpe_trans_rmse_m", m.rpe_trans_rmse_m},
-      {"rpe_rot_rmse_deg", m.rpe_rot_rmse_deg},
-      {"drift_pct", m.drift_pct},
-      {"drift_deg_per_m", m.drift_deg_per_m},
-  };
-  for (const auto& [key, v] : table) {
-    if (name == key) {
-      *value = v;
-      return true;
-    }
-  }
-  return false;
 }
 
 // Score of a sequence the VO never initialised on.
@@ -731,30 +696,31 @@ bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& opti
     *error = sequence.name + ": fewer than 2 frames";
     return false;
   }
-  std::vector<Eigen::Isometry3d> est, gt;
-  SequenceScore s;
-  for (const DatasetFrame& f : sequence.frames) {
-    if (InterruptSignal() != 0) {  // RunTune words the message
-      *error = sequence.name + ": interrupted";
-      return false;
-    }
-    const vo::OdometryResult r = odometry->Process(f.left, f.right, f.time_s);
-    if (vo::IsLostFrame(r)) ++s.lost_frames;
-    // Frames before the first one the VO initialised on have no pose (as in `run`): they are
-    // penalised as lost frames and left out of the trajectory, anchored at that first frame.
-    if (est.empty() && r.status == vo::TrackingStatus::kLost) continue;
-    est.push_back(r.T_world_cam0);
-    gt.push_back(f.T_world_cam0);
+  // The run pipeline without the folder: no progress, no match statistics.
+  RunFramesOptions run_options;
+  run_options.progress = false;
+  run_options.match_stats = false;
+  RunRecords records;
+  if (!RunFrames(sequence.name, FramesInMemory(sequence.frames), *odometry, run_options, &records,
+                 &why)) {
+    *error = sequence.name + ": " + why;  // RunTune words the message of an interrupt
+    return false;
   }
-  if (est.size() < 2) {  // never (or only at the last frame) initialised: the worst score
+  SequenceScore s;
+  // Frames before the first one the VO initialised on have no pose (as in `run`): they are
+  // penalised as lost frames and left out of the trajectory, anchored at that first frame.
+  for (const FrameRecord& f : records.frames) s.lost_frames += vo::IsLostFrame(f.result) ? 1 : 0;
+  if (records.frames.size() - FirstInitialisedFrame(records) < 2) {
+    // never (or only at the last frame) initialised: the worst score
     s.metric = kUnusableScore;
     s.score = kUnusableScore;
     *score = s;
     return true;
   }
-  s.metrics = ComputeTrajectoryMetrics(est, gt);
-  s.metrics.frames = static_cast<int>(est.size());
-  if (!MetricByName(s.metrics, objective.metric, &s.metric)) {
+  RunSummary summary;
+  if (!Summarize(records, &summary, error)) return false;
+  s.metrics = summary.metrics;
+  if (!ObjectiveValue(summary, objective.metric, &s.metric)) {
     *error = "unknown metric '" + objective.metric + "'";
     return false;
   }

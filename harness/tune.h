@@ -128,8 +128,6 @@ struct SequenceScore {
   double score = 0.0;         // metric + lost_frame_penalty × lost_frames
 };
 
-// Value of a metric by name; false for an unknown name.
-bool MetricByName(const TrajectoryMetrics& metrics, const std::string& name, double* value);
 // Runs the VO over the sequence and scores it.
 bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& options,
                    const TuneObjective& objective, SequenceScore* score, std::string* error);

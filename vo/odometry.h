@@ -385,6 +385,17 @@ inline bool IsLostFrame(const OdometryResult& r) {
   return !r.motion_measured && r.status != TrackingStatus::kInitializing;
 }
 
+// What one StereoOdometry call matched, beside its OdometryResult: the frame's features (with
+// depth, track ids set when tracked), the reference frame's features, the matches between
+// them (prev = index into reference_features, curr = index into features) and per match
+// whether it is a RANSAC inlier. Empty for a frame that matched nothing (first, lost).
+struct FrameDiagnostics {
+  const std::vector<Feature>& features;
+  const std::vector<Feature>& reference_features;
+  const std::vector<Match>& matches;
+  const std::vector<bool>& inlier_mask;
+};
+
 class StereoOdometry {
  public:
   // Aborts with a message when the camera or the options are invalid (a programmer error);
@@ -416,13 +427,11 @@ class StereoOdometry {
   OdometryResult ProcessFeatures(std::vector<Feature> features,
                                  const std::vector<Match>& matches_to_prev, double time_s);
 
-  // The last call's features (with depth, track ids set when tracked), its matches to the
-  // reference frame (prev = index into last_reference_features()), and per match whether it
-  // is a RANSAC inlier. For matcher evaluation by the harness.
-  const std::vector<Feature>& last_features() const { return last_features_; }
-  const std::vector<Match>& last_matches() const { return last_matches_; }
-  const std::vector<bool>& last_inlier_mask() const { return last_inlier_mask_; }
-  const std::vector<Feature>& last_reference_features() const { return last_reference_features_; }
+  // What the last Process/ProcessFeatures call matched (for matcher evaluation by a harness);
+  // views into the VO, valid until the next call.
+  FrameDiagnostics last_diagnostics() const {
+    return {last_features_, last_reference_features_, last_matches_, last_inlier_mask_};
+  }
 
   // R_hall_cam0 of the first frame from the plane orientation (identity when not estimated or
   // failed; see OdometryResult::initial_orientation_ok).

@@ -110,7 +110,7 @@ TEST(CheckBaselineTest, TolerancesFollowTheRuleAndTheFileRoundTrips) {
   std::string error;
   ASSERT_TRUE(harness::MakeBaseline(result, rule, &b, &error)) << error;
   ASSERT_EQ(b.runs.size(), 2u);
-  ASSERT_EQ(b.runs[0].metrics.size(), std::size(harness::kCheckedMetrics));
+  ASSERT_EQ(b.runs[0].metrics.size(), harness::CheckedMetrics().size());
   auto tol = [&](int run, const std::string& metric) {
     for (const auto& m : b.runs[run].metrics)
       if (m.name == metric) return m.tolerance;

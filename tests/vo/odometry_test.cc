@@ -163,7 +163,7 @@ TEST_P(OdometrySeamTest, ExactMatchesReproduceTheTrajectory) {
                              kSeamTolRad, kSeamTolM));
       EXPECT_EQ(r.ba_ran, GetParam().use_ba);
       EXPECT_EQ(r.num_matches, static_cast<int>(matches.size()));
-      EXPECT_EQ(vo->last_inlier_mask().size(), matches.size());
+      EXPECT_EQ(vo->last_diagnostics().inlier_mask.size(), matches.size());
       if (GetParam().outlier_every == 0) {
         EXPECT_EQ(r.num_inliers, r.num_matches);
       } else {
@@ -208,7 +208,7 @@ TEST(OdometrySeamTest, FeaturesWithoutDepthAreDroppedAndMatchesReindexed) {
   EXPECT_THAT(r1.T_world_cam0, IsNearPose(SeamPose(1), kSeamTolRad, kSeamTolM));
   // Track ids are written into the last features; tracked ones continue frame 0's tracks.
   int tracked = 0;
-  for (const Feature& f : vo.last_features()) tracked += f.track_age == 1;
+  for (const Feature& f : vo.last_diagnostics().features) tracked += f.track_age == 1;
   EXPECT_EQ(tracked, r1.num_inliers);
 }
 

@@ -1,0 +1,117 @@
+// The run pipeline: the one path from stereo frames to numbers that every command running the
+// VO takes (`run`, `eval` and `tune` directly; `suite` and `check` through `run` child
+// processes; `match-eval` reads its frames through the same sequences).
+//
+//   StereoSequence ──RunFrames──▶ RunRecords ──Summarize──▶ RunSummary ──WriteRunFolder──▶ files
+//   (frames, camera,   (the VO,      (per frame:    (no I/O)     (metrics,     (run_folder.h:
+//    ground truth)      no I/O)       result, GT)                 medians)      ownership, plots)
+//
+// RunFrames and Summarize do no I/O and are unit-tested on their own; the run folder's files
+// are written in one place (run_folder.h).
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "harness/dataset.h"
+#include "harness/match_eval.h"
+#include "harness/metrics.h"
+#include "sim/scenario.h"
+#include "vo/odometry.h"
+
+namespace harness {
+
+// A source of stereo frames: fills *frame, returns false at the end (error empty) or on error.
+using FrameSource = std::function<bool(DatasetFrame* frame, std::string* error)>;
+
+// A stereo sequence to run the VO on: its frames, camera and what the run folder records of it.
+struct StereoSequence {
+  std::string name;           // run name (scenario name or dataset folder name)
+  vo::StereoCamera camera;    // rectified stereo camera of the frames
+  FrameSource next;           // the frames in order (with ground truth where known)
+  int expected_frames = 0;    // frames the source will give (for progress; 0 = unknown)
+  std::string scenario_yaml;  // effective scenario (simulated sequences; "" otherwise)
+  std::string outline;        // hallway outline for the trajectory plot ("" = none)
+};
+
+// A simulated scenario as a sequence (the simulator lives as long as the sequence's source).
+bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
+                          std::string* error);
+
+// Frames of `source` into memory (up to max_frames, 0 = all), with a progress display named
+// `label` and the interrupt check of every long loop (the message names `out`).
+bool ReadAllFrames(const FrameSource& source, int max_frames, int expected_frames,
+                   const std::string& label, bool progress, const std::string& out,
+                   std::vector<DatasetFrame>* frames, std::string* error);
+
+// A source over frames in memory (they must outlive it).
+FrameSource FramesInMemory(const std::vector<DatasetFrame>& frames);
+
+// One frame the VO saw.
+struct FrameRecord {
+  int64_t source_index = 0;  // position in the source (0, k, 2k, ... with frame stride k)
+  double time_s = 0.0;       // time stamp (s)
+  vo::OdometryResult result;
+  bool has_gt = false;                                                // ground truth known
+  Eigen::Isometry3d T_world_cam0_gt = Eigen::Isometry3d::Identity();  // when has_gt
+};
+
+// What RunFrames records of a run.
+struct RunRecords {
+  std::string name;
+  int frame_stride = 1;
+  std::vector<FrameRecord> frames;  // every frame the VO saw, in order
+  VoMatchStats match_stats;  // the VO's matches against the ground truth (frames with depth);
+                             // matches == 0 when not available or not asked for
+};
+
+struct RunFramesOptions {
+  int max_frames = 0;       // stop after this many frames of the source (0 = all)
+  int frame_stride = 1;     // the VO sees every k-th source frame (0, k, 2k, ...), >= 1
+  int expected_frames = 0;  // frames of the source (for progress; 0 = unknown)
+  bool progress = true;     // progress display on stderr ("vo <name>")
+  bool match_stats = true;  // check the VO's matches against the ground-truth depth and poses
+  std::string out_dir;      // named in the message of an interrupted run
+};
+
+// Runs `odometry` over `source` (SIGINT/SIGTERM stop it with InterruptedMessage). No I/O other
+// than the progress display.
+bool RunFrames(const std::string& name, const FrameSource& source, vo::StereoOdometry& odometry,
+               const RunFramesOptions& options, RunRecords* records, std::string* error);
+
+// The frames before the first one the VO initialised on (black, over-exposed, textureless
+// starts): they have no pose and are left out of trajectories and metrics. == frames.size()
+// when the VO never initialised.
+size_t FirstInitialisedFrame(const RunRecords& records);
+
+struct RunSummary {
+  std::string name;
+  TrajectoryMetrics metrics;
+  int lost_frames = 0;        // frames without a measured motion (vo::IsLostFrame)
+  int reinitialisations = 0;  // of those, frames the VO re-initialised on
+  int frames_not_initialised = 0;  // frames before the first one the VO initialised on: no
+                                   // pose, not in the trajectories, metrics or lost_frames
+  double vo_ms_median = 0.0;
+  double vo_ms_p95 = 0.0;
+  std::map<std::string, double> stage_ms_median;  // disparity, detect, depth, match, motion, ba
+  double features_median = 0.0;
+  double inliers_median = 0.0;
+  bool initial_orientation_ok = false;
+  double initial_orientation_error_deg = -1.0;  // vs ground truth; < 0 when not known
+  bool has_ground_truth = false;  // at least 2 frames with ground truth: the metrics are set
+  int ground_truth_frames = 0;    // frames with a ground-truth pose; the metrics use these only
+  VoMatchStats match_stats;  // the VO's matches against the ground truth (simulated runs and
+                             // datasets with depth); matches == 0 when not available
+  int frame_stride = 1;  // RunFramesOptions::frame_stride of the run
+};
+
+// The summary of a run: trajectory metrics over the frames with ground truth from the first
+// initialised frame on (at least 2, otherwise has_ground_truth is false and the metrics are
+// left out), counts and medians. Fails when the VO never initialised or fewer than 2 frames
+// remain. No I/O.
+bool Summarize(const RunRecords& records, RunSummary* summary, std::string* error);
+
+}  // namespace harness

@@ -1,0 +1,53 @@
+// The run folder: the files of one VO run, written in one place for `run` and `eval` (and so
+// for `suite` and `check`, whose runs are `run` child processes).
+//
+//   trajectory_tum.txt / trajectory_kitti.txt   the estimate T_world_cam0 in the VO's world
+//   estimate_in_gt_world_tum.txt                the estimate anchored at the first ground-truth
+//                                               pose (same frame as groundtruth_tum.txt)
+//   groundtruth_tum.txt / groundtruth_kitti.txt  ground truth T_world_cam0 (simulator world)
+//   per_frame.csv      status, counts, per-stage ms, errors per frame
+//   metrics.json       summary (frames, path_length_m, end_pose_error_m, end_pose_error_pct,
+//                      ate_rmse_m, lost_frames, vo_ms_median, vo_ms_p95, ...)
+//   vo_options.yaml    effective VO options (accepted by --config)
+//   scenario.yaml      effective scenario (simulated runs)
+//   trajectory.png, errors.png, timing.png, report.md
+//
+// The folder is written as DIR.partial and moved into place only when complete
+// (PartialFolder), so a half-written folder never looks finished.
+#pragma once
+
+#include <string>
+
+#include "harness/metric_registry.h"  // MetricsJson
+#include "harness/pipeline.h"
+#include "harness/trajectory_io.h"
+
+namespace harness {
+
+// What the run folder records besides the frames and the summary.
+struct RunFolderContents {
+  std::string options_yaml;   // effective VO options (vo_options.yaml)
+  std::string scenario_yaml;  // effective scenario (scenario.yaml; "" = none)
+  bool plots = true;          // PNG plots (python3-matplotlib)
+  std::string outline;        // hallway outline name for the trajectory plot ("" = none)
+};
+
+// Opens DIR for writing (as DIR.partial): refused when DIR exists and is not a run folder.
+// Call before the frames run, so a refused folder fails fast.
+bool OpenRunFolder(const std::string& dir, PartialFolder* folder, std::string* error);
+
+// Writes every file of the run into `folder` (opened by OpenRunFolder), makes the plots and
+// publishes it as DIR. Nothing is published on an error or an interrupt.
+bool WriteRunFolder(const RunRecords& records, const RunSummary& summary,
+                    const RunFolderContents& contents, const std::string& dir,
+                    PartialFolder* folder, std::string* error);
+
+// The plots of a written run folder (trajectory.png and errors.png with ground truth,
+// timing.png); a missing python3-matplotlib gives a warning on stderr, not an error.
+void MakePlots(const std::string& folder, bool has_ground_truth, const std::string& outline);
+
+// The per-frame log (per_frame.csv): one row per frame, frames before the first initialised
+// one marked not_initialised (no pose, no error).
+std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary);
+
+}  // namespace harness

@@ -1,0 +1,185 @@
+// The run pipeline's steps on their own: RunFrames (frame stride, max frames, records),
+// Summarize on crafted records with exact answers (counts, medians, metrics, the bad start)
+// and the per-frame log of the run folder.
+#include "harness/pipeline.h"
+
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "harness/run_folder.h"
+
+namespace {
+
+using harness::FrameRecord;
+using harness::RunRecords;
+using harness::RunSummary;
+
+vo::StereoCamera SmallCamera() {
+  vo::StereoCamera c;
+  c.width = 64;
+  c.height = 48;
+  c.fx_px = c.fy_px = 50.0;
+  c.cx_px = 32.0;
+  c.cy_px = 24.0;
+  c.baseline_m = 0.1;
+  return c;
+}
+
+// `n` black frames 0.1 s apart with ground truth moving 0.1 m along z per frame.
+harness::FrameSource BlackFrames(int n, int* given) {
+  return [n, given](harness::DatasetFrame* f, std::string*) {
+    if (*given >= n) return false;
+    f->time_s = 0.1 * *given;
+    f->left = cv::Mat::zeros(48, 64, CV_8UC1);
+    f->right = cv::Mat::zeros(48, 64, CV_8UC1);
+    f->has_gt = true;
+    f->T_world_cam0 = Eigen::Isometry3d::Identity();
+    f->T_world_cam0.translation() = Eigen::Vector3d(0, 0, 0.1 * *given);
+    ++*given;
+    return true;
+  };
+}
+
+TEST(PipelineTest, RunFramesTakesEveryKthFrameUpToMaxFrames) {
+  vo::StereoOdometry odometry(SmallCamera(), vo::OdometryOptions());
+  int given = 0;
+  harness::RunFramesOptions options;
+  options.progress = false;
+  options.frame_stride = 3;
+  options.max_frames = 8;  // source frames 0..7: the VO sees 0, 3, 6
+  RunRecords records;
+  std::string error;
+  ASSERT_TRUE(harness::RunFrames("black", BlackFrames(20, &given), odometry, options, &records,
+                                 &error))
+      << error;
+  ASSERT_EQ(records.frames.size(), 3u);
+  EXPECT_EQ(given, 8);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(records.frames[i].source_index, static_cast<int64_t>(3 * i));
+    EXPECT_DOUBLE_EQ(records.frames[i].time_s, 0.3 * i);
+    EXPECT_TRUE(records.frames[i].has_gt);
+    EXPECT_DOUBLE_EQ(records.frames[i].T_world_cam0_gt.translation().z(), 0.3 * i);
+    EXPECT_EQ(records.frames[i].result.status, vo::TrackingStatus::kLost);  // black: no features
+  }
+  EXPECT_EQ(records.frame_stride, 3);
+  // A VO that never initialised has no summary, and the message says so.
+  RunSummary summary;
+  EXPECT_FALSE(harness::Summarize(records, &summary, &error));
+  EXPECT_NE(error.find("black: the VO never initialised on any of the 3 frames"), std::string::npos)
+      << error;
+}
+
+TEST(PipelineTest, RunFramesRefusesAStrideBelowOne) {
+  vo::StereoOdometry odometry(SmallCamera(), vo::OdometryOptions());
+  int given = 0;
+  harness::RunFramesOptions options;
+  options.frame_stride = 0;
+  RunRecords records;
+  std::string error;
+  EXPECT_FALSE(harness::RunFrames("x", BlackFrames(3, &given), odometry, options, &records, &error));
+  EXPECT_EQ(error, "frame stride must be >= 1, got 0");
+}
+
+// Records of a crafted run: 2 frames before the VO initialised, then 6 frames whose estimate
+// equals the ground truth (1 m steps along x, 1 s apart), one of them lost and re-initialised.
+RunRecords CraftedRecords() {
+  RunRecords r;
+  r.name = "crafted";
+  for (int i = 0; i < 8; ++i) {
+    FrameRecord f;
+    f.source_index = i;
+    f.time_s = i;
+    f.has_gt = true;
+    f.T_world_cam0_gt.translation() = Eigen::Vector3d(i, 0, 0);
+    vo::OdometryResult& res = f.result;
+    res.time_s = i;
+    res.T_world_cam0 = f.T_world_cam0_gt;
+    res.times.total_ms = 10.0 * i;  // medians over frames 3..7 (the first initialised excluded)
+    res.times.detect_ms = i;
+    res.num_features_with_depth = 100 + i;
+    res.num_inliers = 50 + i;
+    if (i < 2) {
+      res.status = vo::TrackingStatus::kLost;
+    } else if (i == 2) {
+      res.status = vo::TrackingStatus::kInitializing;
+    } else if (i == 5) {
+      res.status = vo::TrackingStatus::kRecovered;
+      res.reinitialised = true;
+    } else {
+      res.status = vo::TrackingStatus::kTracking;
+      res.motion_measured = true;
+    }
+    r.frames.push_back(f);
+  }
+  return r;
+}
+
+TEST(PipelineTest, SummarizeCountsAndMediansOfACraftedRunAreExact) {
+  const RunRecords records = CraftedRecords();
+  EXPECT_EQ(harness::FirstInitialisedFrame(records), 2u);
+  RunSummary s;
+  std::string error;
+  ASSERT_TRUE(harness::Summarize(records, &s, &error)) << error;
+  EXPECT_EQ(s.name, "crafted");
+  EXPECT_EQ(s.frames_not_initialised, 2);
+  EXPECT_EQ(s.metrics.frames, 6);
+  EXPECT_EQ(s.lost_frames, 1);  // frame 5: no measured motion
+  EXPECT_EQ(s.reinitialisations, 1);
+  EXPECT_TRUE(s.has_ground_truth);
+  EXPECT_EQ(s.ground_truth_frames, 6);
+  EXPECT_DOUBLE_EQ(s.metrics.path_length_m, 5.0);
+  EXPECT_NEAR(s.metrics.end_pose_error_m, 0.0, 1e-12);
+  EXPECT_NEAR(s.metrics.ate_rmse_m, 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(s.vo_ms_median, 50.0);         // 30, 40, 50, 60, 70
+  EXPECT_DOUBLE_EQ(s.stage_ms_median.at("detect"), 5.0);
+  EXPECT_DOUBLE_EQ(s.features_median, 104.0);  // 102..107, first included; nearest rank
+  EXPECT_DOUBLE_EQ(s.inliers_median, 55.0);       // 53..57
+}
+
+TEST(PipelineTest, SummarizeUsesOnlyTheFramesWithGroundTruth) {
+  RunRecords records = CraftedRecords();
+  records.frames[7].has_gt = false;
+  records.frames[7].result.T_world_cam0.translation().x() += 3.0;  // not compared
+  RunSummary s;
+  std::string error;
+  ASSERT_TRUE(harness::Summarize(records, &s, &error)) << error;
+  EXPECT_EQ(s.ground_truth_frames, 5);
+  EXPECT_DOUBLE_EQ(s.metrics.path_length_m, 4.0);
+  EXPECT_NEAR(s.metrics.end_pose_error_m, 0.0, 1e-12);
+  records.frames.resize(4);  // 2 not initialised + 2
+  for (auto& f : records.frames) f.has_gt = false;
+  ASSERT_TRUE(harness::Summarize(records, &s, &error)) << error;
+  EXPECT_FALSE(s.has_ground_truth);
+  records.frames.resize(3);  // 1 frame after the bad start
+  EXPECT_FALSE(harness::Summarize(records, &s, &error));
+  EXPECT_EQ(error, "crafted: fewer than 2 frames after the first 2 (not initialised)");
+}
+
+TEST(PipelineTest, PerFrameCsvMarksTheFramesBeforeTheFirstInitialisedOne) {
+  const RunRecords records = CraftedRecords();
+  RunSummary s;
+  std::string error;
+  ASSERT_TRUE(harness::Summarize(records, &s, &error)) << error;
+  std::istringstream csv(harness::PerFrameCsv(records, s));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("frame,time_s,status,", 0), 0u);
+  std::vector<std::string> statuses;
+  while (std::getline(csv, line)) {
+    std::stringstream fields(line);
+    std::string frame, time, status;
+    std::getline(fields, frame, ',');
+    std::getline(fields, time, ',');
+    std::getline(fields, status, ',');
+    EXPECT_EQ(frame, std::to_string(statuses.size()));
+    statuses.push_back(status);
+  }
+  ASSERT_EQ(statuses.size(), 8u);
+  EXPECT_EQ(statuses[0], "not_initialised");
+  EXPECT_EQ(statuses[1], "not_initialised");
+  EXPECT_EQ(statuses[2], vo::ToString(vo::TrackingStatus::kInitializing));
+  EXPECT_EQ(statuses[5], vo::ToString(vo::TrackingStatus::kRecovered));
+}
+
+}  // namespace
