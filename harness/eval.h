@@ -59,6 +59,12 @@ struct EvalInfo {
 // Opens `dir` in `options.format`, runs the VO over its frames (run_options.max_frames caps
 // them) and writes the run folder run_options.out_dir (RunOdometry). The run's name is the
 // dataset folder's name. Errors name the file and the problem; nothing is left at out_dir then.
+// The dataset folder `dir` in `options.format` as a sequence (frames rectified where the layout
+// needs it, ground truth associated), and what `eval` reports of it. One opener per layout;
+// every caller (eval, run --dataset) goes through this one.
+bool OpenDataset(const std::string& dir, const EvalOptions& options, StereoSequence* sequence,
+                 EvalInfo* info, std::string* error);
+
 bool EvalDataset(const std::string& dir, const EvalOptions& options,
                  const vo::OdometryOptions& vo_options, const RunOptions& run_options,
                  RunSummary* summary, EvalInfo* info, std::string* error);

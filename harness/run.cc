@@ -1,12 +1,9 @@
 #include "harness/run.h"
 
-#include <filesystem>
-
+#include "harness/eval.h"
 #include "harness/vo_config.h"
 
 namespace harness {
-
-namespace fs = std::filesystem;
 
 bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameSource source,
                  int expected_frames, const vo::OdometryOptions& vo_options, const RunOptions& options,
@@ -57,15 +54,11 @@ bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_op
 
 bool RunKittiDataset(const std::string& dir, const vo::OdometryOptions& vo_options, const RunOptions& options,
                      RunSummary* summary, std::string* error) {
-  KittiReader reader;
-  if (!reader.Open(dir, error)) return false;
-  size_t next = 0;
-  FrameSource source = [&](DatasetFrame* frame, std::string* err) {
-    if (next >= reader.size()) return false;
-    return reader.ReadFrame(next++, frame, err);
-  };
-  return RunOdometry(fs::path(dir).filename().string(), reader.camera(), source, static_cast<int>(reader.size()),
-                     vo_options, options, "", summary, error);
+  EvalOptions kitti;  // the KITTI layout with its own poses.txt, if any
+  EvalInfo info;
+  StereoSequence sequence;
+  return OpenDataset(dir, kitti, &sequence, &info, error) &&
+         RunSequence(sequence, vo_options, options, summary, error);
 }
 
 }  // namespace harness
