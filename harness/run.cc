@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/interrupt.h"
+#include "harness/output_folder.h"
 #include "harness/plots.h"
 #include "harness/progress.h"
 #include "harness/render.h"
@@ -124,12 +125,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     return false;
   }
   const fs::path dir = options.out_dir;
-  if (fs::exists(dir) && !fs::exists(dir / "metrics.json")) {
-    *error = dir.string() + ": exists and is not a vobench run folder (no metrics.json); choose another --out";
-    return false;
-  }
-  PartialFolder folder;  // the run folder is written as DIR.partial and moved into place
-  if (!folder.Create(dir.string(), error)) return false;
+  OutputFolder folder;  // written as a marked DIR.partial-<pid>-<random>, moved into place
+  if (!folder.Create(dir.string(), "run", error)) return false;
 
   std::vector<double> times;
   std::vector<Eigen::Isometry3d> est, gt;
@@ -339,7 +336,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
                                 "frames", options.out_dir);
     return false;
   }
-  return folder.Publish("metrics.json", "run", error);
+  return folder.Publish(error);
 }
 
 bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_options,
