@@ -261,6 +261,7 @@ bool AdoptFolder(const std::string& dir_arg, const std::string& kind, std::strin
   const std::string dir = NormalizeDir(dir_arg);
   if (dir.empty()) return Fail(error, "empty output folder name");
   std::error_code ec;
+  RemoveStaleWorkFolders(dir);  // of callers killed between creating and renaming
   for (int attempt = 0; attempt < kLockAttempts; ++attempt) {
     if (!CheckReplaceable(dir, kind, error)) return false;
     if (HasFolderMarker(dir, kind)) return true;
