@@ -148,8 +148,8 @@ bool WriteFolderMarker(const std::string& dir, const std::string& kind, std::str
   j["pid"] = static_cast<long>(::getpid());
   j["host"] = HostName();
   const fs::path path = fs::path(dir) / kFolderMarkerFile;
-  const fs::path tmp = fs::path(dir) / (std::string(kFolderMarkerFile) + ".tmp-" +
-                                        std::to_string(::getpid()));
+  const fs::path tmp =
+      fs::path(dir) / (std::string(kFolderMarkerFile) + ".tmp-" + std::to_string(::getpid()));
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     out << j.dump(2) << "\n";
@@ -303,7 +303,8 @@ bool FolderLock::Acquire(const std::string& lock_path, const std::string& what,
       for (ssize_t i = 0; i < n && buf[i] >= '0' && buf[i] <= '9'; ++i) holder += buf[i];
       ::close(fd);
       if (flock_errno == EWOULDBLOCK)
-        return Fail(error, what + ": another vobench (pid " + (holder.empty() ? "unknown" : holder) +
+        return Fail(error, what + ": another vobench (pid " +
+                               (holder.empty() ? "unknown" : holder) +
                                ") is writing this folder; wait for it to end or choose another "
                                "--out");
       return Fail(error, lock_path + ": cannot lock: " + std::strerror(flock_errno));

@@ -6,6 +6,8 @@
 #include "harness/output_folder.h"
 
 #include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -14,13 +16,10 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
@@ -85,8 +84,8 @@ TEST(OutputFolderTest, WritesTheMarkerFirstAndPublishesUnderALock) {
   std::string error;
   ASSERT_TRUE(folder.Create(out, "run", &error)) << error;
   // The work folder: DIR.partial-<pid>-<random>, holding only its marker so far.
-  EXPECT_THAT(folder.path(), ::testing::StartsWith(out + ".partial-" + std::to_string(getpid()) +
-                                                   "-"));
+  EXPECT_THAT(folder.path(),
+              ::testing::StartsWith(out + ".partial-" + std::to_string(getpid()) + "-"));
   std::vector<std::string> files;
   for (const auto& e : fs::directory_iterator(folder.path()))
     files.push_back(e.path().filename().string());
@@ -105,8 +104,8 @@ TEST(OutputFolderTest, WritesTheMarkerFirstAndPublishesUnderALock) {
   EXPECT_THAT(marker.version, ::testing::StartsWith("0."));
   ASSERT_FALSE(marker.command.empty());
   EXPECT_THAT(marker.command[0], HasSubstr("output_folder_test"));
-  EXPECT_THAT(marker.created_utc, ::testing::MatchesRegex(
-                                      "[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9]{2}:[0-9]{2}:[0-9]{2}Z"));
+  EXPECT_THAT(marker.created_utc,
+              ::testing::MatchesRegex("[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9]{2}:[0-9]{2}:[0-9]{2}Z"));
   EXPECT_EQ(marker.pid, getpid());
   EXPECT_EQ(marker.host, HostName());
   EXPECT_TRUE(fs::exists(out + "/metrics.json"));
@@ -375,7 +374,8 @@ TEST(OwnershipCliTest, RunKeepsAFolderThatOnlyHoldsAStrayMetricsJson) {
   fs::create_directories(m);
   WriteText(m + "/metrics.json", "{}");
   WriteText(m + "/thesis.tex", "t");
-  const auto r = RunVobench("run " + ShortScenario(dir) + " --max-frames 5 --no-plots -q --out " + m);
+  const auto r =
+      RunVobench("run " + ShortScenario(dir) + " --max-frames 5 --no-plots -q --out " + m);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_THAT(r.output, HasSubstr("vobench run: " + m +
                                   ": exists and was not written by vobench (no .vobench.json), so "
@@ -412,9 +412,8 @@ TEST(OwnershipCliTest, SecondConcurrentWriterFailsFastAndTheFirstCompletes) {
   TempDir dir("own_concurrent");
   const std::string out = dir / "o";
   const std::string log = dir / "first.log";
-  std::vector<std::string> args = {VOBENCH_BINARY, "run",      "l_hallway", "--max-frames",
-                                   "80",           "--no-plots", "-q",      "--out",
-                                   out};
+  std::vector<std::string> args = {
+      VOBENCH_BINARY, "run", "l_hallway", "--max-frames", "80", "--no-plots", "-q", "--out", out};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -464,8 +463,8 @@ TEST(OwnershipCliTest, RunCleansOnlyMarkedStaleWorkFolders) {
   const std::string foreign = out + ".partial-" + std::to_string(dead) + "-y";
   fs::create_directories(foreign);
   WriteText(foreign + "/data.bin", "mine");
-  const auto r = RunVobench("run " + ShortScenario(dir) + " --max-frames 4 --no-plots -q --out " +
-                            out);
+  const auto r =
+      RunVobench("run " + ShortScenario(dir) + " --max-frames 4 --no-plots -q --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(stale));
   EXPECT_EQ(ReadAll(foreign + "/data.bin"), "mine");
