@@ -470,4 +470,30 @@ TEST(OwnershipCliTest, RunCleansOnlyMarkedStaleWorkFolders) {
   EXPECT_EQ(ReadAll(foreign + "/data.bin"), "mine");
 }
 
+// A suite folder: marked on creation; a second call on the same shard fails at once, while a
+// folder vobench did not write is not used.
+TEST(OwnershipCliTest, SuiteLocksItsShardAndRefusesAFolderItDidNotWrite) {
+  TempDir dir("own_suite");
+  WriteText(dir / "s.yaml",
+            "name: s\nscenarios:\n  - scenario: l_hallway\n    max_frames: 2\nconfigs:\n"
+            "  - name: a\n");
+  const std::string out = dir / "out";
+  std::string error;
+  ASSERT_TRUE(harness::AdoptFolder(out, "suite", &error)) << error;
+  harness::FolderLock shard;  // as a running `suite --shard 1/1` holds it
+  ASSERT_TRUE(shard.Acquire(out + "/.shard1of1.lock", out + " (shard shard1of1)", &error)) << error;
+  const auto busy = RunVobench("suite " + (dir / "s.yaml") + " -q --out " + out);
+  EXPECT_EQ(busy.exit_code, 1) << busy.output;
+  EXPECT_THAT(busy.output, HasSubstr(out + " (shard shard1of1): another vobench (pid " +
+                                     std::to_string(getpid()) + ") is writing this folder"));
+  EXPECT_FALSE(fs::exists(out + "/runs"));
+
+  fs::create_directories(dir / "mine");
+  WriteText(dir / "mine/suite.json", "{}");
+  const auto mine = RunVobench("suite " + (dir / "s.yaml") + " -q --out " + (dir / "mine"));
+  EXPECT_EQ(mine.exit_code, 1) << mine.output;
+  EXPECT_THAT(mine.output, HasSubstr("exists and was not written by vobench (no .vobench.json)"));
+  EXPECT_EQ(ReadAll(dir / "mine/suite.json"), "{}");
+}
+
 }  // namespace
