@@ -19,6 +19,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "harness/output_folder.h"
 #include "sim/scenario.h"
 #include "sim/yaml_input.h"
 
@@ -26,8 +27,6 @@ namespace harness {
 namespace fs = std::filesystem;
 namespace {
 
-// Name of the file in a partial folder that records the writing process (removed by Finish).
-constexpr const char* kWriterPidFile = ".writer_pid";
 // Tolerances for "is this a rotation" on options and EuRoC extrinsics.
 constexpr double kRotationTolerance = 1e-6;  // max |R^T R - I| entry
 // A rectified pair must have its baseline along x: |y|, |z| of rect1 in rect0 at most this
@@ -137,24 +136,6 @@ cv::Mat DepthToMillimetres(const cv::Mat& depth_m) {
     }
   }
   return mm;
-}
-
-// Removes "<dir>.partial-*" siblings left by writer processes that no longer run.
-void RemoveStalePartials(const std::string& dir) {
-  const fs::path target(dir);
-  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  const std::string prefix = target.filename().string() + ".partial-";
-  std::error_code ec;
-  std::vector<fs::path> stale;
-  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.compare(0, prefix.size(), prefix) != 0) continue;
-    std::ifstream pid_in(it->path() / kWriterPidFile);
-    long pid = 0;
-    if (!(pid_in >> pid) || pid <= 0) continue;  // not ours, or still being created
-    if (::kill(static_cast<pid_t>(pid), 0) == -1 && errno == ESRCH) stale.push_back(it->path());
-  }
-  for (const fs::path& p : stale) fs::remove_all(p, ec);
 }
 
 std::string CalibRow(const char* key, const double p[12]) {
@@ -289,8 +270,7 @@ DatasetWriter::~DatasetWriter() { RemovePartial(); }
 
 void DatasetWriter::RemovePartial() {
   if (finished_ || partial_dir_.empty()) return;
-  std::error_code ec;
-  fs::remove_all(partial_dir_, ec);
+  folder_.Discard();
   partial_dir_.clear();
 }
 
@@ -304,29 +284,13 @@ bool DatasetWriter::Open(const std::string& dir, const vo::StereoCamera& camera,
   dir_ = NormalizeDir(dir);
   camera_ = camera;
 
-  std::error_code ec;
-  if (fs::exists(dir_, ec)) {
-    if (!fs::is_directory(dir_, ec))
-      return Fail(error, dir_ + ": exists and is not a folder; refusing to replace it");
-    if (!options_.overwrite)
-      return Fail(error, dir_ + ": output folder already exists (set overwrite to replace it)");
-  }
-  const fs::path parent =
-      fs::path(dir_).has_parent_path() ? fs::path(dir_).parent_path() : fs::path(".");
-  if (!MakeDir(parent.string(), error)) return false;
-  RemoveStalePartials(dir_);
-
-  // The partial folder: a unique sibling, created atomically.
-  std::string pattern = dir_ + ".partial-XXXXXX";
-  std::vector<char> buffer(pattern.begin(), pattern.end());
-  buffer.push_back('\0');
-  if (::mkdtemp(buffer.data()) == nullptr)
-    return Fail(error, pattern + ": cannot create the partial folder: " + std::strerror(errno));
-  partial_dir_ = buffer.data();
-  {
-    std::ofstream pid_out(Join(partial_dir_, kWriterPidFile));
-    pid_out << ::getpid() << '\n';
-  }
+  // The partial folder: a marked, locked, unique sibling (output_folder.h); an existing DIR is
+  // replaced only with overwrite, and only when it is a vobench dataset.
+  OutputFolder::Options folder_options;
+  folder_options.replace_existing = options_.overwrite;
+  folder_options.replace_flag = "--overwrite";
+  if (!folder_.Create(dir_, "dataset", folder_options, error)) return false;
+  partial_dir_ = folder_.path();
 
   std::vector<std::string> folders = {"image_0", "image_1"};
   if (options_.format == DatasetFormat::kEuroc) {
@@ -523,35 +487,10 @@ bool DatasetWriter::Finish(std::string* error) {
   if (options_.format == DatasetFormat::kEuroc && !WriteEurocText(error)) return false;
   if (options_.format == DatasetFormat::kTum && !WriteTumText(error)) return false;
 
-  std::error_code ec;
-  fs::remove(Join(partial_dir_, kWriterPidFile), ec);
-
-  // Publish: rename the partial folder to DIR (replacing an old DIR when allowed).
-  std::string old_dir;
-  if (fs::exists(dir_, ec)) {
-    if (!options_.overwrite)
-      return Fail(error,
-                  dir_ + ": output folder appeared while writing (set overwrite to replace it)");
-    std::string pattern = dir_ + ".old-XXXXXX";
-    std::vector<char> buffer(pattern.begin(), pattern.end());
-    buffer.push_back('\0');
-    if (::mkdtemp(buffer.data()) == nullptr)
-      return Fail(error, pattern + ": cannot create: " + std::strerror(errno));
-    old_dir = buffer.data();
-    if (::rename(dir_.c_str(), old_dir.c_str()) != 0) {
-      const std::string why = std::strerror(errno);
-      fs::remove_all(old_dir, ec);
-      return Fail(error, dir_ + ": cannot move the existing folder aside: " + why);
-    }
-  }
-  if (::rename(partial_dir_.c_str(), dir_.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    if (!old_dir.empty()) ::rename(old_dir.c_str(), dir_.c_str());  // put the old one back
-    return Fail(error, partial_dir_ + ": cannot rename to " + dir_ + ": " + why);
-  }
+  // Publish: rename the partial folder to DIR (replacing an old vobench dataset when allowed).
+  if (!folder_.Publish(error)) return false;
   finished_ = true;
   partial_dir_.clear();
-  if (!old_dir.empty()) fs::remove_all(old_dir, ec);
   return true;
 }
 

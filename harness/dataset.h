@@ -44,6 +44,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/output_folder.h"
 #include "harness/trajectory_io.h"
 #include "vo/camera.h"
 
@@ -68,12 +69,14 @@ enum class DatasetFormat {
 bool ParseDatasetFormat(const std::string& name, DatasetFormat* format);
 const char* DatasetFormatName(DatasetFormat format);
 
-// Writes a sequence atomically: everything goes into a temporary sibling folder
-// "DIR.partial-XXXXXX" that is renamed to DIR only by Finish(). Destroying the writer before
-// Finish() (error, exception) removes the partial folder, so a half-written DIR never exists.
-// A process killed outright (SIGKILL, Ctrl-C without a handler) leaves the ".partial-" folder,
-// never DIR; Open() removes such leftovers of dead processes. Identical input gives
-// byte-identical files (fixed PNG parameters, FormatDouble numbers, no "now" anywhere).
+// Writes a sequence atomically: everything goes into a marked, locked work folder
+// "DIR.partial-<pid>-<random>" (an OutputFolder of kind "dataset", output_folder.h) that is
+// renamed to DIR only by Finish(). Destroying the writer before Finish() (error, exception)
+// removes the partial folder, so a half-written DIR never exists. A process killed outright
+// (SIGKILL, Ctrl-C without a handler) leaves the ".partial-" folder, never DIR; Open() removes
+// such leftovers of dead processes when they carry vobench's marker. Identical input gives
+// byte-identical files (fixed PNG parameters, FormatDouble numbers, no "now" anywhere), except
+// the marker .vobench.json (command line, time, pid).
 //
 // Usage:  DatasetWriter writer(options);
 //         if (!writer.Open(dir, camera, &error)) ...;
@@ -84,7 +87,8 @@ class DatasetWriter {
   struct Options {
     DatasetFormat format = DatasetFormat::kKitti;  // kEuroc also writes the mav0/ layout, kTum
                                                    // the TUM-style one
-    bool overwrite = false;   // replace an existing DIR (on Finish); otherwise refuse
+    bool overwrite = false;   // replace an existing DIR (on Finish) when it is a vobench
+                              // dataset (.vobench.json kind "dataset"); otherwise refuse
     bool write_depth = true;  // write depth/%06d.png for frames that carry depth
     int png_compression = 3;  // zlib level of every PNG, 0 (none) .. 9 (smallest, slowest)
     // EuRoC body frame: the left camera's pose in the body (rotation, metres).
@@ -101,8 +105,9 @@ class DatasetWriter {
   DatasetWriter(const DatasetWriter&) = delete;
   DatasetWriter& operator=(const DatasetWriter&) = delete;
 
-  // Checks options and camera, refuses an existing DIR unless options.overwrite, creates the
-  // partial folder (and DIR's parent folders).
+  // Checks options and camera, refuses an existing DIR unless options.overwrite (and then any
+  // DIR vobench did not write as a dataset), creates the partial folder (and DIR's parent
+  // folders) under the lock DIR.lock.
   bool Open(const std::string& dir, const vo::StereoCamera& camera, std::string* error);
   // Writes the frame's images at once. Frames must come in strictly increasing time (distinct
   // t_ns); images must be CV_8UC1 of the camera's size, depth empty or CV_32FC1 of that size.
@@ -124,7 +129,8 @@ class DatasetWriter {
   Options options_;
   vo::StereoCamera camera_;
   std::string dir_;
-  std::string partial_dir_;
+  OutputFolder folder_;      // the marked, locked work folder and its publishing
+  std::string partial_dir_;  // folder_.path() while open
   bool finished_ = false;
   bool has_gt_ = false;
   bool has_depth_ = false;

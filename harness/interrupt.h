@@ -1,6 +1,6 @@
 // SIGINT / SIGTERM for the long commands (run, eval, render, match-eval, tune, suite, check):
 // the handler only records the signal; the frame loops poll InterruptSignal(), stop, let their
-// work folders be removed (PartialFolder, DatasetWriter) and fail with InterruptedMessage();
+// work folders be removed (OutputFolder, DatasetWriter) and fail with InterruptedMessage();
 // main() then exits with InterruptExitCode() (128 + the signal: 130 for SIGINT, 143 for
 // SIGTERM). A second signal of the same kind kills at once (the handler resets itself).
 #pragma once

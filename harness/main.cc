@@ -16,6 +16,7 @@
 #include "harness/eval_command.h"
 #include "harness/interrupt.h"
 #include "harness/match_eval.h"
+#include "harness/output_folder.h"
 #include "harness/path_names.h"
 #include "harness/plots.h"
 #include "harness/progress.h"
@@ -120,6 +121,11 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
     }
     out = "out/match_eval/" + scenario.name;
   }
+  harness::OutputFolder folder;  // marked and locked now, published when complete
+  if (!folder.Create(out, "match-eval", &error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
 
   // Simulate the scenario into memory: images, ground-truth depth and poses.
   harness::StereoSequence sequence;
@@ -152,15 +158,18 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
                      .c_str());
     return 1;
   }
-  std::filesystem::create_directories(out);
-  const std::string csv = out + "/match_eval.csv";
-  if (!harness::WriteMatchEvalCsv(csv, rows, &error) ||
-      !harness::WriteTextFile(out + "/scenario.yaml", sim::ScenarioToYaml(scenario), &error)) {
+  const std::string work = folder.path(), csv = out + "/match_eval.csv";
+  if (!harness::WriteMatchEvalCsv(work + "/match_eval.csv", rows, &error) ||
+      !harness::WriteTextFile(work + "/scenario.yaml", sim::ScenarioToYaml(scenario), &error)) {
     std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
     return 1;
   }
-  if (!harness::RunPlot({"match-eval", csv, out + "/match_eval.png"}, &error))
+  if (!harness::RunPlot({"match-eval", work + "/match_eval.csv", work + "/match_eval.png"}, &error))
     std::fprintf(stderr, "vobench match-eval: warning: no plot: %s\n", error.c_str());
+  if (!folder.Publish(&error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
   std::printf("%-14s %6s %6s %8s %8s %9s %7s %7s %9s\n", "matcher", "stride", "pairs", "matches", "correct",
               "precision", "recall", "F1", "ms/pair");
   for (const auto& r : rows)
@@ -264,7 +273,7 @@ int main(int argc, char** argv) {
   render->add_option("scenario", scenario, "Scenario YAML file or built-in name (l_hallway, plain_corridor)")->capture_default_str();
   render->add_option("--out,-o", out, "Output folder (must not exist unless --overwrite)")->required();
   render->add_option("--format", format, "Dataset layout: kitti, euroc or tum (euroc and tum also write kitti)")->capture_default_str();
-  render->add_flag("--overwrite", overwrite, "Replace an existing output folder");
+  render->add_flag("--overwrite", overwrite, "Replace an existing output folder if it is a dataset vobench wrote");
   render->add_flag("-q,--quiet", quiet, "No progress display");
 
   std::string me_scenario = "l_hallway", me_strides = "1,2,3,5,8", me_matchers, me_out,

@@ -17,7 +17,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     *error = "invalid VO options or camera: " + *error;
     return false;
   }
-  PartialFolder folder;  // the run folder is written as DIR.partial and moved into place
+  OutputFolder folder;  // written as a marked DIR.partial-<pid>-<random>, moved into place
   if (!OpenRunFolder(options.out_dir, &folder, error)) return false;
   RunFramesOptions frames_options;
   frames_options.max_frames = options.max_frames;

@@ -146,13 +146,8 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary) {
   return csv.str();
 }
 
-bool OpenRunFolder(const std::string& dir, PartialFolder* folder, std::string* error) {
-  const fs::path d = dir;
-  if (fs::exists(d) && !fs::exists(d / "metrics.json")) {
-    *error = d.string() + ": exists and is not a vobench run folder (no metrics.json); choose another --out";
-    return false;
-  }
-  return folder->Create(d.string(), error);
+bool OpenRunFolder(const std::string& dir, OutputFolder* folder, std::string* error) {
+  return folder->Create(dir, "run", error);
 }
 
 void MakePlots(const std::string& folder, bool has_ground_truth, const std::string& outline) {
@@ -173,7 +168,7 @@ void MakePlots(const std::string& folder, bool has_ground_truth, const std::stri
 }
 
 bool WriteRunFolder(const RunRecords& records, const RunSummary& s, const RunFolderContents& contents,
-                    const std::string& dir, PartialFolder* folder, std::string* error) {
+                    const std::string& dir, OutputFolder* folder, std::string* error) {
   const fs::path p = folder->path();
   const Trajectories t = InitialisedTrajectories(records, static_cast<size_t>(s.frames_not_initialised));
   if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(t.times, t.est), error) ||
@@ -208,7 +203,7 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s, const RunFol
     *error = InterruptedMessage(frames, frames, "frames", dir);
     return false;
   }
-  return folder->Publish("metrics.json", "run", error);
+  return folder->Publish(error);
 }
 
 }  // namespace harness

@@ -12,14 +12,16 @@
 //   scenario.yaml      effective scenario (simulated runs)
 //   trajectory.png, errors.png, timing.png, report.md
 //
-// The folder is written as DIR.partial and moved into place only when complete
-// (PartialFolder), so a half-written folder never looks finished.
+// The folder is written as a marked work folder beside DIR and moved into place only when
+// complete (OutputFolder: the ownership rules, the lock), so a half-written folder never looks
+// finished and a folder vobench did not write is never replaced.
 #pragma once
 
 #include <string>
 
 #include "harness/metric_registry.h"  // MetricsJson
 #include "harness/pipeline.h"
+#include "harness/output_folder.h"
 #include "harness/trajectory_io.h"
 
 namespace harness {
@@ -32,15 +34,15 @@ struct RunFolderContents {
   std::string outline;        // hallway outline name for the trajectory plot ("" = none)
 };
 
-// Opens DIR for writing (as DIR.partial): refused when DIR exists and is not a run folder.
-// Call before the frames run, so a refused folder fails fast.
-bool OpenRunFolder(const std::string& dir, PartialFolder* folder, std::string* error);
+// Opens DIR for writing (locked, into a marked work folder): refused when DIR exists and is not
+// a vobench run folder. Call before the frames run, so a refused folder fails fast.
+bool OpenRunFolder(const std::string& dir, OutputFolder* folder, std::string* error);
 
 // Writes every file of the run into `folder` (opened by OpenRunFolder), makes the plots and
 // publishes it as DIR. Nothing is published on an error or an interrupt.
 bool WriteRunFolder(const RunRecords& records, const RunSummary& summary,
                     const RunFolderContents& contents, const std::string& dir,
-                    PartialFolder* folder, std::string* error);
+                    OutputFolder* folder, std::string* error);
 
 // The plots of a written run folder (trajectory.png and errors.png with ground truth,
 // timing.png); a missing python3-matplotlib gives a warning on stderr, not an error.

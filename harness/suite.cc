@@ -28,6 +28,7 @@
 
 #include "harness/interrupt.h"
 #include "harness/metric_registry.h"
+#include "harness/output_folder.h"
 #include "harness/overrides.h"
 #include "harness/path_names.h"
 #include "harness/progress.h"
@@ -523,26 +524,12 @@ bool ReadManifest(const fs::path& dir, std::string* name, std::vector<SuiteRun>*
   return true;
 }
 
-// A folder that may become a suite output folder: absent, empty, or a suite folder of `name`.
+// A folder that may become a suite output folder: absent, empty, or a marked suite folder
+// (output_folder.h) of `name`; one without suite.json yet is being created by a shard started
+// at the same time.
 bool CheckOutDir(const fs::path& dir, const std::string& name, std::string* error) {
-  std::error_code ec;
-  if (!fs::exists(dir)) return true;
-  if (!fs::is_directory(dir)) {
-    *error = dir.string() + ": exists and is not a folder";
-    return false;
-  }
-  if (!fs::exists(dir / "suite.json")) {
-    // Empty, or a shard started at the same time is just writing its manifest (only
-    // WriteFileAtomically's "suite.json.tmp<pid>" is there yet).
-    bool being_created = true;
-    for (const auto& entry : fs::directory_iterator(dir, ec)) {
-      being_created &= entry.path().filename().string().rfind("suite.json.tmp", 0) == 0;
-    }
-    if (!ec && being_created) return true;
-    *error = dir.string() +
-             ": exists and is not a vobench suite folder (no suite.json); choose another --out";
-    return false;
-  }
+  if (!CheckReplaceable(dir.string(), "suite", error)) return false;
+  if (!fs::exists(dir / "suite.json")) return true;
   std::string other;
   std::vector<SuiteRun> runs;
   if (!ReadManifest(dir, &other, &runs, error)) return false;
@@ -578,9 +565,10 @@ void RemoveLeftovers(const fs::path& out, const fs::path& work) {
   std::error_code ec;
   fs::remove_all(work, ec);
   fs::remove(out / "tmp", ec);  // only if empty
-  std::vector<fs::path> partial;
+  std::vector<fs::path> partial;  // only folders vobench marked as its own
   for (fs::directory_iterator it(out / "runs", ec), end; !ec && it != end; it.increment(ec))
-    if (it->path().filename().string().find(".partial") != std::string::npos)
+    if (it->path().filename().string().find(".partial") != std::string::npos &&
+        HasFolderMarker(it->path().string()))
       partial.push_back(it->path());
   for (const auto& p : partial) fs::remove_all(p, ec);
 }
@@ -706,12 +694,8 @@ bool FinishJob(const fs::path& out, const Job& job, int status, double wall_s, b
     stamp["command"] = CommandLine(job.argv);
     if (!WriteTextFile((tmp / "suite_run.json").string(), stamp.dump(2) + "\n", error))
       return false;
-    fs::remove_all(dst, ec);
-    fs::rename(tmp, dst, ec);
-    if (ec) {
-      *error = dst.string() + ": cannot move the finished run into place: " + ec.message();
-      return false;
-    }
+    // runs/<id> is replaced only when it is a vobench run folder (output_folder.h).
+    if (!ReplaceFolder(tmp.string(), dst.string(), "run", error)) return false;
     fs::remove(failed, ec);
     return true;
   }
@@ -1069,12 +1053,13 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
   const std::vector<SuiteRun> runs = ExpandSuite(suite);
   // The manifest first: a folder with suite.json is recognised as this suite's on resume.
   std::error_code ec;
-  if (!CheckOutDir(out, suite.name, error)) return false;
-  fs::create_directories(out, ec);
-  if (ec) {
-    *error = out.string() + ": cannot create: " + ec.message();
+  // A marked suite folder (created with its marker, or an earlier one of this suite), and the
+  // lock of this shard in it: a second `suite` on the same folder and shard fails at once.
+  FolderLock shard_lock;
+  if (!CheckOutDir(out, suite.name, error) || !AdoptFolder(out.string(), "suite", error) ||
+      !shard_lock.Acquire((out / ("." + shard_tag + ".lock")).string(),
+                          out.string() + " (shard " + shard_tag + ")", error))
     return false;
-  }
   if (!WriteFileAtomically((out / "suite.json").string(),
                            Manifest(suite, runs, options.shard).dump(2) + "\n", error) ||
       !WriteFileAtomically((out / "suite.yaml").string(), suite.source_text, error) ||
@@ -1241,7 +1226,11 @@ bool MergeSuiteShards(const std::vector<std::string>& shard_dirs, const std::str
       }
   }
   const fs::path out = out_dir;
-  if (!CheckOutDir(out, name, error) || !MakeDirs(out, error)) return false;
+  FolderLock merge_lock;
+  if (!CheckOutDir(out, name, error) || !AdoptFolder(out.string(), "suite", error) ||
+      !merge_lock.Acquire((out / ".merge.lock").string(), out.string() + " (merge)", error) ||
+      !MakeDirs(out, error))
+    return false;
   const fs::path work = WorkDir(out, "merge");
   RemoveLeftovers(out, work);
   for (const auto& r : runs) {
@@ -1256,12 +1245,11 @@ bool MergeSuiteShards(const std::vector<std::string>& shard_dirs, const std::str
       fs::remove_all(tmp, ec);
       fs::create_directories(work, ec);
       if (!ec) fs::copy(src, tmp, fs::copy_options::recursive, ec);
-      if (!ec) fs::remove_all(dst, ec);
-      if (!ec) fs::rename(tmp, dst, ec);
       if (ec) {
         *error = dst.string() + ": cannot copy the run from " + src.string() + ": " + ec.message();
         return false;
       }
+      if (!ReplaceFolder(tmp.string(), dst.string(), "run", error)) return false;
       fs::remove(out / "runs" / (r.id + ".failed.txt"), ec);
       break;
     }

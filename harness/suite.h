@@ -21,7 +21,9 @@
 // Runs are the product scenarios × configs × seeds × strides in that nesting order (the stride
 // varies fastest); run i (from 0) has the id `<scenario>__<config>__s<seed>__k<stride>`.
 //
-// Output folder (OUT):
+// Output folder (OUT), a marked folder of kind "suite" (harness/output_folder.h: an existing OUT
+// without that marker is refused):
+//   .vobench.json   the marker; .shard<i>of<N>.lock / .merge.lock while a call writes
 //   suite.json      manifest: suite name, the shard, every run of the suite (id, axes, spec hash)
 //   suite.yaml      copy of the suite file
 //   specs/<id>.scenario.yaml, specs/<id>.vo.yaml
@@ -29,14 +31,15 @@
 //   runs/<id>/      finished run folders (`vobench run` layout + suite_run.json: spec hash,
 //                   wall time). A run appears here only when finished: the child writes under
 //                   tmp/shard<i>of<N>/<id>, the suite adds suite_run.json and renames it into
-//                   runs/ (shards sharing one output folder keep out of each other's tmp/).
+//                   runs/ (shards sharing one output folder keep out of each other's tmp/);
+//                   an existing runs/<id> is replaced only when it is a marked run folder.
 //   runs/<id>.failed.txt   a failed run: command, exit status, the tail of its log
 //   logs/<id>.log   stdout and stderr of the child
 //   summary.csv, summary.md, summary.png   the table across runs (written atomically)
 //
 // Resume: a run whose runs/<id>/suite_run.json records the same spec hash (effective scenario,
 // VO options, stride, max_frames) is kept; anything else is redone; the shard's tmp/ folder and
-// runs/*.partial leftovers are removed. The hash does not cover the vobench binary: use --force
+// marked runs/*.partial leftovers are removed. The hash does not cover the vobench binary: use --force
 // after changing the code.
 #pragma once
 

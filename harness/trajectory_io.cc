@@ -65,47 +65,6 @@ bool WriteTextFile(const std::string& path, const std::string& text, std::string
   return true;
 }
 
-PartialFolder::~PartialFolder() {
-  if (published_ || partial_.empty()) return;
-  std::error_code ec;
-  std::filesystem::remove_all(partial_, ec);
-}
-
-bool PartialFolder::Create(const std::string& dir, std::string* error) {
-  dir_ = dir;
-  partial_ = dir + ".partial";
-  published_ = false;
-  std::error_code ec;
-  std::filesystem::remove_all(partial_, ec);
-  std::filesystem::create_directories(partial_, ec);
-  if (ec) {
-    SetError(error, partial_ + ": cannot create: " + ec.message());
-    return false;
-  }
-  return true;
-}
-
-bool PartialFolder::Publish(const std::string& marker, const std::string& what,
-                            std::string* error) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(dir_)) {
-    if (!fs::exists(fs::path(dir_) / marker)) {
-      SetError(error, dir_ + ": exists and is not a vobench " + what + " folder (no " + marker +
-                          "); not replacing it");
-      return false;
-    }
-    fs::remove_all(dir_, ec);
-  }
-  fs::rename(partial_, dir_, ec);
-  if (ec) {
-    SetError(error, dir_ + ": cannot move the finished " + what + " into place: " + ec.message());
-    return false;
-  }
-  published_ = true;
-  return true;
-}
-
 bool IsBlankOrComment(std::string_view line) {
   const size_t first = line.find_first_not_of(" \t");
   return first == std::string::npos || line[first] == '#';

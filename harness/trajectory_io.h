@@ -92,29 +92,6 @@ bool ReadTextLines(const std::string& path, std::vector<std::string>* lines, std
 // Writes `text` to `path` byte for byte (replacing the file). Error names the file.
 bool WriteTextFile(const std::string& path, const std::string& text, std::string* error);
 
-// A result folder written as "DIR.partial" and moved to DIR only when complete, so a half-
-// written folder never looks finished. The destructor removes the partial folder unless
-// Publish() succeeded.
-class PartialFolder {
- public:
-  PartialFolder() = default;
-  ~PartialFolder();
-  PartialFolder(const PartialFolder&) = delete;
-  PartialFolder& operator=(const PartialFolder&) = delete;
-
-  // Creates DIR.partial (an earlier leftover is removed first). Error names the folder.
-  bool Create(const std::string& dir, std::string* error);
-  const std::string& path() const { return partial_; }  // DIR.partial
-  // Replaces DIR by the partial folder. An existing DIR is replaced only when it holds
-  // `marker` (a file every finished result of this kind has); `what` names the result in
-  // messages ("run", "tune result").
-  bool Publish(const std::string& marker, const std::string& what, std::string* error);
-
- private:
-  std::string dir_, partial_;
-  bool published_ = false;
-};
-
 // True for a line that is empty, blank, or whose first non-blank character is '#'.
 bool IsBlankOrComment(std::string_view line);
 

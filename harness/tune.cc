@@ -17,6 +17,7 @@
 
 #include "harness/interrupt.h"
 #include "harness/metric_registry.h"
+#include "harness/output_folder.h"
 #include "harness/overrides.h"
 #include "harness/path_names.h"
 #include "harness/pipeline.h"
@@ -750,11 +751,9 @@ bool RunTuneSteps(const TuneSpec& spec, const TuneOptions& options, TuneSummary*
     *error = "no output folder given";
     return false;
   }
-  if (fs::exists(dir) && !fs::exists(dir / "summary.json")) {
-    *error = dir.string() +
-             ": exists and is not a vobench tune folder (no summary.json); choose another --out";
-    return false;
-  }
+  // The output folder first (locked, refused early when not vobench's), published at the end.
+  OutputFolder folder;
+  if (!folder.Create(dir.string(), "tune", error)) return false;
   OptimizerOptions opt = spec.optimizer;
   if (options.max_evals > 0) opt.max_evals = options.max_evals;
   if (!opt.IsValid(error)) return false;
@@ -839,8 +838,6 @@ bool RunTuneSteps(const TuneSpec& spec, const TuneOptions& options, TuneSummary*
   s.validation_s = Seconds(validation_start);
 
   // 4. The output folder, written beside DIR and moved into place.
-  PartialFolder folder;
-  if (!folder.Create(dir.string(), error)) return false;
   const fs::path p = folder.path();
   if (!WriteTextFile((p / "best_vo.yaml").string(), VoConfigToYaml(s.best_options), error) ||
       !WriteTextFile((p / "base_vo.yaml").string(), VoConfigToYaml(base_options), error) ||
@@ -861,7 +858,7 @@ bool RunTuneSteps(const TuneSpec& spec, const TuneOptions& options, TuneSummary*
   if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(spec, s, opt, has_plot), error))
     return false;
   if (InterruptSignal() != 0) return false;  // nothing published yet
-  if (!folder.Publish("summary.json", "tune", error)) return false;
+  if (!folder.Publish(error)) return false;
   *summary = s;
   return true;
 }

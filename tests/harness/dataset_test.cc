@@ -382,19 +382,47 @@ TEST_F(DatasetTest, ExistingFolderRefusedUnlessOverwrite) {
   EXPECT_EQ(EntriesStartingWith("out"), std::vector<std::string>{"out"});  // no .old / .partial
 }
 
-TEST_F(DatasetTest, OpenRemovesPartialFoldersOfDeadWriters) {
-  // A writer killed outright leaves DIR.partial-XXXXXX with its pid; no process has this pid.
-  const fs::path stale = root_ / "seq.partial-AbC123";
+TEST_F(DatasetTest, OpenRemovesOnlyMarkedPartialFoldersOfDeadWriters) {
+  // A writer killed outright leaves DIR.partial-<pid>-XXXXXX with vobench's marker naming it; no
+  // process has this pid.
+  const fs::path stale = root_ / "seq.partial-2147483646-AbC123";
   fs::create_directories(stale / "image_0");
-  WriteAll(stale / ".writer_pid", "2147483646\n");
+  char host[256] = {};
+  gethostname(host, sizeof(host) - 1);
+  const auto marker = [&](long pid) {
+    return "{\"vobench_folder\": 1, \"kind\": \"dataset\", \"pid\": " + std::to_string(pid) +
+           ", \"host\": \"" + std::string(host) + "\"}\n";
+  };
+  WriteAll(stale / ".vobench.json", marker(2147483646));
+  // The same without a marker (written by someone else, or by an older vobench): left alone.
+  const fs::path foreign = root_ / "seq.partial-old000";
+  fs::create_directories(foreign);
+  WriteAll(foreign / ".writer_pid", "2147483646\n");
   // A partial folder of a live writer (this process) stays.
   const fs::path live = root_ / "seq.partial-live00";
   fs::create_directories(live);
-  WriteAll(live / ".writer_pid", std::to_string(::getpid()) + "\n");
+  WriteAll(live / ".vobench.json", marker(::getpid()));
   WriteSequence("seq", MakeSequence(1, false, false));
   EXPECT_FALSE(fs::exists(stale));
+  EXPECT_TRUE(fs::exists(foreign / ".writer_pid"));
   EXPECT_TRUE(fs::exists(live));
   EXPECT_FALSE(fs::exists(root_ / "seq" / ".writer_pid"));
+  EXPECT_TRUE(fs::exists(root_ / "seq" / ".vobench.json"));
+}
+
+TEST_F(DatasetTest, OverwriteReplacesOnlyAVobenchDataset) {
+  // --overwrite used to remove any folder; now only one with vobench's dataset marker.
+  const std::string dir = Dir("mine");
+  fs::create_directories(dir);
+  WriteAll(dir + "/important.txt", "x");
+  DatasetWriter::Options options;
+  options.overwrite = true;
+  DatasetWriter writer(options);
+  std::string error;
+  EXPECT_FALSE(writer.Open(dir, TestCamera(), &error));
+  EXPECT_THAT(error, HasSubstr(dir + ": exists and was not written by vobench (no .vobench.json)"));
+  EXPECT_EQ(ReadAll(dir + "/important.txt"), "x");
+  EXPECT_EQ(EntriesStartingWith("mine"), std::vector<std::string>{"mine"});
 }
 
 TEST_F(DatasetTest, WriterRejectsBadFrames) {

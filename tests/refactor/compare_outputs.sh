@@ -5,8 +5,8 @@
 # match-eval, a tiny suite, check (on that suite) and a small tune with each build, then diffs
 # the two output trees. Timing values (wall clock) differ from run to run and are masked before
 # the diff: CSV columns and JSON keys named *_ms, *_s (not time_s), ms_per_pair and the
-# Markdown table rows that hold them; PNG plots are not compared (runs use --no-plots where
-# the command has it).
+# Markdown table rows that hold them; PNG plots, logs and the folder markers
+# (.vobench.json: time, pid, command line) are not compared.
 #   tests/refactor/compare_outputs.sh OLD_VOBENCH NEW_VOBENCH [WORK_DIR]
 # Exit 0 when the trees agree; otherwise lists the files that differ (and the first lines).
 set -euo pipefail
@@ -154,7 +154,7 @@ PY
 status=0
 cd "$WORK"
 while IFS= read -r f; do
-  case "$f" in *.png|*/logs/*|*.log) continue ;; esac
+  case "$f" in *.png|*/logs/*|*.log|*/.vobench.json|*.lock) continue ;; esac
   if [ ! -e "new/$f" ]; then echo "only in old: $f"; status=1; continue; fi
   if ! cmp -s "old/$f" "new/$f"; then
     if ! diff -q <(normalise "old/$f" | sed "s|$WORK/old|<d>|g;s|$OLD|<bin>|g") \
@@ -166,7 +166,7 @@ while IFS= read -r f; do
   fi
 done < <(cd old && find . -type f | sort)
 while IFS= read -r f; do
-  case "$f" in *.png|*/logs/*|*.log) continue ;; esac
+  case "$f" in *.png|*/logs/*|*.log|*/.vobench.json|*.lock) continue ;; esac
   [ -e "old/$f" ] || { echo "only in new: $f"; status=1; }
 done < <(cd new && find . -type f | sort)
 files=$(cd old && find . -type f ! -name '*.png' | wc -l)
