@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "sim/data_dir.h"
+
 namespace harness {
 
 std::string ShellQuoted(const std::string& s) {
@@ -17,7 +19,7 @@ std::string ShellQuoted(const std::string& s) {
 
 bool RunPythonScript(const std::string& script, const std::vector<std::string>& args,
                      std::string* error) {
-  const std::string path = std::string(VOBENCH_SOURCE_DIR) + "/harness/" + script;
+  const std::string path = sim::DataDir() + "/harness/" + script;
   const std::string python =
       std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   std::string cmd = python + " " + ShellQuoted(path);
