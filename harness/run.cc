@@ -322,13 +322,9 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     std::string plot_error;
     bool ok = true;
     if (has_gt) {
-      std::vector<std::string> args = {"trajectory", (p / "groundtruth_tum.txt").string(),
-                                       (p / "estimate_in_gt_world_tum.txt").string(), (p / "trajectory.png").string()};
-      if (!options.outline.empty()) {
-        args.push_back("--outline");
-        args.push_back(options.outline);
-      }
-      ok = RunPlot(args, &plot_error) && RunPlot({"errors", p.string(), (p / "errors.png").string()}, &plot_error);
+      ok = RunTrajectoryPlot((p / "groundtruth_tum.txt").string(), (p / "estimate_in_gt_world_tum.txt").string(),
+                             (p / "trajectory.png").string(), options.outline_scene, &plot_error) &&
+           RunPlot({"errors", p.string(), (p / "errors.png").string()}, &plot_error);
     }
     ok = ok && RunPlot({"timing", p.string(), (p / "timing.png").string()}, &plot_error);
     if (!ok) std::fprintf(stderr, "warning: plots not made: %s\n", plot_error.c_str());
@@ -347,7 +343,7 @@ bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_op
   auto simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
   RunOptions o = options;
-  if (o.outline.empty()) o.outline = fs::path(scenario.scene_path).stem().string();
+  if (o.outline_scene.empty()) o.outline_scene = scenario.scene_path;
   sim::StereoFrame f;
   FrameSource source = [&](DatasetFrame* frame, std::string* err) {
     if (!simulator->Next(&f, err)) return false;
