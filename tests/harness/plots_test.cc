@@ -119,9 +119,10 @@ TEST(PlotScriptsTest, EveryScriptWritesAPngFromTheCommittedResults) {
 
   // A new script in harness/ needs a case here.
   for (const auto& e : fs::directory_iterator(kSource + "/harness")) {
-    if (e.path().extension() == ".py")
+    if (e.path().extension() == ".py") {
       EXPECT_TRUE(ran.count(e.path().filename().string()))
           << e.path() << " is not run by this smoke test: add it";
+    }
   }
 }
 
