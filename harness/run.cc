@@ -322,7 +322,8 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     std::string plot_error;
     bool ok = true;
     if (has_gt) {
-      ok = RunTrajectoryPlot((p / "groundtruth_tum.txt").string(), (p / "estimate_in_gt_world_tum.txt").string(),
+      ok = RunTrajectoryPlot((p / "groundtruth_tum.txt").string(),
+                             (p / "estimate_in_gt_world_tum.txt").string(),
                              (p / "trajectory.png").string(), options.outline_scene, &plot_error) &&
            RunPlot({"errors", p.string(), (p / "errors.png").string()}, &plot_error);
     }

@@ -38,7 +38,6 @@ void WallsOfModel(const mjModel* m, std::vector<SceneWall>* walls);
 
 // The walls of the MJCF scene at `scene_path` (loads it): false with *error naming the file when
 // it cannot be loaded.
-bool WallsOfScene(const std::string& scene_path, std::vector<SceneWall>* walls,
-                  std::string* error);
+bool WallsOfScene(const std::string& scene_path, std::vector<SceneWall>* walls, std::string* error);
 
 }  // namespace sim

@@ -3,6 +3,8 @@
 // trajectory plot's outline comes from the scene's walls. Skipped without python3-matplotlib.
 #include "harness/plots.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -11,8 +13,6 @@
 #include <set>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "sim/data_dir.h"
 #include "tests/sim/sim_test_util.h"
@@ -76,16 +76,16 @@ TEST(SceneOutlineTest, UnloadableSceneNamesTheFile) {
 // Every plot script with every subcommand, on the committed fixtures.
 TEST(PlotScriptsTest, EveryScriptWritesAPngFromTheCommittedResults) {
   if (!HaveMatplotlib()) GTEST_SKIP() << "python3-matplotlib is not installed (/usr/bin/python3)";
-  ASSERT_EQ(sim::DataDir(), kSource) << "the test binary should find the scripts in the source tree";
+  ASSERT_EQ(sim::DataDir(), kSource)
+      << "the test binary should find the scripts in the source tree";
   TempDir dir("plots");
   const std::string l_run = kSource + "/results/l_hallway";
   std::string error;
   std::set<std::string> ran;
 
-  EXPECT_TRUE(harness::RunTrajectoryPlot(l_run + "/groundtruth_tum.txt",
-                                         l_run + "/estimate_in_gt_world_tum.txt",
-                                         dir / "trajectory.png",
-                                         kSource + "/scenes/hallway_l.xml", &error))
+  EXPECT_TRUE(harness::RunTrajectoryPlot(
+      l_run + "/groundtruth_tum.txt", l_run + "/estimate_in_gt_world_tum.txt",
+      dir / "trajectory.png", kSource + "/scenes/hallway_l.xml", &error))
       << error;
   ExpectPng(dir / "trajectory.png");
   EXPECT_FALSE(fs::exists(dir / "trajectory.png.outline.csv")) << "the outline file is left behind";
@@ -111,8 +111,8 @@ TEST(PlotScriptsTest, EveryScriptWritesAPngFromTheCommittedResults) {
   ExpectPng(dir / "summary.png");
   ran.insert("suite_plot.py");
 
-  EXPECT_TRUE(harness::RunPythonScript("tune_plot.py", {kSource + "/results/tune", dir / "objective.png"},
-                                       &error))
+  EXPECT_TRUE(harness::RunPythonScript("tune_plot.py",
+                                       {kSource + "/results/tune", dir / "objective.png"}, &error))
       << error;
   ExpectPng(dir / "objective.png");
   ran.insert("tune_plot.py");

@@ -2,9 +2,9 @@
 // executable falls back to the source tree.
 #include "sim/data_dir.h"
 
-#include <filesystem>
-
 #include <gtest/gtest.h>
+
+#include <filesystem>
 
 #include "tests/sim/sim_test_util.h"
 
