@@ -30,6 +30,7 @@ for m in "${modules[@]}"; do
         why="relative include out of the folder; name it from the source root (vo/..., sim/...)"
       elif [[ "$inc" == */* ]] && [[ " vo sim harness " == *" $top "* ]] &&
            [[ " ${allowed[$m]} " != *" $top "* ]]; then
+        # shellcheck disable=SC2086  # the list is split into its words on purpose
         ok_list="$(printf '%s/, ' ${allowed[$m]})"
         why="$m/ may include only ${ok_list%, } (DESIGN.md: $m/ never depends on $top/)"
       else
