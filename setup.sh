@@ -12,6 +12,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
   python3 python3-matplotlib python3-numpy    # plots in reports
   libnlopt-cxx-dev                            # derivative-free optimisers (vobench tune)
+  parallel                                    # tests: the README's GNU-parallel shard recipe
+  clang-format-14                             # tests/format_check.sh (the version it pins)
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -19,7 +19,7 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
   sequence->camera = ToStereoCamera(simulator->calibration());
   sequence->expected_frames = simulator->EstimatedFrames();
   sequence->scenario_yaml = sim::ScenarioToYaml(scenario);
-  sequence->outline = std::filesystem::path(scenario.scene_path).stem().string();
+  sequence->outline_scene = scenario.scene_path;
   sequence->next = [simulator, f = sim::StereoFrame()](DatasetFrame* frame,
                                                        std::string* err) mutable {
     if (!simulator->Next(&f, err)) return false;

@@ -34,7 +34,7 @@ struct StereoSequence {
   FrameSource next;           // the frames in order (with ground truth where known)
   int expected_frames = 0;    // frames the source will give (for progress; 0 = unknown)
   std::string scenario_yaml;  // effective scenario (simulated sequences; "" otherwise)
-  std::string outline;        // hallway outline for the trajectory plot ("" = none)
+  std::string outline_scene;  // MJCF scene whose walls outline the trajectory plot ("" = none)
 };
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).

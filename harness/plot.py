@@ -2,8 +2,10 @@
 """Plots for vobench reports (matplotlib, Agg backend, PNG).
 
   plot.py match-eval CSV PNG          precision / recall / F1 vs stride, one line per matcher
-  plot.py trajectory GT_TUM EST_TUM PNG [--outline hallway_l]
-                                      top-down trajectory, estimate vs ground truth
+  plot.py trajectory GT_TUM EST_TUM PNG [--outline-file CSV]
+                                      top-down trajectory, estimate vs ground truth; CSV: the
+                                      scene's walls (wall,x0_m,y0_m,x1_m,y1_m), written by the
+                                      harness from the MJCF (harness/plots.h, SceneOutlineCsv)
   plot.py errors RUN_DIR PNG          translation / rotation error along the path (per_frame.csv)
   plot.py timing RUN_DIR PNG          per-stage time per frame (per_frame.csv)
 """
@@ -14,13 +16,6 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-# Hallway outlines (x, y polygons in the world, metres), as in scenes/*.xml.
-OUTLINES = {
-    "hallway_l": [(-1.5, -1), (9, -1), (9, 12), (7, 12), (7, 1), (-1.5, 1), (-1.5, -1)],
-    "corridor_plain": [(-1.5, -1), (14, -1), (14, 1), (-1.5, 1), (-1.5, -1)],
-}
-
 
 def read_csv(path):
     with open(path) as f:
@@ -60,11 +55,45 @@ def read_tum(path):
     return out
 
 
-def trajectory(gt_path, est_path, png, outline=None):
+def read_outline(path):
+    """The walls of a scene, top-down: one (x0, y0, x1, y1) segment per row (metres)."""
+    return [tuple(float(r[k]) for k in ("x0_m", "y0_m", "x1_m", "y1_m")) for r in read_csv(path)]
+
+
+def outline_polylines(segments, tol=1e-6):
+    """Segments chained into polylines where their ends meet (drawn with joins, not end caps)."""
+    def near(a, b):
+        return abs(a[0] - b[0]) <= tol and abs(a[1] - b[1]) <= tol
+    left = [((x0, y0), (x1, y1)) for x0, y0, x1, y1 in segments]
+    lines = []
+    while left:
+        line = list(left.pop(0))
+        grown = True
+        while grown:
+            grown = False
+            for i, (a, b) in enumerate(left):
+                if near(a, line[-1]) or near(b, line[-1]):
+                    line.append(b if near(a, line[-1]) else a)
+                    left.pop(i)
+                    grown = True
+                    break
+        if len(line) > 2 and near(line[0], line[-1]):  # a closed loop: start at its lowest (x, y)
+            k = min(range(len(line) - 1), key=lambda i: line[i])
+            line = line[k:-1] + line[:k + 1]
+        lines.append(line)
+    return lines
+
+
+def trajectory(gt_path, est_path, png, outline_file=None):
     gt, est = read_tum(gt_path), read_tum(est_path)
     fig, ax = plt.subplots(figsize=(6.5, 6.5))
-    if outline in OUTLINES:
-        xs, ys = zip(*OUTLINES[outline])
+    walls = outline_polylines(read_outline(outline_file)) if outline_file else []
+    if walls:
+        # One line (one legend entry), the polylines separated by NaN breaks.
+        xs, ys = [], []
+        for line in walls:
+            xs += [p[0] for p in line] + [float("nan")]
+            ys += [p[1] for p in line] + [float("nan")]
         ax.plot(xs, ys, color="0.6", linewidth=1, label="hallway walls")
     ax.plot([p[1] for p in gt], [p[2] for p in gt], "k-", linewidth=2, label="ground truth")
     ax.plot([p[1] for p in est], [p[2] for p in est], "r--", linewidth=1.5, label="VO estimate")
@@ -128,8 +157,8 @@ def main(argv):
     if cmd == "match-eval":
         match_eval(argv[2], argv[3])
     elif cmd == "trajectory":
-        outline = argv[argv.index("--outline") + 1] if "--outline" in argv else None
-        trajectory(argv[2], argv[3], argv[4], outline)
+        outline_file = argv[argv.index("--outline-file") + 1] if "--outline-file" in argv else None
+        trajectory(argv[2], argv[3], argv[4], outline_file)
     elif cmd == "errors":
         errors(argv[2], argv[3])
     elif cmd == "timing":

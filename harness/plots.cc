@@ -2,8 +2,13 @@
 
 #include <sys/wait.h>
 
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+
+#include "sim/data_dir.h"
 
 namespace harness {
 
@@ -17,7 +22,7 @@ std::string ShellQuoted(const std::string& s) {
 
 bool RunPythonScript(const std::string& script, const std::vector<std::string>& args,
                      std::string* error) {
-  const std::string path = std::string(VOBENCH_SOURCE_DIR) + "/harness/" + script;
+  const std::string path = sim::DataDir() + "/harness/" + script;
   const std::string python =
       std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   std::string cmd = python + " " + ShellQuoted(path);
@@ -42,6 +47,42 @@ bool RunPythonScript(const std::string& script, const std::vector<std::string>& 
 
 bool RunPlot(const std::vector<std::string>& args, std::string* error) {
   return RunPythonScript("plot.py", args, error);
+}
+
+std::string SceneOutlineCsv(const std::vector<sim::SceneWall>& walls) {
+  std::string csv = "wall,x0_m,y0_m,x1_m,y1_m\n";
+  char row[256];
+  for (const sim::SceneWall& w : walls) {
+    if (!std::isfinite(w.half_length_m)) continue;  // an infinite plane: no ends to draw
+    const Eigen::Vector2d a = w.centre_xy - w.half_length_m * w.along_xy;
+    const Eigen::Vector2d b = w.centre_xy + w.half_length_m * w.along_xy;
+    std::snprintf(row, sizeof(row), ",%.9g,%.9g,%.9g,%.9g\n", a.x(), a.y(), b.x(), b.y());
+    csv += w.name + row;
+  }
+  return csv;
+}
+
+bool RunTrajectoryPlot(const std::string& gt_tum, const std::string& est_tum,
+                       const std::string& png, const std::string& scene_path, std::string* error) {
+  std::vector<std::string> args = {"trajectory", gt_tum, est_tum, png};
+  if (scene_path.empty()) return RunPlot(args, error);
+  std::vector<sim::SceneWall> walls;
+  if (!sim::WallsOfScene(scene_path, &walls, error)) return false;
+  const std::string outline = png + ".outline.csv";
+  {
+    std::ofstream out(outline);
+    out << SceneOutlineCsv(walls);
+    if (!out.flush()) {
+      *error = outline + ": cannot write the scene outline";
+      return false;
+    }
+  }
+  args.push_back("--outline-file");
+  args.push_back(outline);
+  const bool ok = RunPlot(args, error);
+  std::error_code ec;
+  std::filesystem::remove(outline, ec);
+  return ok;
 }
 
 }  // namespace harness

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "sim/scene_walls.h"
+
 namespace harness {
 
 // Runs `plot.py ARGS...`; false (with *error) when python3 or matplotlib is missing or the
@@ -15,6 +17,16 @@ bool RunPlot(const std::vector<std::string>& args, std::string* error);
 // script's output) when it cannot start or fails.
 bool RunPythonScript(const std::string& script, const std::vector<std::string>& args,
                      std::string* error);
+
+// The top-down outline of a scene for `plot.py trajectory --outline-file`: CSV with the header
+// `wall,x0_m,y0_m,x1_m,y1_m` and one row per wall of finite length (its two ends in the world,
+// metres), in the order of the scene's geoms.
+std::string SceneOutlineCsv(const std::vector<sim::SceneWall>& walls);
+
+// `plot.py trajectory GT_TUM EST_TUM PNG`, outlined by the walls of the MJCF scene `scene_path`
+// ("" = no outline; the outline goes through a file next to the PNG, removed afterwards).
+bool RunTrajectoryPlot(const std::string& gt_tum, const std::string& est_tum,
+                       const std::string& png, const std::string& scene_path, std::string* error);
 
 // `s` quoted for the POSIX shell (as it is when it holds only safe characters).
 std::string ShellQuoted(const std::string& s);

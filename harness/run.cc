@@ -33,14 +33,14 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   contents.options_yaml = VoConfigToYaml(odometry->options());
   contents.scenario_yaml = scenario_yaml;
   contents.plots = options.plots;
-  contents.outline = options.outline;
+  contents.outline_scene = options.outline_scene;
   return WriteRunFolder(records, *summary, contents, options.out_dir, &folder, error);
 }
 
 bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_options,
                  const RunOptions& options, RunSummary* summary, std::string* error) {
   RunOptions o = options;
-  if (o.outline.empty()) o.outline = sequence.outline;
+  if (o.outline_scene.empty()) o.outline_scene = sequence.outline_scene;
   return RunOdometry(sequence.name, sequence.camera, sequence.next, sequence.expected_frames,
                      vo_options, o, sequence.scenario_yaml, summary, error);
 }

@@ -28,7 +28,7 @@ struct RunOptions {
   std::string out_dir;        // run folder; replaced if it holds an earlier run
   bool progress = true;       // progress display on stderr
   bool plots = true;          // PNG plots (python3-matplotlib)
-  std::string outline;        // hallway outline name for the trajectory plot ("" = none)
+  std::string outline_scene;  // MJCF scene whose walls outline the trajectory plot ("" = none)
   int max_frames = 0;         // stop after this many frames of the source (0 = all)
   int frame_stride = 1;       // the VO sees every k-th source frame (0, k, 2k, ...; less overlap
                               // between its frames), >= 1; metrics are on those frames

@@ -150,18 +150,15 @@ bool OpenRunFolder(const std::string& dir, OutputFolder* folder, std::string* er
   return folder->Create(dir, "run", error);
 }
 
-void MakePlots(const std::string& folder, bool has_ground_truth, const std::string& outline) {
+void MakePlots(const std::string& folder, bool has_ground_truth, const std::string& outline_scene) {
   const fs::path p = folder;
   std::string plot_error;
   bool ok = true;
   if (has_ground_truth) {
-    std::vector<std::string> args = {"trajectory", (p / "groundtruth_tum.txt").string(),
-                                     (p / "estimate_in_gt_world_tum.txt").string(), (p / "trajectory.png").string()};
-    if (!outline.empty()) {
-      args.push_back("--outline");
-      args.push_back(outline);
-    }
-    ok = RunPlot(args, &plot_error) && RunPlot({"errors", p.string(), (p / "errors.png").string()}, &plot_error);
+    ok = RunTrajectoryPlot((p / "groundtruth_tum.txt").string(),
+                           (p / "estimate_in_gt_world_tum.txt").string(),
+                           (p / "trajectory.png").string(), outline_scene, &plot_error) &&
+         RunPlot({"errors", p.string(), (p / "errors.png").string()}, &plot_error);
   }
   ok = ok && RunPlot({"timing", p.string(), (p / "timing.png").string()}, &plot_error);
   if (!ok) std::fprintf(stderr, "warning: plots not made: %s\n", plot_error.c_str());
@@ -195,7 +192,7 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s, const RunFol
                   error))
       return false;
   }
-  if (contents.plots) MakePlots(p.string(), s.has_ground_truth, contents.outline);
+  if (contents.plots) MakePlots(p.string(), s.has_ground_truth, contents.outline_scene);
   if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(s, contents.options_yaml), error))
     return false;
   const int frames = static_cast<int>(t.times.size());

@@ -31,7 +31,7 @@ struct RunFolderContents {
   std::string options_yaml;   // effective VO options (vo_options.yaml)
   std::string scenario_yaml;  // effective scenario (scenario.yaml; "" = none)
   bool plots = true;          // PNG plots (python3-matplotlib)
-  std::string outline;        // hallway outline name for the trajectory plot ("" = none)
+  std::string outline_scene;  // MJCF scene whose walls outline the trajectory plot ("" = none)
 };
 
 // Opens DIR for writing (locked, into a marked work folder): refused when DIR exists and is not
@@ -46,7 +46,7 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& summary,
 
 // The plots of a written run folder (trajectory.png and errors.png with ground truth,
 // timing.png); a missing python3-matplotlib gives a warning on stderr, not an error.
-void MakePlots(const std::string& folder, bool has_ground_truth, const std::string& outline);
+void MakePlots(const std::string& folder, bool has_ground_truth, const std::string& outline_scene);
 
 // The per-frame log (per_frame.csv): one row per frame, frames before the first initialised
 // one marked not_initialised (no pose, no error).

@@ -15,6 +15,7 @@
 #include "harness/overrides.h"
 #include "harness/suite.h"
 #include "harness/vo_config.h"
+#include "sim/data_dir.h"
 
 namespace harness {
 namespace {
@@ -120,8 +121,8 @@ void RunCheckCommand(const CheckArgs& a) {
   std::string error;
   Baseline baseline = DefaultBaselineRule();
   std::string baseline_path = a.baseline;
-  // The default baseline is found from any folder (it lives in the source tree).
-  const std::string in_source = std::string(VOBENCH_SOURCE_DIR) + "/" + a.baseline;
+  // The default baseline is found from any folder (it lives in the data folder, sim/data_dir.h).
+  const std::string in_source = sim::DataDir() + "/" + a.baseline;
   if (!a.update && fs::path(a.baseline).is_relative() && !fs::exists(a.baseline) &&
       fs::exists(in_source))
     baseline_path = in_source;

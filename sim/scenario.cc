@@ -8,6 +8,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "sim/data_dir.h"
 #include "sim/yaml_input.h"
 
 namespace sim {
@@ -400,7 +401,7 @@ std::string ScenarioToYaml(const Scenario& s) {
 }
 
 std::string BuiltinScenarioPath(const std::string& name) {
-  return (fs::path(VOBENCH_SCENES_DIR) / (name + ".yaml")).string();
+  return (fs::path(DataDir()) / "scenes" / (name + ".yaml")).string();
 }
 
 }  // namespace sim

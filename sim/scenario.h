@@ -93,7 +93,8 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
 // Writes the effective scenario as YAML (every field, defaults included).
 std::string ScenarioToYaml(const Scenario& scenario);
 
-// Path of a scenario shipped in scenes/ by name ("l_hallway" -> <scenes>/l_hallway.yaml).
+// Path of a scenario shipped in scenes/ by name ("l_hallway" -> <data dir>/scenes/l_hallway.yaml,
+// sim/data_dir.h: the source tree, or <prefix>/share/vobench when installed).
 std::string BuiltinScenarioPath(const std::string& name);
 
 }  // namespace sim

@@ -59,6 +59,19 @@ void WallsOfModel(const mjModel* m, std::vector<SceneWall>* walls) {
   mj_deleteData(d);
 }
 
+bool WallsOfScene(const std::string& scene_path, std::vector<SceneWall>* walls,
+                  std::string* error) {
+  char load_error[1024] = "";
+  mjModel* m = mj_loadXML(scene_path.c_str(), nullptr, load_error, sizeof(load_error));
+  if (!m) {
+    *error = scene_path + ": cannot load MJCF scene: " + load_error;
+    return false;
+  }
+  WallsOfModel(m, walls);
+  mj_deleteModel(m);
+  return true;
+}
+
 std::string PathThroughWallProblem(const Scenario& s, const std::vector<SceneWall>& walls,
                                    int* waypoint) {
   const double camera_z = s.camera.height_m;

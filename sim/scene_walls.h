@@ -36,4 +36,8 @@ std::string PathThroughWallProblem(const Scenario& scenario, const std::vector<S
 // The walls of a loaded model (Simulator::Create checks the path against its own model's).
 void WallsOfModel(const mjModel* m, std::vector<SceneWall>* walls);
 
+// The walls of the MJCF scene at `scene_path` (loads it): false with *error naming the file when
+// it cannot be loaded.
+bool WallsOfScene(const std::string& scene_path, std::vector<SceneWall>* walls, std::string* error);
+
 }  // namespace sim
