@@ -1,4 +1,4 @@
-// Windowed sparse bundle adjustment of a stereo head. Kwolek, PAPER.md
+// Windowed sparse bundle adjustment of a stereo head. Kwolek, docs/PAPER.md
 // "refinement", section V: minimise the squared reprojection error, eq. (8),
 //   min over poses P_i and points X_j of  Σ_i Σ_j d(P_i X_j, x_ij)²,
 // over the last few frames (paper: 3–5, 10 wished for), pose as quaternion + translation

@@ -1,6 +1,6 @@
 // Rectified stereo pinhole camera model shared by every VO stage.
 //
-// Conventions (see DESIGN.md): computer-vision camera axes (x right, y down, z forward);
+// Conventions (see docs/DESIGN.md): computer-vision camera axes (x right, y down, z forward);
 // pixel centres at integer coordinates (OpenCV convention: the top-left pixel covers
 // [-0.5, 0.5]^2). cam1 (right) sits at +baseline_m along cam0's x axis and has the same
 // intrinsics and orientation: T_cam0_cam1 = [I | (baseline_m, 0, 0)].

@@ -1,6 +1,6 @@
 // Dense area-based disparity for a rectified stereo pair, and 3D for sparse features.
 //
-// The paper (Kwolek, PAPER.md, "depth") takes 3D from a dense disparity map computed by the
+// The paper (Kwolek, docs/PAPER.md, "depth") takes 3D from a dense disparity map computed by the
 // SRI Small Vision System (Konolige 1997, "Small Vision Systems: Hardware and
 // Implementation"): correlation of small windows along the epipolar line, sub-pixel
 // interpolation, then two post-filters: a confidence (texture) filter and a left-right

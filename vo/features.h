@@ -1,5 +1,5 @@
 // Feature detection in the left image: Harris corners (the paper's choice) or SIFT (its
-// alternative). Kwolek, PAPER.md, "features": Harris corners, 0.04 s per 320x240 frame on a
+// alternative). Kwolek, docs/PAPER.md, "features": Harris corners, 0.04 s per 320x240 frame on a
 // Pentium IV; SIFT 0.94 s.
 //
 // Plug-in point: FeatureDetector is a small interface; a new detector = a .h/.cc pair, a

@@ -1,5 +1,5 @@
 // Closed-form rigid motion between two matched 3D point sets with unit quaternions:
-// Kwolek, PAPER.md "pose, rough", eq. (6)-(7), after Horn (1987), "Closed-form solution of
+// Kwolek, docs/PAPER.md "pose, rough", eq. (6)-(7), after Horn (1987), "Closed-form solution of
 // absolute orientation using unit quaternions", JOSA A 4(4).
 //
 // Given matched points u_i (source) and v_i (target) with v_i ≈ R u_i + t, the estimate

@@ -1,5 +1,5 @@
 // The stereo visual-odometry pipeline: one call per stereo pair, the camera's pose back.
-// Kwolek, PAPER.md (the whole table), sections IV–V of the paper:
+// Kwolek, docs/PAPER.md (the whole table), sections IV–V of the paper:
 //
 //   frame 0      dense disparity → features (left image) → depth → [plane-based initial
 //                orientation]

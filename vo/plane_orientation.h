@@ -1,5 +1,5 @@
 // Initial orientation of the stereo head from the first frame's 3D points, for a piecewise-
-// planar indoor scene. Kwolek, PAPER.md "initial orientation" / section VI: the paper runs
+// planar indoor scene. Kwolek, docs/PAPER.md "initial orientation" / section VI: the paper runs
 // POSIT (DeMenthon & Davis 1995) on the output of a plane extractor. With stereo depth the
 // planes already give the orientation directly, so no POSIT is needed: we extract the
 // dominant planes (floor, walls, ceiling) and read the camera's orientation off their normals.

@@ -1,5 +1,5 @@
 // Robust frame-to-frame motion of a stereo head: RANSAC (Fischler & Bolles 1981) around the
-// closed-form quaternion estimator of horn.h. Kwolek, PAPER.md "outliers": RANSAC seeded with
+// closed-form quaternion estimator of horn.h. Kwolek, docs/PAPER.md "outliers": RANSAC seeded with
 // features tracked stably over the last frames; iteration count from the desired confidence
 // (Stewart 1999, "Robust parameter estimation in computer vision", SIAM Review 41(3)).
 //

@@ -11,7 +11,7 @@
 // are p_world (metres); every point a residual refers to is free. One residual block per
 // observation: [u_l, v_l, u_r, v_r] − observed (pixels) for a stereo one, [u_l, v_l] − observed
 // for a left-only one, with p_cam0 = R_world_cam0ᵀ (p_world − t_world_cam0) (eq. (8) of
-// PAPER.md, both cameras). Cost = ½ Σ ρ(s), s = the block's squared norm, ρ the robust loss.
+// docs/PAPER.md, both cameras). Cost = ½ Σ ρ(s), s = the block's squared norm, ρ the robust loss.
 //
 // Tangent space (ceres::EigenQuaternionManifold × EuclideanManifold<3>): a pose moves by
 // δ = [δθ, δt] as q ← [cos|δθ|, sin|δθ| δθ/|δθ|] ⊗ q (a rotation by 2|δθ| applied on the

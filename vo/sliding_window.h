@@ -1,4 +1,4 @@
-// The back end of the pipeline (Kwolek, PAPER.md "refinement", section V): the feature tracks
+// The back end of the pipeline (Kwolek, docs/PAPER.md "refinement", section V): the feature tracks
 // of the last few frames, those frames' poses, and the windowed bundle adjustment with its
 // divergence guard. StereoOdometry (odometry.h) keeps the front end, RANSAC, the blend with
 // the motion prior and the tracking status; this class owns what the window remembers.

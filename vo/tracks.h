@@ -1,7 +1,7 @@
 // Multi-frame feature tracks: chains the inter-frame matches (previous → current, one-to-one)
 // into tracks with persistent ids, and keeps each track's observations over a sliding window
 // of the last `window_size` frames, as the windowed bundle adjustment needs them
-// (Kwolek, PAPER.md "refinement": SBA over 3–5 frames; features live 4–5 frames).
+// (Kwolek, docs/PAPER.md "refinement": SBA over 3–5 frames; features live 4–5 frames).
 //
 // Rules, per AddFrame(frame_id, features, matches):
 //   * a current feature reached by a match inherits the previous feature's track: same

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Include-boundary gate: the dependency direction of DESIGN.md ("The house"), checked on the
+# Include-boundary gate: the dependency direction of docs/DESIGN.md ("The house"), checked on the
 # #include lines of the modules' own sources (every *.h/*.cc under vo/, sim/, harness/).
 #   vo/       includes vo/ only, never MuJoCo or OpenGL (usable without the simulator)
 #   sim/      includes sim/ only (never vo/ or harness/)
@@ -32,10 +32,10 @@ for m in "${modules[@]}"; do
            [[ " ${allowed[$m]} " != *" $top "* ]]; then
         # shellcheck disable=SC2086  # the list is split into its words on purpose
         ok_list="$(printf '%s/, ' ${allowed[$m]})"
-        why="$m/ may include only ${ok_list%, } (DESIGN.md: $m/ never depends on $top/)"
+        why="$m/ may include only ${ok_list%, } (docs/DESIGN.md: $m/ never depends on $top/)"
       else
         for p in ${forbidden_third_party[$m]}; do
-          [[ "$inc" == "$p"* ]] && why="$m/ must build without ${p%/} (DESIGN.md: vo/ never uses MuJoCo or OpenGL)"
+          [[ "$inc" == "$p"* ]] && why="$m/ must build without ${p%/} (docs/DESIGN.md: vo/ never uses MuJoCo or OpenGL)"
         done
       fi
       if [ -n "$why" ]; then

@@ -22,7 +22,7 @@ constexpr double kSeamTolRad = 1e-6;  // exact features and matches: the pipelin
 constexpr double kSeamTolM = 1e-6;
 constexpr double kDeg = M_PI / 180.0;
 
-// The simulator's hallway rig (DESIGN.md / the harness): 320x240, fx ≈ 230 px, 0.09 m.
+// The simulator's hallway rig (docs/DESIGN.md / the harness): 320x240, fx ≈ 230 px, 0.09 m.
 StereoCamera HallwayCamera() {
   StereoCamera cam;
   cam.width = 320;
