@@ -5,7 +5,7 @@
 # local job slots instead of ssh hosts (`nodes` = "2/:", GNU parallel's name for this machine),
 # a 4-run suite of 12 frames per run instead of suites/hallway.yaml, a temporary folder instead
 # of /srv/vobench, and no rsync (one machine). Compared: summary.csv without its timing columns
-# (vo_ms_median, vo_ms_p95, wall_s) and every run's trajectory.
+# (vo_ms_*, stage_ms_median.*, wall_s: the wall-clock ones) and every run's trajectory.
 # Usage: tests/gates/parallel_shards.sh VOBENCH_BINARY
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -62,7 +62,7 @@ deterministic() {
   /usr/bin/python3 - "$1" <<'PY'
 import csv, sys
 rows = list(csv.reader(open(sys.argv[1])))
-keep = [i for i, c in enumerate(rows[0]) if c not in ("vo_ms_median", "vo_ms_p95", "wall_s")]
+keep = [i for i, c in enumerate(rows[0]) if not (c.startswith(("vo_ms_", "stage_ms_")) or c == "wall_s")]
 for r in rows:
     print(",".join(r[i] for i in keep))
 PY

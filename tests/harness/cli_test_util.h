@@ -1,12 +1,18 @@
 // Helpers for tests that run the `vobench` command and read the files it writes.
 #pragma once
 
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
+
+extern char** environ;
 
 namespace vobench_test {
 
@@ -26,6 +32,25 @@ inline CommandResult RunVobench(const std::string& args, const std::string& dir 
   while (pipe && fgets(buf, sizeof(buf), pipe)) out += buf;
   const int status = pipe ? pclose(pipe) : -1;
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+// Starts `vobench ARGS...` (VOBENCH_BINARY) in the background with stdout and stderr into
+// `log`; its pid, or -1 when it could not start. The caller waits for it (waitpid).
+inline pid_t StartVobench(const std::vector<std::string>& args, const std::string& log) {
+  std::vector<std::string> argv = {VOBENCH_BINARY};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> c_argv;
+  for (auto& a : argv) c_argv.push_back(a.data());
+  c_argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, c_argv[0], &actions, nullptr, c_argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return rc == 0 ? pid : -1;
 }
 
 // The whole file as bytes ("" when it cannot be read).

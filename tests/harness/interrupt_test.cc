@@ -20,8 +20,6 @@
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
 
-extern char** environ;
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -35,20 +33,7 @@ constexpr auto kStopTimeout = std::chrono::seconds(30);   // until it has stoppe
 
 // Starts `vobench ARGS...` with stdout and stderr into `log`.
 pid_t Start(const std::vector<std::string>& args, const std::string& log) {
-  std::vector<std::string> argv = {VOBENCH_BINARY};
-  argv.insert(argv.end(), args.begin(), args.end());
-  std::vector<char*> c_argv;
-  for (auto& a : argv) c_argv.push_back(a.data());
-  c_argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, c_argv[0], &actions, nullptr, c_argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  return rc == 0 ? pid : -1;
+  return vobench_test::StartVobench(args, log);
 }
 
 // Waits for `pid` to end; its wait status, or -1 on timeout (then it is killed).

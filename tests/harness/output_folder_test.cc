@@ -24,7 +24,6 @@
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
 
-extern char** environ;
 
 namespace {
 
@@ -412,19 +411,9 @@ TEST(OwnershipCliTest, SecondConcurrentWriterFailsFastAndTheFirstCompletes) {
   TempDir dir("own_concurrent");
   const std::string out = dir / "o";
   const std::string log = dir / "first.log";
-  std::vector<std::string> args = {
-      VOBENCH_BINARY, "run", "l_hallway", "--max-frames", "80", "--no-plots", "-q", "--out", out};
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  pid_t first = -1;
-  ASSERT_EQ(posix_spawn(&first, argv[0], &actions, nullptr, argv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&actions);
+  const pid_t first = vobench_test::StartVobench(
+      {"run", "l_hallway", "--max-frames", "80", "--no-plots", "-q", "--out", out}, log);
+  ASSERT_GT(first, 0);
   // Once the first holds the folder (its work folder exists), start the second.
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (EntriesStartingWith(dir.str(), "o.partial-").empty() &&
