@@ -653,14 +653,16 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   result.num_matches = static_cast<int>(matches.size());
   result.prediction = attempt.source;
 
-  // Too few matches or inliers for a consensus: the few-point solver with the prior.
+  // Too few matches for a consensus, or a frame with fewer than min_features features (matched
+  // only for this): the few-point solver with the prior. Such a frame takes no RANSAC motion.
   const RobustTrackingOptions& tracking = options_.tracking;
-  const bool ransac_failed =
-      !ransac.ok() || ransac.num_inliers < options_.min_inliers || !IsFinite(ransac.T_prev_curr);
+  const bool few_features = static_cast<int>(frame.features.size()) < options_.min_features;
+  bool ransac_failed = few_features || !ransac.ok() || ransac.num_inliers < options_.min_inliers ||
+                       !IsFinite(ransac.T_prev_curr);
   if (ransac_failed && tracking.few_point_motion && T_ref_curr_prior != nullptr &&
       previous_measured_ && consecutive_lost_ == 0 &&
       options_.matcher.prediction != PredictionMode::kNone && !correspondences.empty() &&
-      static_cast<int>(correspondences.size()) < options_.min_inliers) {
+      (few_features || static_cast<int>(correspondences.size()) < options_.min_inliers)) {
     const PriorMotionResult few =
         EstimateMotionWithPrior(camera_, correspondences, *T_ref_curr_prior, tracking.few_point);
     bool agrees = few.ok;
@@ -713,7 +715,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
 
   if (!result.few_point_motion && ransac_failed) {
     std::ostringstream why;
-    why << "motion failed: " << (ransac.ok() ? "too few inliers" : ToString(ransac.status)) << " ("
+    why << "motion failed: "
+        << (few_features  ? "too few features for RANSAC, no few-point motion"
+            : ransac.ok() ? "too few inliers"
+                          : ToString(ransac.status))
+        << " ("
         << ransac.num_inliers << " inliers of " << correspondences.size() << " correspondences, "
         << matches.size() << " matches; need " << options_.min_inliers << ")";
     if (!ransac.message.empty()) why << ": " << ransac.message;

@@ -77,8 +77,9 @@
 //
 // Few points (tracking.few_point_motion, beyond the paper). While tracking normally (the
 // previous frame's motion measured, no loss since), a frame with too few matches for RANSAC
-// (fewer correspondences than min_inliers; fewer than min_features features with depth is
-// fine down to tracking.few_point_min_features) takes the few-point motion of prior_motion.h:
+// (fewer correspondences than min_inliers), or with fewer than min_features features with
+// depth (down to tracking.few_point_min_features; such a frame takes no RANSAC motion, only
+// this one), takes the few-point motion of prior_motion.h:
 // the prior corrected by the few matches (inliers >= few_point.min_inliers and >=
 // few_point.min_inlier_fraction of them), unless the frame's coarse-to-fine image shift
 // contradicts it (few_point_max_shift_disagreement_px). That frame is not bundle-adjusted
