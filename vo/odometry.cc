@@ -136,6 +136,9 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
   if (coarse_to_fine && !image_shift.IsValid(&part_error)) {
     return FailPart("image_shift", part_error, error);
   }
+  if (few_point_motion && !few_point.IsValid(&part_error)) {
+    return FailPart("few_point", part_error, error);
+  }
   std::ostringstream msg;
   if (!(prior_radius_scale >= 0.05 && prior_radius_scale <= 20.0)) {
     msg << "prior_radius_scale must be in [0.05, 20], got " << prior_radius_scale;
@@ -155,6 +158,14 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
     msg << "rotation_min_residual_px must be finite and >= 0, got " << rotation_min_residual_px;
   } else if (reliable_min_inliers < 3) {
     msg << "reliable_min_inliers must be >= 3, got " << reliable_min_inliers;
+  } else if (!(few_point_max_shift_disagreement_px >= 0.0) ||
+             !std::isfinite(few_point_max_shift_disagreement_px)) {
+    msg << "few_point_max_shift_disagreement_px must be finite and >= 0, got "
+        << few_point_max_shift_disagreement_px;
+  } else if (few_point_min_features < 1) {
+    msg << "few_point_min_features must be >= 1, got " << few_point_min_features;
+  } else if (!(few_point_prior_update >= 0.0 && few_point_prior_update <= 1.0)) {
+    msg << "few_point_prior_update must be in [0, 1], got " << few_point_prior_update;
   }
   if (msg.tellp() != 0) return Fail(msg, error);
   return true;
@@ -311,6 +322,7 @@ void StereoOdometry::Reset() {
   frame_index_ = 0;
   initialised_ = false;
   consecutive_lost_ = 0;
+  previous_measured_ = false;
   reference_ = Reference();
   T_world_prev_ = Eigen::Isometry3d::Identity();
   velocity_ = Eigen::Isometry3d::Identity();
@@ -338,6 +350,7 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
   result.T_prev_curr = result.frame_index == 0 ? Eigen::Isometry3d::Identity()
                                                : Eigen::Isometry3d(T_world_prev_.inverse() * T);
   T_world_prev_ = T;
+  previous_measured_ = result.motion_measured;
   // Next frame's disparity search range from the depths of this one (full after a loss).
   scene_num_disparities_ = 0;
   if (options_.disparity_range_from_scene && result.status != TrackingStatus::kLost) {
@@ -356,6 +369,21 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
   current_left_ = cv::Mat();
   result.times.total_ms = MsSince(start);
   return result;
+}
+
+Eigen::Vector2d PredictedCentreShift(const StereoCamera& camera,
+                                     const Eigen::Isometry3d& T_ref_curr, double depth_m) {
+  const Eigen::Vector2d centre(camera.cx_px, camera.cy_px);
+  const bool near = std::isfinite(depth_m) && depth_m > 0.0;
+  const Eigen::Isometry3d T_curr_ref = T_ref_curr.inverse();
+  const Eigen::Vector3d ray(0.0, 0.0, 1.0);
+  const Eigen::Vector3d p_curr = near ? Eigen::Vector3d(T_curr_ref * (depth_m * ray))
+                                      : Eigen::Vector3d(T_curr_ref.linear() * ray);
+  if (!(p_curr.z() > 1e-9)) {
+    return Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  }
+  return Eigen::Vector2d(camera.fx_px * p_curr.x() / p_curr.z(),
+                         camera.fy_px * p_curr.y() / p_curr.z());
 }
 
 Eigen::Isometry3d CorrectPriorWithImageShift(const StereoCamera& camera,
@@ -621,9 +649,56 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const std::vector<Match>& matches = attempt.matches;
   const std::vector<StereoCorrespondence>& correspondences = attempt.correspondences;
   const std::vector<int>& match_index = attempt.match_index;
-  const RansacResult& ransac = attempt.ransac;
+  RansacResult& ransac = attempt.ransac;
   result.num_matches = static_cast<int>(matches.size());
   result.prediction = attempt.source;
+
+  // Too few matches for a consensus, or a frame with fewer than min_features features (matched
+  // only for this): the few-point solver with the prior. Such a frame takes no RANSAC motion.
+  const RobustTrackingOptions& tracking = options_.tracking;
+  const bool few_features = static_cast<int>(frame.features.size()) < options_.min_features;
+  bool ransac_failed = few_features || !ransac.ok() || ransac.num_inliers < options_.min_inliers ||
+                       !IsFinite(ransac.T_prev_curr);
+  if (ransac_failed && tracking.few_point_motion && T_ref_curr_prior != nullptr &&
+      previous_measured_ && consecutive_lost_ == 0 &&
+      options_.matcher.prediction != PredictionMode::kNone && !correspondences.empty() &&
+      (few_features || static_cast<int>(correspondences.size()) < options_.min_inliers)) {
+    const PriorMotionResult few =
+        EstimateMotionWithPrior(camera_, correspondences, *T_ref_curr_prior, tracking.few_point);
+    bool agrees = few.ok;
+    if (few.ok && result.image_shift_ok) {
+      // The image shift the motions predict at the image centre (reference's median depth)
+      // against the measured one.
+      std::vector<double> z;
+      for (const Feature& f : ref_features) {
+        if (f.has_depth() && f.p_cam0.allFinite()) z.push_back(f.p_cam0.z());
+      }
+      double depth_m = -1.0;
+      if (!z.empty()) {
+        std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+        depth_m = z[z.size() / 2];
+      }
+      const double few_px =
+          (PredictedCentreShift(camera_, few.T_prev_curr, depth_m) - result.image_shift_px).norm();
+      const double prior_px =
+          (PredictedCentreShift(camera_, *T_ref_curr_prior, depth_m) - result.image_shift_px)
+              .norm();
+      agrees = few_px <= prior_px + tracking.few_point_max_shift_disagreement_px;
+    }
+    if (agrees) {
+      ransac.status = RansacResult::Status::kOk;
+      ransac.message.clear();
+      ransac.T_prev_curr = few.T_prev_curr;
+      ransac.inlier_mask = few.inlier_mask;
+      ransac.num_inliers = few.num_inliers;
+      ransac.rms_reprojection_px = few.rms_reprojection_px;
+      result.few_point_motion = true;
+      std::ostringstream msg;
+      msg << "few-point motion with the prior (" << few.num_inliers << " inliers of "
+          << correspondences.size() << " correspondences)";
+      result.message = msg.str();
+    }
+  }
 
   last_matches_ = matches;
   last_inlier_mask_.assign(matches.size(), false);
@@ -638,9 +713,13 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   last_features_ = frame.features;
   result.num_inliers = ransac.ok() ? ransac.num_inliers : 0;
 
-  if (!ransac.ok() || ransac.num_inliers < options_.min_inliers || !IsFinite(ransac.T_prev_curr)) {
+  if (!result.few_point_motion && ransac_failed) {
     std::ostringstream why;
-    why << "motion failed: " << (ransac.ok() ? "too few inliers" : ToString(ransac.status)) << " ("
+    why << "motion failed: "
+        << (few_features  ? "too few features for RANSAC, no few-point motion"
+            : ransac.ok() ? "too few inliers"
+                          : ToString(ransac.status))
+        << " ("
         << ransac.num_inliers << " inliers of " << correspondences.size() << " correspondences, "
         << matches.size() << " matches; need " << options_.min_inliers << ")";
     if (!ransac.message.empty()) why << ": " << ransac.message;
@@ -661,7 +740,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const int64_t gap = result.frame_index - reference_.frame_index;
   const double inlier_ratio =
       static_cast<double>(ransac.num_inliers) / std::max<size_t>(1, matches.size());
-  const double w = T_ref_curr_prior != nullptr
+  // (A few-point motion already is the prior's fit to the matches: no second blend.)
+  const double w = T_ref_curr_prior != nullptr && !result.few_point_motion
                        ? options_.prior_weight * (1.0 - std::min(1.0, inlier_ratio))
                        : 0.0;
   const Eigen::Isometry3d T_ref_curr_initial = T_ref_curr_prior != nullptr
@@ -687,7 +767,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
 
   // Windowed bundle adjustment, the oldest pose(s) fixed (sliding_window.h).
   const Clock::time_point ba_start = Clock::now();
-  const WindowRefinement refinement = window_.Refine(camera_, result.frame_index);
+  const WindowRefinement refinement =
+      result.few_point_motion ? WindowRefinement() : window_.Refine(camera_, result.frame_index);
   if (refinement.attempted) result.times.ba_ms = MsSince(ba_start);
   const bool ba_rejected = refinement.rejected;
   if (ba_rejected) result.message = refinement.message;
@@ -709,9 +790,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
   // Weight of this motion in the prior: 1 from reliable_min_inliers inliers up, less below
   // (a weak motion moves the prior only part of the way), 0 when the BA was rejected.
-  const double weight = ba_rejected ? 0.0
-                                    : std::min(1.0, static_cast<double>(ransac.num_inliers) /
-                                                        options_.tracking.reliable_min_inliers);
+  const double weight =
+      ba_rejected               ? 0.0
+      : result.few_point_motion ? tracking.few_point_prior_update
+                                : std::min(1.0, static_cast<double>(ransac.num_inliers) /
+                                                    tracking.reliable_min_inliers);
   if (IsFinite(per_frame) && (weight > 0.0 || !has_velocity_)) {
     velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
     has_velocity_ = true;
@@ -821,7 +904,14 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   result.times.depth_ms = MsSince(t);
   result.num_features_with_depth = static_cast<int>(frame.features.size());
   last_features_ = frame.features;
-  if (result.num_features_with_depth < options_.min_features) {
+  // Below min_features a frame is still matched when the few-point solver can use it (a
+  // reference, a prior, at least few_point_min_features features).
+  const bool few_point_possible =
+      options_.tracking.few_point_motion && options_.matcher.prediction != PredictionMode::kNone &&
+      reference_.valid && (prior != nullptr || has_velocity_) && previous_measured_ &&
+      consecutive_lost_ == 0 &&
+      result.num_features_with_depth >= options_.tracking.few_point_min_features;
+  if (result.num_features_with_depth < options_.min_features && !few_point_possible) {
     std::ostringstream msg;
     msg << "too few features with depth (" << result.num_features_with_depth << " of "
         << result.num_features << " features; need " << options_.min_features
@@ -933,7 +1023,11 @@ OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
   }
   prev_call_index_map_.clear();
 
-  if (result.num_features_with_depth < options_.min_features) {
+  const bool few_point_possible =
+      options_.tracking.few_point_motion && options_.matcher.prediction != PredictionMode::kNone &&
+      prev_is_reference && has_velocity_ && previous_measured_ &&
+      result.num_features_with_depth >= options_.tracking.few_point_min_features;
+  if (result.num_features_with_depth < options_.min_features && !few_point_possible) {
     std::ostringstream msg;
     msg << "too few features with depth (" << result.num_features_with_depth << " of "
         << result.num_features << "; need " << options_.min_features << ")";

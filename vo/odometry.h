@@ -58,7 +58,8 @@
 // its input is invalid (empty, not CV_8UC1, sizes differ from each other or from the camera),
 // its disparity fails, it has fewer than min_features features with depth (black or
 // textureless frame), or the motion fails (RANSAC without consensus, fewer than min_inliers
-// inliers). Its pose is the prior's prediction from the previous output, never NaN — corrected,
+// inliers; but see "Few points" below). Its pose is the prior's prediction from the previous
+// output, never NaN — corrected,
 // when the image shift from the previous frame is found (tracking.rotation_from_shift), by the
 // rotation that explains that shift (CorrectPriorWithImageShift): a turn in front of a plain
 // wall is followed, not extrapolated. The reference frame, the tracks and the window are kept.
@@ -73,6 +74,19 @@
 // long weakly textured stretch still updates it. Frames without a measured motion (lost and
 // re-initialised ones) are what IsLostFrame() counts. The frame after a kRecovered frame is
 // kTracking again.
+//
+// Few points (tracking.few_point_motion, beyond the paper; off by default, see the option).
+// While tracking normally (the
+// previous frame's motion measured, no loss since), a frame with too few matches for RANSAC
+// (fewer correspondences than min_inliers), or with fewer than min_features features with
+// depth (down to tracking.few_point_min_features; such a frame takes no RANSAC motion, only
+// this one), takes the few-point motion of prior_motion.h:
+// the prior corrected by the few matches (inliers >= few_point.min_inliers and >=
+// few_point.min_inlier_fraction of them), unless the frame's coarse-to-fine image shift
+// contradicts it (few_point_max_shift_disagreement_px). That frame is not bundle-adjusted
+// (OdometryResult::few_point_motion). A plain end wall with two or three specks in front of a
+// robot that stops and turns (l_hallway's texture seeds) is followed that way, not bridged.
+// After a loss the prior is a bridge, not a measurement, and the solver is not used.
 //
 // Determinism: every random choice is seeded (RANSAC, plane extraction), the bundle
 // adjustment is single-threaded; the same inputs give bit-identical outputs. Global OpenCV
@@ -98,6 +112,7 @@
 #include "vo/image_motion.h"
 #include "vo/matcher.h"
 #include "vo/plane_orientation.h"
+#include "vo/prior_motion.h"
 #include "vo/ransac.h"
 #include "vo/tracks.h"
 #include "vo/types.h"
@@ -174,6 +189,35 @@ struct RobustTrackingOptions {
                                            // adjustment was rejected not at all; >= 3. 30 =
                                            // confident_min_inliers: a motion the matcher trusts is
                                            // one the prior may repeat
+  bool few_point_motion = false;  // OFF by default (measured, l_hallway texture seeds 1-10:
+                                 // stride 1 lost frames 113 -> 38, median end-pose error
+                                 // 0.347 -> 0.152 m, but strides 2 and 3 worse on seeds 2, 5,
+                                 // 10: median 0.256 -> 0.331 m at stride 2). On: when RANSAC
+                                 // finds no consensus (too few features or
+                                 // matches: a plain wall in front of the camera), the motion is
+                                 // estimated from the few matches and the motion prior
+                                 // (prior_motion.h: 1-point rotation hypotheses, then a
+                                 // Gauss-Newton fit regularised by the prior) instead of losing
+                                 // the frame; needs a prior (not on the first tracked frame)
+  int few_point_min_features = 3;  // a frame with fewer than min_features features with depth,
+                                   // but at least this many, is still matched against the
+                                   // reference (few_point_motion), >= 1
+  PriorMotionOptions few_point;    // that solver (fewer inliers than its min_inliers and
+                                   // min_inlier_fraction: lost)
+  double few_point_max_shift_disagreement_px = 3.0;  // a few-point motion is rejected when
+                                   // the image shift it predicts (the image centre at the
+                                   // reference's median depth) is farther from the
+                                   // coarse-to-fine shift measured for the frame than the
+                                   // prior's prediction is, by more than this (pixels), >= 0:
+                                   // two wrong matches that agree must not turn the camera by
+                                   // degrees that the image does not show, while the global
+                                   // shift's own error (parallax and zoom of forward motion)
+                                   // is what the prior shows too. No check without a shift.
+                                   // A few-point frame is never bundle-adjusted: a BA over a
+                                   // few points has no prior and is weaker than the solver
+  double few_point_prior_update = 1.0;  // weight of a few-point motion in the constant-velocity
+                                        // prior, in [0, 1] (the solver's estimate already
+                                        // contains the prior)
 
   bool IsValid(std::string* error) const;
 };
@@ -344,6 +388,8 @@ struct OdometryResult {
                                      // first frame, lost frames and re-initialisations (their
                                      // pose is the prior's prediction)
   bool reinitialised = false;        // the pipeline restarted on this frame after a loss
+  bool few_point_motion = false;     // the motion came from the few-point solver with the
+                                     // prior (RobustTrackingOptions::few_point_motion)
   bool rotation_from_shift = false;  // lost or re-initialised, its pose is the prior corrected
                                      // by the image shift from the previous frame
   PredictionSource prediction = PredictionSource::kNone;  // centre of the used matches' search
@@ -368,6 +414,13 @@ std::vector<Eigen::Vector2d> PredictFeaturePositions(const StereoCamera& camera,
                                                      const std::vector<Feature>& features,
                                                      const Eigen::Isometry3d& T_ref_curr,
                                                      double min_depth_m);
+
+// The image shift (pixels, image_motion.h convention) that the motion T_ref_curr predicts for
+// the reference image's centre at depth_m (metres; <= 0 or non-finite = infinitely far, the
+// rotation alone): where that point appears in the current image minus the centre. +inf when
+// it falls behind the camera.
+Eigen::Vector2d PredictedCentreShift(const StereoCamera& camera,
+                                     const Eigen::Isometry3d& T_ref_curr, double depth_m);
 
 // The prior's frame-to-frame motion T_prev_curr_prior corrected by a measured image shift
 // (image_motion.h: curr(x + shift) ≈ prev(x)): the shift the prior predicts for the image
@@ -516,6 +569,8 @@ class StereoOdometry {
   int64_t frame_index_ = 0;   // index of the next call
   bool initialised_ = false;  // a reference was set at least once since Reset
   int consecutive_lost_ = 0;  // lost frames since the last good one
+  bool previous_measured_ = false;  // the previous call's motion was measured (the prior is
+                                    // a measured motion, not a bridge: few_point_motion)
   Reference reference_;
   Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();  // previous call's output
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();      // constant-velocity model: last

@@ -212,10 +212,82 @@ TEST(OdometrySeamTest, FeaturesWithoutDepthAreDroppedAndMatchesReindexed) {
   EXPECT_EQ(tracked, r1.num_inliers);
 }
 
+// Five exact matches are too few for RANSAC (min_inliers 12), not for the few-point solver
+// with the constant-velocity prior: the frame where the turn starts (0.2° → 3° per frame) is
+// tracked, its motion measured, its rotation far closer to the truth than the prior's, and the
+// next frame (all matches) tracks as usual.
+TEST(OdometrySeamTest, FewMatchesAreTrackedWithThePrior) {
+  const StereoCamera cam = HallwayCamera();
+  OdometryOptions options;
+  options.estimate_initial_orientation = false;
+  options.tracking.few_point_motion = true;  // off by default
+  StereoOdometry vo(cam, options);
+  const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  std::vector<SeamFrame> frames;
+  for (int i = 0; i < 7; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
+  vo.ProcessFeatures(frames[0].features, {}, 0.0);
+  for (int i = 1; i < 5; ++i) {
+    const OdometryResult r =
+        vo.ProcessFeatures(frames[i].features, SeamMatches(frames[i - 1], frames[i], 0), 0.1 * i);
+    ASSERT_EQ(r.status, TrackingStatus::kTracking) << r.message;
+  }
+  // Frame 5: 5 matches only.
+  std::vector<Match> few = SeamMatches(frames[4], frames[5], 0);
+  few.resize(5);
+  const OdometryResult r5 = vo.ProcessFeatures(frames[5].features, few, 0.5);
+  EXPECT_EQ(r5.status, TrackingStatus::kTracking) << r5.message;
+  EXPECT_TRUE(r5.motion_measured);
+  EXPECT_TRUE(r5.few_point_motion);
+  EXPECT_FALSE(r5.ba_ran);
+  EXPECT_FALSE(IsLostFrame(r5));
+  EXPECT_EQ(r5.num_inliers, 5);
+  const Eigen::Isometry3d true_motion = SeamPose(4).inverse() * SeamPose(5);
+  const Eigen::Isometry3d prior_motion = SeamPose(3).inverse() * SeamPose(4);
+  const double prior_error_rad = RotationAngleRad(prior_motion.linear(), true_motion.linear());
+  EXPECT_GT(prior_error_rad, 2.5 * kDeg);
+  EXPECT_LT(RotationAngleRad(r5.T_prev_curr.linear(), true_motion.linear()),
+            0.05 * prior_error_rad);
+  // Five points 1–10 m away hardly tell the translation: it stays near the prior's (1 cm).
+  EXPECT_THAT(r5.T_prev_curr, IsNearPose(true_motion, 0.1 * kDeg, 0.01));
+  // Frame 6: every match again.
+  const OdometryResult r6 =
+      vo.ProcessFeatures(frames[6].features, SeamMatches(frames[5], frames[6], 0), 0.6);
+  EXPECT_EQ(r6.status, TrackingStatus::kTracking) << r6.message;
+  EXPECT_FALSE(r6.few_point_motion);
+  // Without the few-point solver the same frame is lost.
+  options.tracking.few_point_motion = false;
+  StereoOdometry plain(cam, options);
+  plain.ProcessFeatures(frames[0].features, {}, 0.0);
+  for (int i = 1; i < 5; ++i) {
+    plain.ProcessFeatures(frames[i].features, SeamMatches(frames[i - 1], frames[i], 0), 0.1 * i);
+  }
+  EXPECT_TRUE(IsLostFrame(plain.ProcessFeatures(frames[5].features, few, 0.5)));
+}
+
+// The image shift a motion predicts at the image centre: f · tan(θ) for a pan θ (any depth),
+// and for a sideways step b at depth z, −f · b / z.
+TEST(OdometrySeamTest, PredictedCentreShiftIsExact) {
+  const StereoCamera cam = HallwayCamera();
+  const double theta = 3.0 * kDeg;
+  const Eigen::Isometry3d pan =
+      MakePose(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+               Eigen::Vector3d::Zero());
+  // The camera turns right (+y in cv axes turns z towards x): the scene moves left.
+  const Eigen::Vector2d s_far = PredictedCentreShift(cam, pan, -1.0);
+  const Eigen::Vector2d s_near = PredictedCentreShift(cam, pan, 0.85);
+  EXPECT_NEAR(s_far.x(), -cam.fx_px * std::tan(theta), 1e-9);
+  EXPECT_NEAR(s_far.y(), 0.0, 1e-12);
+  EXPECT_NEAR(s_near.x(), s_far.x(), 1e-9);
+  const Eigen::Isometry3d step = MakePose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.02, 0, 0));
+  EXPECT_NEAR(PredictedCentreShift(cam, step, 0.85).x(), -cam.fx_px * 0.02 / 0.85, 1e-9);
+  EXPECT_NEAR(PredictedCentreShift(cam, step, -1.0).x(), 0.0, 1e-12);
+}
+
 TEST(OdometrySeamTest, TooFewMatchesIsLostThenReinitialises) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
   options.estimate_initial_orientation = false;
+  options.tracking.few_point_motion = false;  // the loss itself is under test here
   StereoOdometry vo(cam, options);
   const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
   std::vector<SeamFrame> frames;

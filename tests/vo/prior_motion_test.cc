@@ -1,0 +1,200 @@
+#include "vo/prior_motion.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "tests/test_util.h"
+#include "tests/vo/vo_test_util.h"
+
+namespace vo {
+namespace {
+
+using test::TestCamera;
+using vobench_test::IsNearPose;
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kExactRad = 1e-9;  // exact data, nothing to trade against the prior
+constexpr double kExactM = 1e-9;
+
+// A robot turning in front of a wall: yaw about the camera's y axis and a small translation.
+Eigen::Isometry3d Motion(double yaw_deg, const Eigen::Vector3d& t_m) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T.translation() = t_m;
+  return T;
+}
+
+// Exact stereo correspondence of p_prev under the true T_prev_curr.
+StereoCorrespondence Exact(const StereoCamera& cam, const Eigen::Isometry3d& T_prev_curr,
+                           const Eigen::Vector3d& p_prev) {
+  StereoCorrespondence c;
+  c.p_prev_cam0 = p_prev;
+  const Eigen::Vector3d p_curr = T_prev_curr.inverse() * p_prev;
+  Eigen::Vector2d uv;
+  EXPECT_TRUE(cam.ProjectLeft(p_curr, &uv));
+  c.uv_curr_px = uv;
+  c.disparity_curr_px = cam.DisparityFromDepth(p_curr.z());
+  return c;
+}
+
+// Points on a plain wall 0.85 m ahead, a few specks.
+std::vector<Eigen::Vector3d> WallSpecks() {
+  return {{0.45, -0.20, 0.85}, {-0.28, -0.27, 0.85}, {-0.31, 0.15, 0.86}};
+}
+
+double RotationErrorRad(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+}
+
+TEST(PriorMotionTest, ExactWhenTheTruthIsThePrior) {
+  const StereoCamera cam = TestCamera();
+  const Eigen::Isometry3d T_true = Motion(2.2, {0.006, 0.0, 0.001});
+  std::vector<StereoCorrespondence> corr;
+  for (const Eigen::Vector3d& p : WallSpecks()) corr.push_back(Exact(cam, T_true, p));
+  const PriorMotionResult r = EstimateMotionWithPrior(cam, corr, T_true);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.num_inliers, 3);
+  EXPECT_THAT(r.T_prev_curr, IsNearPose(T_true, kExactRad, kExactM));
+}
+
+// The prior missed the start of a turn (no rotation, 2.2° true): three specks recover the
+// rotation to a small fraction of the prior's error.
+TEST(PriorMotionTest, ThreeSpecksRecoverAMissedTurn) {
+  const StereoCamera cam = TestCamera();
+  const Eigen::Isometry3d T_true = Motion(2.2, {0.006, 0.0, 0.001});
+  const Eigen::Isometry3d T_prior = Motion(0.0, {0.006, 0.0, 0.001});
+  std::vector<StereoCorrespondence> corr;
+  for (const Eigen::Vector3d& p : WallSpecks()) corr.push_back(Exact(cam, T_true, p));
+  const PriorMotionResult r = EstimateMotionWithPrior(cam, corr, T_prior);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.num_inliers, 3);
+  // Points at one depth cannot tell a yaw from a sideways step exactly; the prior's σ decide
+  // the split, and the image residual stays far below a pixel.
+  EXPECT_LT(RotationErrorRad(r.T_prev_curr, T_true), 0.1 * 2.2 * kDeg);
+  EXPECT_LT((r.T_prev_curr.translation() - T_true.translation()).norm(), 0.003);
+  EXPECT_LT(r.rms_reprojection_px, 0.2);
+}
+
+// A pure rotation seen at one far point, the prior's translation exact: the 1-point solver
+// puts the point on its bearing, the pan is exact.
+TEST(PriorMotionTest, OneFarPointGivesThePan) {
+  const StereoCamera cam = TestCamera();
+  const Eigen::Isometry3d T_true = Motion(-3.0, Eigen::Vector3d::Zero());
+  const Eigen::Isometry3d T_prior = Eigen::Isometry3d::Identity();
+  PriorMotionOptions options;
+  options.min_inliers = 1;
+  const std::vector<StereoCorrespondence> corr = {
+      Exact(cam, T_true, Eigen::Vector3d(0.0, 0.0, 40.0))};
+  const PriorMotionResult r = EstimateMotionWithPrior(cam, corr, T_prior, options);
+  ASSERT_TRUE(r.ok) << r.message;
+  // The point pins the bearing: the pan is recovered up to the MAP's pull towards the prior,
+  // σ_px² / (f² σ_rot²) ≈ 1 % of the prior's 3° error.
+  EXPECT_LT(RotationErrorRad(r.T_prev_curr, T_true), 0.02 * 3.0 * kDeg);
+  // With a vague prior the 1-point solution is exact.
+  options.prior_rotation_sigma_deg = 1e4;
+  const PriorMotionResult vague = EstimateMotionWithPrior(cam, corr, T_prior, options);
+  ASSERT_TRUE(vague.ok) << vague.message;
+  EXPECT_LT(RotationErrorRad(vague.T_prev_curr, T_true), 1e-7);
+}
+
+// Many points at several depths: the data decide, the prior's pull vanishes.
+TEST(PriorMotionTest, ManyPointsOverruleAWrongPrior) {
+  const StereoCamera cam = TestCamera();
+  const Eigen::Isometry3d T_true = Motion(2.0, {0.01, -0.002, 0.03});
+  const Eigen::Isometry3d T_prior = Motion(0.5, {0.0, 0.0, 0.04});
+  std::vector<StereoCorrespondence> corr;
+  for (int i = 0; i < 40; ++i) {
+    const double x = -1.0 + 0.05 * i, y = 0.4 * std::sin(1.7 * i), z = 1.0 + 0.1 * (i % 7);
+    corr.push_back(Exact(cam, T_true, Eigen::Vector3d(x * z * 0.5, y * z * 0.5, z)));
+  }
+  const PriorMotionResult r = EstimateMotionWithPrior(cam, corr, T_prior);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.num_inliers, 40);
+  // The MAP keeps a small pull towards the prior (1.5° and 14 mm off here).
+  EXPECT_LT(RotationErrorRad(r.T_prev_curr, T_true), 0.03 * 1.5 * kDeg);
+  EXPECT_LT((r.T_prev_curr.translation() - T_true.translation()).norm(), 0.1 * 0.014);
+  EXPECT_LT(r.rms_reprojection_px, 0.1);
+  // A vague prior (σ × 10⁴): the exact motion, to rounding.
+  PriorMotionOptions vague_options;
+  vague_options.prior_rotation_sigma_deg *= 1e4;
+  vague_options.prior_translation_sigma_m *= 1e4;
+  const PriorMotionResult vague = EstimateMotionWithPrior(cam, corr, T_prior, vague_options);
+  ASSERT_TRUE(vague.ok) << vague.message;
+  EXPECT_THAT(vague.T_prev_curr, IsNearPose(T_true, 1e-8, 1e-9));
+}
+
+TEST(PriorMotionTest, GrossOutliersAreNotInliers) {
+  const StereoCamera cam = TestCamera();
+  const Eigen::Isometry3d T_true = Motion(2.2, {0.006, 0.0, 0.001});
+  const Eigen::Isometry3d T_prior = Motion(1.5, {0.006, 0.0, 0.0});
+  std::vector<StereoCorrespondence> corr;
+  for (const Eigen::Vector3d& p : WallSpecks()) corr.push_back(Exact(cam, T_true, p));
+  corr.push_back(Exact(cam, T_true, Eigen::Vector3d(0.1, 0.1, 0.85)));
+  corr.back().uv_curr_px += Eigen::Vector2d(25.0, -12.0);  // a wrong match
+  corr.push_back(Exact(cam, T_true, Eigen::Vector3d(-0.1, 0.2, 0.85)));
+  corr.back().uv_curr_px.y() += 9.0;
+  const PriorMotionResult r = EstimateMotionWithPrior(cam, corr, T_prior);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.num_inliers, 3);
+  EXPECT_THAT(r.inlier_mask, ::testing::ElementsAre(true, true, true, false, false));
+  EXPECT_LT(RotationErrorRad(r.T_prev_curr, T_true), 0.1 * 0.7 * kDeg);
+}
+
+TEST(PriorMotionTest, TooFewInliersIsNotOk) {
+  const StereoCamera cam = TestCamera();
+  const Eigen::Isometry3d T_true = Motion(2.2, Eigen::Vector3d::Zero());
+  std::vector<StereoCorrespondence> corr = {Exact(cam, T_true, WallSpecks()[0])};
+  const PriorMotionResult r = EstimateMotionWithPrior(cam, corr, T_true);  // min_inliers 2
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.num_inliers, 1);
+  // Two that agree among five (three wrong): below min_inlier_fraction 0.5.
+  corr.push_back(Exact(cam, T_true, WallSpecks()[1]));
+  for (int k = 0; k < 3; ++k) {
+    corr.push_back(Exact(cam, T_true, WallSpecks()[2]));
+    corr.back().uv_curr_px += Eigen::Vector2d(20.0 + 15.0 * k, -30.0 + 25.0 * k);
+  }
+  const PriorMotionResult fraction = EstimateMotionWithPrior(cam, corr, T_true);
+  EXPECT_FALSE(fraction.ok);
+  EXPECT_EQ(fraction.num_inliers, 2);
+  corr.resize(2);
+  EXPECT_TRUE(EstimateMotionWithPrior(cam, corr, T_true).ok);
+  const PriorMotionResult none = EstimateMotionWithPrior(cam, {}, T_true);
+  EXPECT_FALSE(none.ok);
+  EXPECT_EQ(none.num_inliers, 0);
+  EXPECT_THAT(none.T_prev_curr, IsNearPose(T_true, 0.0, 0.0));
+}
+
+TEST(PriorMotionTest, InvalidInputIsNotOk) {
+  const StereoCamera cam = TestCamera();
+  std::vector<StereoCorrespondence> corr = {
+      Exact(cam, Eigen::Isometry3d::Identity(), WallSpecks()[0])};
+  PriorMotionOptions bad;
+  bad.prior_rotation_sigma_deg = 0.0;
+  std::string error;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_THAT(error, ::testing::HasSubstr("prior_rotation_sigma_deg"));
+  EXPECT_FALSE(EstimateMotionWithPrior(cam, corr, Eigen::Isometry3d::Identity(), bad).ok);
+  Eigen::Isometry3d nan_prior = Eigen::Isometry3d::Identity();
+  nan_prior.translation().x() = std::nan("");
+  EXPECT_FALSE(EstimateMotionWithPrior(cam, corr, nan_prior).ok);
+  corr[0].uv_curr_px.x() = std::nan("");
+  EXPECT_FALSE(EstimateMotionWithPrior(cam, corr, Eigen::Isometry3d::Identity()).ok);
+}
+
+TEST(PriorMotionTest, Deterministic) {
+  const StereoCamera cam = TestCamera();
+  const Eigen::Isometry3d T_true = Motion(2.2, {0.006, 0.0, 0.001});
+  std::vector<StereoCorrespondence> corr;
+  for (const Eigen::Vector3d& p : WallSpecks()) corr.push_back(Exact(cam, T_true, p));
+  corr[1].uv_curr_px += Eigen::Vector2d(0.3, -0.2);
+  const PriorMotionResult a = EstimateMotionWithPrior(cam, corr, Eigen::Isometry3d::Identity());
+  const PriorMotionResult b = EstimateMotionWithPrior(cam, corr, Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(a.T_prev_curr.matrix() == b.T_prev_curr.matrix());
+  EXPECT_EQ(a.inlier_mask, b.inlier_mask);
+}
+
+}  // namespace
+}  // namespace vo

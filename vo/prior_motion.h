@@ -1,0 +1,69 @@
+// Frame-to-frame motion from FEW stereo correspondences and a motion prior: what the pipeline
+// does when RANSAC has too few matches for a consensus (a plain wall in front of the camera:
+// 2–12 features), instead of calling the frame lost and extrapolating the prior.
+//
+// Model (maximum a posteriori, Gaussian): the motion is the prior moved by a small correction,
+//   T_prev_curr = T_prior · [Exp(ω) | v],   ω, v ∈ R³ (rotation vector, radians; metres),
+// and it minimises
+//   Σ_inliers |e_left|² / σ_px² + e_right,u² / σ_px²  +  |ω|² / σ_rot²  +  |v|² / σ_t²,
+// e = the stereo reprojection errors of p_prev in the current left and right images (as in the
+// RANSAC inlier test, ransac.h). With many points the data decide; with one or two the bearing
+// fixes the rotation (pan and tilt), and what the points cannot tell apart (roll about a single
+// bearing, translation against rotation for points at one depth) comes from the prior.
+//
+// Hypotheses (deterministic, exhaustive, no random sampling): the prior itself, and for every
+// correspondence i the prior's translation with the smallest rotation correction that puts
+// p_prev(i) exactly on its observed bearing (a 1-point rotation solver). Each is scored by its
+// inliers (left and right errors <= inlier_threshold_px; ties: the smaller sum of squared
+// errors, then the lower index). The best one's inliers are refined (Gauss-Newton on (ω, v),
+// numeric Jacobians), re-classified, and refined once more.
+//
+// Cost: O(n²) reprojections for n correspondences (n is small where it is used: RANSAC failed)
+// plus a few 6×6 solves. Deterministic: the same input gives bit-identical output.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "vo/camera.h"
+#include "vo/ransac.h"
+
+namespace vo {
+
+struct PriorMotionOptions {
+  int min_inliers = 2;                      // fewer inliers than this: not ok, >= 1
+  double min_inlier_fraction = 0.5;         // and fewer than this fraction of the
+                                            // correspondences: not ok, in [0, 1] (two points
+                                            // that agree among five matches are more likely a
+                                            // coincidence of wrong matches than the motion)
+  double inlier_threshold_px = 2.0;         // max reprojection error (pixels) in EACH of the
+                                            // current left and right images, > 0
+  double measurement_sigma_px = 1.0;        // σ_px of the image observations (pixels), > 0
+  double prior_rotation_sigma_deg = 2.0;    // σ_rot of the prior's rotation (degrees), > 0
+  double prior_translation_sigma_m = 0.01;  // σ_t of the prior's translation (metres), > 0
+  int max_iterations = 10;                  // Gauss-Newton iterations per refinement, >= 1
+  double min_depth_m = 1e-3;                // transformed points closer than this (z, metres)
+                                            // are outliers, > 0
+
+  bool IsValid(std::string* error) const;
+};
+
+struct PriorMotionResult {
+  bool ok = false;      // at least min_inliers inliers support T_prev_curr
+  std::string message;  // why not ok (empty when ok)
+  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();  // p_prev = T * p_curr (cam0);
+                                                                  // the prior when not ok
+  std::vector<bool> inlier_mask;                                  // one per correspondence
+  int num_inliers = 0;
+  double rms_reprojection_px = 0.0;  // sqrt(mean over inliers and both images of |e|²) (pixels)
+};
+
+// T_prev_curr from `correspondences` (any number, 0 allowed) and the prior T_prev_curr_prior
+// (see the header comment). Invalid options or camera, or a non-finite prior: not ok.
+PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
+                                          const std::vector<StereoCorrespondence>& correspondences,
+                                          const Eigen::Isometry3d& T_prev_curr_prior,
+                                          const PriorMotionOptions& options = PriorMotionOptions());
+
+}  // namespace vo
