@@ -1,7 +1,5 @@
 #include "harness/suite.h"
 
-#include "harness/plots.h"
-
 #include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
@@ -32,6 +30,7 @@
 #include "harness/output_folder.h"
 #include "harness/overrides.h"
 #include "harness/path_names.h"
+#include "harness/plots.h"
 #include "harness/progress.h"
 #include "harness/trajectory_io.h"
 #include "harness/vo_config.h"
@@ -243,8 +242,7 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
     std::set<uint64_t> seen;
     for (size_t i = 0; r.ok() && i < seeds.size(); ++i) {
       uint64_t v = 0;
-      if (r.ReadUint64(seeds[i], YamlReader::Item("seeds", i), &v) &&
-          !seen.insert(v).second)
+      if (r.ReadUint64(seeds[i], YamlReader::Item("seeds", i), &v) && !seen.insert(v).second)
         r.Fail(seeds[i], "seeds[" + std::to_string(i) + "]",
                "seed " + std::to_string(v) + " is given twice");
       s.seeds.push_back(v);

@@ -190,7 +190,8 @@ bool ReadParameters(YamlReader& r, const YAML::Node& root, TuneSpec* spec) {
       std::string type;
       if (!r.String(n, where, "type", &type, false)) return false;
       if (!ParseParameterType(type, &p.type))
-        return r.Fail(n["type"], where + ".type", "expected real, int or scale, got '" + type + "'");
+        return r.Fail(n["type"], where + ".type",
+                      "expected real, int or scale, got '" + type + "'");
     }
     if (!r.Bool(n, where, "log", &p.log)) return false;
     if (YamlReader::Has(n, "step") &&
@@ -222,13 +223,13 @@ bool ReadParameters(YamlReader& r, const YAML::Node& root, TuneSpec* spec) {
                         (option.IsSequence() ? "; use type: scale" : ""));
     }
     if (!IsAttainable(p, start))
-      return r.Fail(n, where,
-                    who + "the base configuration's value " + Short(start) + " is outside [" +
-                        Short(p.min) + ", " + Short(p.max) + "]" +
-                        (p.type == ParameterType::kInt
-                             ? " or off the grid of step " + std::to_string(p.step)
-                             : "") +
-                        "; the search starts there, widen the range");
+      return r.Fail(
+          n, where,
+          who + "the base configuration's value " + Short(start) + " is outside [" + Short(p.min) +
+              ", " + Short(p.max) + "]" +
+              (p.type == ParameterType::kInt ? " or off the grid of step " + std::to_string(p.step)
+                                             : "") +
+              "; the search starts there, widen the range");
 
     // Values the search can take, each alone on the base options.
     std::vector<double> probes;
@@ -277,7 +278,8 @@ bool ReadObjective(YamlReader& r, const YAML::Node& root, TuneObjective* objecti
 bool ReadOptimizer(YamlReader& r, const YAML::Node& root, OptimizerOptions* optimizer) {
   const YAML::Node n = root["optimizer"];
   if (!n.IsDefined() || n.IsNull()) return true;
-  if (!r.CheckKeys(n, "optimizer", {"algorithm", "max_evals", "seed", "initial_step", "xtol_abs"}) ||
+  if (!r.CheckKeys(n, "optimizer",
+                   {"algorithm", "max_evals", "seed", "initial_step", "xtol_abs"}) ||
       !r.String(n, "optimizer", "algorithm", &optimizer->algorithm, false) ||
       (YamlReader::Has(n, "max_evals") &&
        !ReadCount(r, n["max_evals"], "optimizer.max_evals", 1, 1000000, &optimizer->max_evals)) ||
@@ -499,8 +501,9 @@ bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
   TuneSpec s;
   s.text = yaml_text;
   s.name = fs::path(source_name).stem().string();
-  if (!r.CheckKeys(root, "", {"name", "base_config", "train", "validation", "parameters",
-                              "objective", "optimizer"}) ||
+  if (!r.CheckKeys(
+          root, "",
+          {"name", "base_config", "train", "validation", "parameters", "objective", "optimizer"}) ||
       !r.String(root, "", "name", &s.name, false))
     return r.Report(error);
   std::string name_error;

@@ -1,5 +1,8 @@
 #include "harness/vo_config.h"
 
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -8,9 +11,6 @@
 #include <sstream>
 #include <type_traits>
 #include <vector>
-
-#include <Eigen/Core>
-#include <yaml-cpp/yaml.h>
 
 #include "sim/yaml_input.h"
 
@@ -319,7 +319,8 @@ bool Apply(YamlReader& r, const YAML::Node& node, const std::string& prefix,
     if (it != entries.end()) {
       const auto [first, inserted] = seen->emplace(key, line);
       if (!inserted)
-        return r.Fail(kv.first, key, "duplicate (first at line " + std::to_string(first->second) + ")");
+        return r.Fail(kv.first, key,
+                      "duplicate (first at line " + std::to_string(first->second) + ")");
     }
     if (it == entries.end()) {
       if (v.IsMap()) {

@@ -232,8 +232,8 @@ bool YamlReader::ReadDouble(const YAML::Node& value, const std::string& key, dou
   return true;
 }
 
-bool YamlReader::ReadDoubleIn(const YAML::Node& value, const std::string& key, double lo,
-                              double hi, double* out) {
+bool YamlReader::ReadDoubleIn(const YAML::Node& value, const std::string& key, double lo, double hi,
+                              double* out) {
   double v = 0.0;
   if (!ReadDouble(value, key, &v)) return false;
   if (!(v >= lo && v <= hi))
@@ -253,13 +253,16 @@ bool YamlReader::ReadInt(const YAML::Node& value, const std::string& key, long l
     v = value.as<long long>();
   } catch (const YAML::Exception&) {
     return Fail(value, key,
-                "expected an integer, got '" + (value.IsScalar() ? value.Scalar() : "a " +
-                    std::string(value.IsMap() ? "mapping" : value.IsSequence() ? "list" : "null")) +
+                "expected an integer, got '" +
+                    (value.IsScalar() ? value.Scalar()
+                                      : "a " + std::string(value.IsMap()        ? "mapping"
+                                                           : value.IsSequence() ? "list"
+                                                                                : "null")) +
                     "'");
   }
   if (v < lo || v > hi) {
-    const bool unbounded = hi == std::numeric_limits<long long>::max() ||
-                           hi == std::numeric_limits<int>::max();
+    const bool unbounded =
+        hi == std::numeric_limits<long long>::max() || hi == std::numeric_limits<int>::max();
     const std::string range = unbounded
                                   ? ">= " + std::to_string(lo)
                                   : "in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
@@ -344,9 +347,9 @@ bool YamlReader::ReadNumbers(const YAML::Node& value, const std::string& key, si
                              std::vector<double>* out, const std::string& what) {
   if (!ok()) return false;
   const std::string expected =
-      what.empty() ? "expected a list of " + (count > 0 ? std::to_string(count) : "any") +
-                         " numbers"
-                   : "expected " + what;
+      what.empty()
+          ? "expected a list of " + (count > 0 ? std::to_string(count) : "any") + " numbers"
+          : "expected " + what;
   if (!value.IsSequence() || (count > 0 && value.size() != count))
     return Fail(value, key, expected);
   std::vector<double> v;

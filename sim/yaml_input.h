@@ -116,8 +116,8 @@ class YamlReader {
   }
   // A number with a whole value in [lo, hi], written as any number may be ("3", "3.0", "1e3";
   // tune files take their counts so): "expected an integer in [lo, hi], got 'X'".
-  bool ReadWholeNumber(const YAML::Node& value, const std::string& key, long long lo,
-                       long long hi, long long* out);
+  bool ReadWholeNumber(const YAML::Node& value, const std::string& key, long long lo, long long hi,
+                       long long* out);
   // A non-negative integer up to 2^64 - 1: "expected a non-negative integer, got 'X'".
   bool ReadUint64(const YAML::Node& value, const std::string& key, uint64_t* out);
   // true / false (also YAML's yes/no/on/off): "expected true or false, got 'X'".

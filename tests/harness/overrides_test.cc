@@ -84,8 +84,8 @@ TEST(OverridesTest, ErrorsOfFileOverridesNameTheFileLineAndFullKey) {
   std::string error;
   EXPECT_FALSE(harness::ApplyVoOverrides(YAML::Load("{matcher.type: nonsense}"),
                                          harness::kOverridesSource, &options, &error));
-  EXPECT_EQ(harness::OverrideErrorAt("s.yaml:6", "configs[0].set", error).rfind(
-                "s.yaml:6: key 'configs[0].set.matcher.type': expected one of ", 0),
+  EXPECT_EQ(harness::OverrideErrorAt("s.yaml:6", "configs[0].set", error)
+                .rfind("s.yaml:6: key 'configs[0].set.matcher.type': expected one of ", 0),
             0u)
       << error;
   sim::Scenario base, s;

@@ -59,7 +59,6 @@ TEST(YamlInputTest, ReadInputFileNamesFoldersAndMissingPaths) {
   EXPECT_EQ(text, "a: 1\n");
 }
 
-
 // The one strict reader (issue #12 item 3): one message format "SOURCE:LINE: key 'a.b': WHAT".
 sim::YamlReader Reader(const std::string& text) {
   sim::YamlReader r("f.yaml");
@@ -168,8 +167,9 @@ TEST(YamlReaderTest, TypedGettersSayWhatWasExpected) {
 }
 
 TEST(YamlReaderTest, GoodValuesAreRead) {
-  sim::YamlReader r = Reader("d: 1.5\ni: 7\nu: 18446744073709551615\nb: yes\ne: b\n"
-                             "w: 3.0\nl: [1, 2]\np: [[1, 2], [3, 4]]\ns: hi\n");
+  sim::YamlReader r = Reader(
+      "d: 1.5\ni: 7\nu: 18446744073709551615\nb: yes\ne: b\n"
+      "w: 3.0\nl: [1, 2]\np: [[1, 2], [3, 4]]\ns: hi\n");
   double d = 0;
   int i = 0, e = 0;
   uint64_t u = 0;
