@@ -79,15 +79,6 @@ YAML::Node FindDotted(const YAML::Node& node, const std::vector<std::string>& pa
 
 using sim::YamlReader;
 
-// A count of the tune file (max_frames, step, max_evals): any number with a whole value.
-bool ReadCount(YamlReader& r, const YAML::Node& n, const std::string& key, long lo, long hi,
-               int* out) {
-  long long v = 0;
-  if (!r.ReadWholeNumber(n, key, lo, hi, &v)) return false;
-  *out = static_cast<int>(v);
-  return true;
-}
-
 // "train" / "validation" lists.
 bool ReadScenarios(YamlReader& r, const YAML::Node& root, const std::string& what,
                    const std::string& base_dir, std::vector<TuneScenario>* out) {
@@ -121,7 +112,7 @@ bool ReadScenarios(YamlReader& r, const YAML::Node& root, const std::string& wha
     s.name = what + "_" + std::to_string(i);
     if (!r.String(n, where, "name", &s.name, false)) return false;
     if (YamlReader::Has(n, "max_frames")) {
-      if (!ReadCount(r, n["max_frames"], where + ".max_frames", 0, 1000000, &s.max_frames))
+      if (!r.ReadWholeNumber(n["max_frames"], where + ".max_frames", 0, 1000000, &s.max_frames))
         return false;
       if (s.max_frames == 1)
         return r.Fail(n["max_frames"], where + ".max_frames", "needs >= 2 frames (or 0 = all)");
@@ -195,7 +186,7 @@ bool ReadParameters(YamlReader& r, const YAML::Node& root, TuneSpec* spec) {
     }
     if (!r.Bool(n, where, "log", &p.log)) return false;
     if (YamlReader::Has(n, "step") &&
-        !ReadCount(r, n["step"], where + ".step", 1, 1000000, &p.step))
+        !r.ReadWholeNumber(n["step"], where + ".step", 1, 1000000, &p.step))
       return false;
     std::string why;
     if (!p.IsValid(&why)) return r.Fail(n, where, why);  // names the parameter
@@ -281,8 +272,8 @@ bool ReadOptimizer(YamlReader& r, const YAML::Node& root, OptimizerOptions* opti
   if (!r.CheckKeys(n, "optimizer",
                    {"algorithm", "max_evals", "seed", "initial_step", "xtol_abs"}) ||
       !r.String(n, "optimizer", "algorithm", &optimizer->algorithm, false) ||
-      (YamlReader::Has(n, "max_evals") &&
-       !ReadCount(r, n["max_evals"], "optimizer.max_evals", 1, 1000000, &optimizer->max_evals)) ||
+      (YamlReader::Has(n, "max_evals") && !r.ReadWholeNumber(n["max_evals"], "optimizer.max_evals",
+                                                             1, 1000000, &optimizer->max_evals)) ||
       !r.Uint64(n, "optimizer", "seed", &optimizer->seed) ||
       !r.Double(n, "optimizer", "initial_step", &optimizer->initial_step) ||
       !r.Double(n, "optimizer", "xtol_abs", &optimizer->xtol_abs))

@@ -118,6 +118,14 @@ class YamlReader {
   // tune files take their counts so): "expected an integer in [lo, hi], got 'X'".
   bool ReadWholeNumber(const YAML::Node& value, const std::string& key, long long lo, long long hi,
                        long long* out);
+  template <typename T>
+  bool ReadWholeNumber(const YAML::Node& value, const std::string& key, T lo, T hi, T* out) {
+    long long v = 0;
+    if (!ReadWholeNumber(value, key, static_cast<long long>(lo), static_cast<long long>(hi), &v))
+      return false;
+    *out = static_cast<T>(v);
+    return true;
+  }
   // A non-negative integer up to 2^64 - 1: "expected a non-negative integer, got 'X'".
   bool ReadUint64(const YAML::Node& value, const std::string& key, uint64_t* out);
   // true / false (also YAML's yes/no/on/off): "expected true or false, got 'X'".
