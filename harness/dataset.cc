@@ -672,7 +672,7 @@ bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibr
   EurocCameraCalibration c;
   sim::YamlReader r(path);
   if (!r.Parse(text)) return r.Report(error);
-  const YAML::Node root = r.root();
+  YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
   if (!root.IsMap()) return Fail(error, path + ": expected a YAML mapping (T_BS, intrinsics, ...)");
   std::vector<double> T, k, res;
   if (!r.Require(root, "", "T_BS", "rows: 4, cols: 4, data: [16 numbers]") ||

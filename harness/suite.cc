@@ -136,7 +136,7 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
                 const std::string& base_dir, Suite* suite, std::string* error) {
   YamlReader r(source_name);
   if (!r.Parse(yaml_text)) return r.Report(error);
-  const YAML::Node root = r.root();
+  YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
   if (!root.IsMap()) {
     *error =
         source_name + ": expected a YAML mapping at the top level (name, scenarios, configs, ...)";

@@ -349,7 +349,7 @@ bool ParseVoConfig(const std::string& yaml_text, const std::string& source_name,
                    vo::OdometryOptions* options, std::string* error) {
   YamlReader r(source_name);
   if (!r.Parse(yaml_text)) return r.Report(error);
-  const YAML::Node root = r.root();
+  YAML::Node root = r.root();      // not const: a missing key reads as undefined, not invalid
   if (root.IsNull()) return true;  // an empty file: defaults
   if (!root.IsMap()) {
     *error = source_name + ": expected a YAML mapping of VO options";

@@ -209,9 +209,16 @@ bool YamlReader::Check(bool condition, const YAML::Node& map, const std::string&
   return Fail(Has(map, key) ? map[key] : map, Join(prefix, key), what);
 }
 
+bool YamlReader::Present(const YAML::Node& value, const std::string& key) {
+  // A missing key of a const mapping is an invalid node, on which type queries throw.
+  if (value.IsDefined()) return true;
+  return Fail(value, key, "required: a value");
+}
+
 bool YamlReader::ReadString(const YAML::Node& value, const std::string& key, std::string* out,
                             bool allow_empty) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   if (!value.IsScalar() || (!allow_empty && value.Scalar().empty()))
     return Fail(value, key, allow_empty ? "expected a string" : "expected a non-empty string");
   *out = value.Scalar();
@@ -220,6 +227,7 @@ bool YamlReader::ReadString(const YAML::Node& value, const std::string& key, std
 
 bool YamlReader::ReadDouble(const YAML::Node& value, const std::string& key, double* out) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   if (!value.IsScalar()) return Fail(value, key, "expected a number");
   double v = 0.0;
   try {
@@ -247,6 +255,7 @@ bool YamlReader::ReadDoubleIn(const YAML::Node& value, const std::string& key, d
 bool YamlReader::ReadInt(const YAML::Node& value, const std::string& key, long long lo,
                          long long hi, long long* out) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   long long v = 0;
   try {
     if (!value.IsScalar()) throw YAML::Exception(value.Mark(), "");
@@ -275,6 +284,7 @@ bool YamlReader::ReadInt(const YAML::Node& value, const std::string& key, long l
 bool YamlReader::ReadWholeNumber(const YAML::Node& value, const std::string& key, long long lo,
                                  long long hi, long long* out) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   double d = 0.0;
   bool number = value.IsScalar();
   if (number) {
@@ -302,6 +312,7 @@ bool YamlReader::ReadWholeNumber(const YAML::Node& value, const std::string& key
 
 bool YamlReader::ReadUint64(const YAML::Node& value, const std::string& key, uint64_t* out) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   try {
     if (!value.IsScalar() || value.Scalar().empty() || value.Scalar()[0] == '-')
       throw YAML::Exception(value.Mark(), "");
@@ -316,6 +327,7 @@ bool YamlReader::ReadUint64(const YAML::Node& value, const std::string& key, uin
 
 bool YamlReader::ReadBool(const YAML::Node& value, const std::string& key, bool* out) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   try {
     if (!value.IsScalar()) throw YAML::Exception(value.Mark(), "");
     *out = value.as<bool>();
@@ -330,6 +342,7 @@ bool YamlReader::ReadBool(const YAML::Node& value, const std::string& key, bool*
 bool YamlReader::ReadName(const YAML::Node& value, const std::string& key,
                           const std::vector<std::string>& names, size_t* index) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   if (value.IsScalar()) {
     for (size_t i = 0; i < names.size(); ++i) {
       if (value.Scalar() == names[i]) {
@@ -346,6 +359,7 @@ bool YamlReader::ReadName(const YAML::Node& value, const std::string& key,
 bool YamlReader::ReadNumbers(const YAML::Node& value, const std::string& key, size_t count,
                              std::vector<double>* out, const std::string& what) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   const std::string expected =
       what.empty()
           ? "expected a list of " + (count > 0 ? std::to_string(count) : "any") + " numbers"
@@ -366,6 +380,7 @@ bool YamlReader::ReadPairs(const YAML::Node& value, const std::string& key,
                            std::vector<std::pair<double, double>>* out, const std::string& what,
                            const std::string& item_what) {
   if (!ok()) return false;
+  if (!Present(value, key)) return false;
   if (!value.IsSequence())
     return Fail(value, key, "expected " + (what.empty() ? std::string("a list of pairs") : what));
   std::vector<std::pair<double, double>> v;

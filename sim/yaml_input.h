@@ -176,6 +176,8 @@ class YamlReader {
   }
 
  private:
+  // false (and an error) when `value` is undefined: a key that is not there.
+  bool Present(const YAML::Node& value, const std::string& key);
   bool ReadName(const YAML::Node& value, const std::string& key,
                 const std::vector<std::string>& names, size_t* index);
 
