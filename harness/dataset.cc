@@ -667,66 +667,49 @@ bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibr
     }
     text += lines[i] + "\n";
   }
+  // Only the keys below are read; the others of the format (sensor_type, comment, T_BS.rows,
+  // T_BS.cols, ...) are not refused.
   EurocCameraCalibration c;
-  YAML::Node root;
-  std::string yaml_error;
-  if (!sim::LoadYamlDocument(text, path, &root, &yaml_error)) return Fail(error, yaml_error);
-  try {
-    auto require = [&](const char* key, const char* expected) -> YAML::Node {
-      const YAML::Node node = root[key];
-      if (!node)
-        throw std::runtime_error(std::string("missing key '") + key + "' (expected " + expected +
-                                 ")");
-      return node;
-    };
-    auto numbers = [&](const YAML::Node& node, const char* key, size_t count) {
-      if (!node.IsSequence() || (count > 0 && node.size() != count))
-        throw std::runtime_error(std::string("'") + key + "': expected a list of " +
-                                 (count > 0 ? std::to_string(count) : std::string("any")) +
-                                 " numbers");
-      std::vector<double> v;
-      for (const YAML::Node& x : node) {
-        v.push_back(x.as<double>());
-        if (!std::isfinite(v.back()))
-          throw std::runtime_error(std::string("'") + key + "': value " + std::to_string(v.size()) +
-                                   " is not finite");
-      }
-      return v;
-    };
-    const YAML::Node T_BS = require("T_BS", "rows: 4, cols: 4, data: [16 numbers]");
-    if (!T_BS.IsMap() || !T_BS["data"])
-      throw std::runtime_error("'T_BS': expected a map with 'data: [16 numbers]'");
-    const std::vector<double> T = numbers(T_BS["data"], "T_BS.data", 16);
-    for (int r = 0; r < 4; ++r)
-      for (int col = 0; col < 4; ++col) c.T_body_cam.matrix()(r, col) = T[4 * r + col];
-    if (!c.T_body_cam.matrix().row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1)) ||
-        !IsRotation(c.T_body_cam.linear(), 1e-5))
-      throw std::runtime_error("'T_BS': expected a rigid transform (rotation, last row 0 0 0 1)");
-    const std::vector<double> k =
-        numbers(require("intrinsics", "[fu, fv, cu, cv]"), "intrinsics", 4);
-    c.fu_px = k[0];
-    c.fv_px = k[1];
-    c.cu_px = k[2];
-    c.cv_px = k[3];
-    if (!(c.fu_px > 0.0) || !(c.fv_px > 0.0))
-      throw std::runtime_error("'intrinsics': focal lengths fu, fv must be > 0");
-    const std::vector<double> res =
-        numbers(require("resolution", "[width, height]"), "resolution", 2);
-    c.width = static_cast<int>(res[0]);
-    c.height = static_cast<int>(res[1]);
-    if (c.width <= 0 || c.height <= 0 || c.width != res[0] || c.height != res[1])
-      throw std::runtime_error("'resolution': expected two positive integers [width, height]");
-    c.camera_model = require("camera_model", "pinhole").as<std::string>();
-    c.distortion_model =
-        require("distortion_model", "radial-tangential | equidistant").as<std::string>();
-    c.distortion_coefficients = numbers(require("distortion_coefficients", "a list of numbers"),
-                                        "distortion_coefficients", 0);
-    if (root["rate_hz"]) c.rate_hz = root["rate_hz"].as<double>();
-  } catch (const YAML::Exception& e) {
-    return Fail(error, (e.mark.line >= 0 ? Where(path, e.mark.line + 1) : path + ": ") + e.msg);
-  } catch (const std::exception& e) {
-    return Fail(error, path + ": " + e.what());
-  }
+  sim::YamlReader r(path);
+  if (!r.Parse(text)) return r.Report(error);
+  YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
+  if (!root.IsMap()) return Fail(error, path + ": expected a YAML mapping (T_BS, intrinsics, ...)");
+  std::vector<double> T, k, res;
+  if (!r.Require(root, "", "T_BS", "rows: 4, cols: 4, data: [16 numbers]") ||
+      !r.ExpectMap(root["T_BS"], "T_BS", "a map with 'data: [16 numbers]'") ||
+      !r.Require(root["T_BS"], "T_BS", "data", "[16 numbers]") ||
+      !r.ReadNumbers(root["T_BS"]["data"], "T_BS.data", 16, &T))
+    return r.Report(error);
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col) c.T_body_cam.matrix()(row, col) = T[4 * row + col];
+  if (!r.Check(c.T_body_cam.matrix().row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1)) &&
+                   IsRotation(c.T_body_cam.linear(), 1e-5),
+               root, "", "T_BS", "expected a rigid transform (rotation, last row 0 0 0 1)") ||
+      !r.Require(root, "", "intrinsics", "[fu, fv, cu, cv]") ||
+      !r.ReadNumbers(root["intrinsics"], "intrinsics", 4, &k))
+    return r.Report(error);
+  c.fu_px = k[0];
+  c.fv_px = k[1];
+  c.cu_px = k[2];
+  c.cv_px = k[3];
+  if (!r.Check(c.fu_px > 0.0 && c.fv_px > 0.0, root, "", "intrinsics",
+               "focal lengths fu, fv must be > 0") ||
+      !r.Require(root, "", "resolution", "[width, height]") ||
+      !r.ReadNumbers(root["resolution"], "resolution", 2, &res))
+    return r.Report(error);
+  c.width = static_cast<int>(res[0]);
+  c.height = static_cast<int>(res[1]);
+  r.Check(c.width > 0 && c.height > 0 && c.width == res[0] && c.height == res[1], root, "",
+          "resolution", "expected two positive integers [width, height]");
+  if (r.Require(root, "", "camera_model", "pinhole"))
+    r.String(root, "", "camera_model", &c.camera_model);
+  if (r.Require(root, "", "distortion_model", "radial-tangential | equidistant"))
+    r.String(root, "", "distortion_model", &c.distortion_model);
+  if (r.Require(root, "", "distortion_coefficients", "a list of numbers"))
+    r.ReadNumbers(root["distortion_coefficients"], "distortion_coefficients", 0,
+                  &c.distortion_coefficients);
+  r.Double(root, "", "rate_hz", &c.rate_hz);
+  if (!r.Report(error)) return false;
   c.path = path;
   *calibration = c;
   return true;

@@ -1,5 +1,7 @@
 #include "harness/overrides.h"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <sstream>
 
@@ -120,6 +122,42 @@ bool ApplyVoOverrides(const YAML::Node& overrides, const std::string& source_nam
   if (!ParseVoConfig(out.c_str(), source_name + " (VO overrides)", &result, error)) return false;
   *options = result;
   return true;
+}
+
+std::string OverrideErrorAt(const std::string& where, const std::string& key_prefix,
+                            const std::string& message) {
+  const std::string source = kOverridesSource;
+  if (message.rfind(source, 0) != 0) return message;
+  size_t at = source.size();
+  // The strict reader's own source name: " (VO overrides)" or " (overrides of NAME)".
+  for (const std::string inner : {" (VO overrides)", " (overrides of "}) {
+    if (message.compare(at, inner.size(), inner) != 0) continue;
+    at += inner.size();
+    if (inner.back() == ' ') {
+      while (at < message.size() && !(message[at] == ')' && message.compare(at + 1, 1, ":") == 0))
+        ++at;
+      ++at;
+    }
+    break;
+  }
+  // The line in the generated text means nothing to the user.
+  if (at < message.size() && message[at] == ':') {
+    size_t digits = at + 1;
+    while (digits < message.size() && std::isdigit(static_cast<unsigned char>(message[digits])))
+      ++digits;
+    if (digits > at + 1) at = digits;
+  }
+  if (message.compare(at, 2, ": ") == 0) at += 2;
+  std::string rest = message.substr(std::min(at, message.size()));
+  std::string key = key_prefix;
+  if (rest.rfind("key '", 0) == 0) {
+    const size_t end = rest.find("': ", 5);
+    if (end != std::string::npos) {
+      key += "." + rest.substr(5, end - 5);
+      rest = rest.substr(end + 3);
+    }
+  }
+  return where + ": key '" + key + "': " + rest;
 }
 
 std::string FlowYaml(const YAML::Node& node) {

@@ -32,6 +32,18 @@ bool ApplyScenarioOverrides(const sim::Scenario& base, const YAML::Node& overrid
 bool ApplyVoOverrides(const YAML::Node& overrides, const std::string& source_name,
                       vo::OdometryOptions* options, std::string* error);
 
+// The source name to give ApplyScenarioOverrides / ApplyVoOverrides for overrides read from a
+// file (a suite's or tune file's `set:`); OverrideErrorAt then tells their message in the one
+// format of the readers, at the place of the overrides in that file:
+//   "(overrides) (VO overrides):1: key 'matcher.type': expected ..."
+//   -> "WHERE: key 'KEY_PREFIX.matcher.type': expected ..."
+// (WHERE = "FILE:LINE" of the override map, KEY_PREFIX its key, e.g. "configs[0].set"). A
+// message without a key ("invalid VO options: ...") is told under KEY_PREFIX itself; a message
+// from another source is returned as it is.
+inline constexpr char kOverridesSource[] = "(overrides)";
+std::string OverrideErrorAt(const std::string& where, const std::string& key_prefix,
+                            const std::string& message);
+
 // A YAML node as one line of flow-style text (for names, logs and messages).
 std::string FlowYaml(const YAML::Node& node);
 

@@ -1,7 +1,5 @@
 #include "harness/suite.h"
 
-#include "harness/plots.h"
-
 #include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
@@ -20,6 +18,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <regex>
 #include <set>
@@ -31,6 +30,7 @@
 #include "harness/output_folder.h"
 #include "harness/overrides.h"
 #include "harness/path_names.h"
+#include "harness/plots.h"
 #include "harness/progress.h"
 #include "harness/trajectory_io.h"
 #include "harness/vo_config.h"
@@ -49,87 +49,8 @@ constexpr auto kWaitPoll = std::chrono::milliseconds(50);  // child-status polli
 // ---------------------------------------------------------------------------------------------
 // Suite file reading.
 
-// Collects the first error as "FILE:LINE: key 'a.b': what".
-class Reader {
- public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
-  bool ok() const { return error_.empty(); }
-  const std::string& error() const { return error_; }
-
-  std::string Where(const YAML::Node& node) const {
-    std::string w = source_;
-    if (node.IsDefined() && node.Mark().line >= 0) w += ":" + std::to_string(node.Mark().line + 1);
-    return w;
-  }
-  // An error message that already names the file and line.
-  void SetError(const std::string& message) {
-    if (error_.empty()) error_ = message;
-  }
-  void Fail(const YAML::Node& node, const std::string& key, const std::string& what) {
-    if (!error_.empty()) return;
-    error_ = Where(node) + (key.empty() ? "" : ": key '" + key + "'") + ": " + what;
-  }
-  void CheckKeys(const YAML::Node& map, const std::string& prefix,
-                 const std::vector<std::string>& allowed) {
-    if (!ok()) return;
-    if (!map.IsMap()) return Fail(map, prefix, "expected a mapping");
-    for (const auto& kv : map) {
-      const std::string key = kv.first.Scalar();
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        return Fail(kv.first, Join(prefix, key), "unknown key (expected one of: " + list + ")");
-      }
-    }
-  }
-  static std::string Join(const std::string& prefix, const std::string& key) {
-    return prefix.empty() ? key : prefix + "." + key;
-  }
-  bool String(const YAML::Node& map, const std::string& prefix, const std::string& key,
-              std::string* out) {
-    const YAML::Node n = map[key];
-    if (!n.IsDefined() || !ok()) return false;
-    if (!n.IsScalar() || n.Scalar().empty()) {
-      Fail(n, Join(prefix, key), "expected a non-empty string");
-      return false;
-    }
-    *out = n.Scalar();
-    return true;
-  }
-  template <typename T>
-  bool Integer(const YAML::Node& n, const std::string& key, T lo, T* out) {
-    if (!ok()) return false;
-    T v;
-    try {
-      if (!n.IsScalar() ||
-          (std::is_unsigned<T>::value && !n.Scalar().empty() && n.Scalar()[0] == '-'))
-        throw YAML::Exception(n.Mark(), "");
-      v = n.as<T>();
-    } catch (const YAML::Exception&) {
-      Fail(n, key,
-           "expected an integer >= " + std::to_string(lo) + ", got '" +
-               (n.IsScalar() ? n.Scalar() : "a non-scalar") + "'");
-      return false;
-    }
-    if (v < lo) {
-      Fail(n, key, "expected an integer >= " + std::to_string(lo) + ", got " + n.Scalar());
-      return false;
-    }
-    *out = v;
-    return true;
-  }
-
- private:
-  std::string source_;
-  std::string error_;
-};
-
-// The strict readers re-parse overrides as generated YAML; a line number in that text means
-// nothing to the user, so it is dropped ("(VO overrides):2: key" -> "(VO overrides): key").
-std::string WithoutGeneratedLine(const std::string& message) {
-  static const std::regex kGeneratedLine(R"(\((VO overrides|overrides of [^)]*)\):[0-9]+)");
-  return std::regex_replace(message, kGeneratedLine, "($1)");
-}
+using sim::YamlReader;
+constexpr int kIntMax = std::numeric_limits<int>::max();
 
 // A name that becomes part of a run id, and so of a folder name (CheckPathName, the one path
 // rule) and of an unquoted summary.csv cell: also letters, digits, '_', '.', '-' only, and no
@@ -145,7 +66,7 @@ bool CheckRunIdPart(const std::string& name, const std::string& what, std::strin
 // Checks every (dotted or nested) key of an override map against `reference` (an effective
 // document that has every supported key), so a typo is reported at its line in the suite file.
 void CheckOverrideKeys(const YAML::Node& set, const YAML::Node& reference,
-                       const std::string& key_prefix, const std::string& what, Reader* r) {
+                       const std::string& key_prefix, const std::string& what, YamlReader* r) {
   for (const auto& kv : set) {
     if (!r->ok()) return;
     const std::string key = kv.first.Scalar();
@@ -160,7 +81,7 @@ void CheckOverrideKeys(const YAML::Node& set, const YAML::Node& reference,
       }
       node.reset(node[part]);
     }
-    const std::string full = Reader::Join(key_prefix, key);
+    const std::string full = YamlReader::Join(key_prefix, key);
     if (!found || key.empty() || key.back() == '.') {
       r->Fail(kv.first, full, "unknown " + what + " key");
       return;
@@ -186,7 +107,7 @@ std::string ReadWholeFile(const fs::path& path, bool* ok) {
 // The scenario of a suite entry: a file relative to the suite, or a built-in name.
 bool ResolveSuiteScenario(const std::string& value, const fs::path& base_dir,
                           const YAML::Node& node, const std::string& key, sim::Scenario* scenario,
-                          Reader* r) {
+                          YamlReader* r) {
   fs::path path = value;
   if (path.is_relative()) path = base_dir / path;
   const std::string builtin = sim::BuiltinScenarioPath(value);
@@ -213,25 +134,23 @@ bool ResolveSuiteScenario(const std::string& value, const fs::path& base_dir,
 
 bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
                 const std::string& base_dir, Suite* suite, std::string* error) {
-  YAML::Node root;
-  if (!sim::LoadYamlDocument(yaml_text, source_name, &root, error)) return false;
+  YamlReader r(source_name);
+  if (!r.Parse(yaml_text)) return r.Report(error);
+  YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
   if (!root.IsMap()) {
     *error =
         source_name + ": expected a YAML mapping at the top level (name, scenarios, configs, ...)";
     return false;
   }
-  Reader r(source_name);
   Suite s;
   s.source_text = yaml_text;
   r.CheckKeys(root, "", {"name", "max_frames", "scenarios", "configs", "seeds", "strides"});
-  if (!r.String(root, "", "name", &s.name) && r.ok())
-    r.Fail(root, "name", "required: the suite's name");
+  if (r.Require(root, "", "name", "the suite's name")) r.String(root, "", "name", &s.name, false);
   std::string name_error;
   if (r.ok() && !CheckRunIdPart(s.name, "suite name", &name_error))
     r.Fail(root["name"], "name", name_error);
   int default_max_frames = 0;
-  if (root["max_frames"].IsDefined())
-    r.Integer(root["max_frames"], "max_frames", 0, &default_max_frames);
+  r.Int(root, "", "max_frames", 0, kIntMax, &default_max_frames);
 
   // scenarios
   const YAML::Node scenarios = root["scenarios"];
@@ -245,22 +164,20 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
     r.CheckKeys(e, key, {"name", "scenario", "set", "max_frames"});
     SuiteScenario sc;
     std::string value;
-    if (!r.String(e, key, "scenario", &value)) {
-      r.Fail(e, key + ".scenario",
-             "required: a built-in scenario name or a scenario file relative to the suite");
+    if (!r.Require(e, key, "scenario",
+                   "a built-in scenario name or a scenario file relative to the suite") ||
+        !r.String(e, key, "scenario", &value, false))
       break;
-    }
     sim::Scenario base;
     if (!ResolveSuiteScenario(value, base_dir, e["scenario"], key + ".scenario", &base, &r)) break;
     sc.name = base.name;
-    r.String(e, key, "name", &sc.name);
+    r.String(e, key, "name", &sc.name, false);
     if (r.ok() && !CheckRunIdPart(sc.name, "scenario name", &name_error))
       r.Fail(e["name"].IsDefined() ? e["name"] : e["scenario"], key + ".name", name_error);
     if (r.ok() && !names.insert(sc.name).second)
       r.Fail(e, key + ".name", "scenario name '" + sc.name + "' is used twice");
     sc.max_frames = default_max_frames;
-    if (e["max_frames"].IsDefined())
-      r.Integer(e["max_frames"], key + ".max_frames", 0, &sc.max_frames);
+    r.Int(e, key, "max_frames", 0, kIntMax, &sc.max_frames);
     sc.scenario = base;
     if (const YAML::Node set = e["set"]; set.IsDefined() && r.ok()) {
       if (!set.IsMap()) {
@@ -269,9 +186,8 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
       }
       CheckOverrideKeys(set, YAML::Load(sim::ScenarioToYaml(base)), key + ".set", "scenario", &r);
       std::string why;
-      if (r.ok() && !ApplyScenarioOverrides(base, set, r.Where(set) + ": " + key + ".set",
-                                            &sc.scenario, &why))
-        r.SetError(WithoutGeneratedLine(why));
+      if (r.ok() && !ApplyScenarioOverrides(base, set, kOverridesSource, &sc.scenario, &why))
+        r.SetError(OverrideErrorAt(r.Where(set), key + ".set", why));
     }
     s.scenarios.push_back(sc);
   }
@@ -288,16 +204,15 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
     const std::string key = "configs[" + std::to_string(i) + "]";
     r.CheckKeys(e, key, {"name", "config", "set"});
     SuiteConfig c;
-    if (!r.String(e, key, "name", &c.name)) {
-      r.Fail(e, key + ".name", "required: the configuration's name");
+    if (!r.Require(e, key, "name", "the configuration's name") ||
+        !r.String(e, key, "name", &c.name, false))
       break;
-    }
     if (!CheckRunIdPart(c.name, "configuration name", &name_error))
       r.Fail(e["name"], key + ".name", name_error);
     if (r.ok() && !names.insert(c.name).second)
       r.Fail(e["name"], key + ".name", "configuration name '" + c.name + "' is used twice");
     std::string file;
-    if (r.String(e, key, "config", &file)) {
+    if (YamlReader::Has(e, "config") && r.String(e, key, "config", &file, false)) {
       fs::path path = file;
       if (path.is_relative()) path = fs::path(base_dir) / path;
       std::string why;
@@ -314,8 +229,8 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
       }
       CheckOverrideKeys(set, vo_reference, key + ".set", "VO option", &r);
       std::string why;
-      if (r.ok() && !ApplyVoOverrides(set, r.Where(set) + ": " + key + ".set", &c.options, &why))
-        r.SetError(WithoutGeneratedLine(why));
+      if (r.ok() && !ApplyVoOverrides(set, kOverridesSource, &c.options, &why))
+        r.SetError(OverrideErrorAt(r.Where(set), key + ".set", why));
     }
     s.configs.push_back(c);
   }
@@ -327,8 +242,7 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
     std::set<uint64_t> seen;
     for (size_t i = 0; r.ok() && i < seeds.size(); ++i) {
       uint64_t v = 0;
-      if (r.Integer(seeds[i], "seeds[" + std::to_string(i) + "]", uint64_t{0}, &v) &&
-          !seen.insert(v).second)
+      if (r.ReadUint64(seeds[i], YamlReader::Item("seeds", i), &v) && !seen.insert(v).second)
         r.Fail(seeds[i], "seeds[" + std::to_string(i) + "]",
                "seed " + std::to_string(v) + " is given twice");
       s.seeds.push_back(v);
@@ -341,17 +255,14 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
     std::set<int> seen;
     for (size_t i = 0; r.ok() && i < strides.size(); ++i) {
       int v = 0;
-      if (r.Integer(strides[i], "strides[" + std::to_string(i) + "]", 1, &v) &&
+      if (r.ReadInt(strides[i], YamlReader::Item("strides", i), 1, kIntMax, &v) &&
           !seen.insert(v).second)
         r.Fail(strides[i], "strides[" + std::to_string(i) + "]",
                "stride " + std::to_string(v) + " is given twice");
       s.strides.push_back(v);
     }
   }
-  if (!r.ok()) {
-    *error = r.error();
-    return false;
-  }
+  if (!r.Report(error)) return false;
   *suite = s;
   return true;
 }

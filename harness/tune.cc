@@ -77,116 +77,45 @@ YAML::Node FindDotted(const YAML::Node& node, const std::vector<std::string>& pa
   return FindDotted(child, parts, i + 1);
 }
 
-// Strict reading of the tune file: every message starts with "<file>:<line>: ".
-class Reader {
- public:
-  Reader(std::string source, std::string* error) : source_(std::move(source)), error_(error) {}
-
-  std::string Loc(const YAML::Node& n) const {
-    return source_ + ":" + std::to_string(n.Mark().line + 1);
-  }
-  bool Fail(const YAML::Node& n, const std::string& message) {
-    *error_ = Loc(n) + ": " + message;
-    return false;
-  }
-
-  // `map` must be a mapping whose keys are all in `allowed`.
-  bool Keys(const YAML::Node& map, const std::string& what,
-            const std::vector<std::string>& allowed) {
-    if (!map.IsMap()) return Fail(map, what + ": expected a mapping");
-    for (const auto& kv : map) {
-      const std::string key = kv.first.Scalar();
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        return Fail(kv.first, "unknown key '" + key + "' in " + what + " (expected " + list + ")");
-      }
-    }
-    return true;
-  }
-
-  bool String(const YAML::Node& n, const std::string& what, std::string* v) {
-    if (!n.IsScalar() || n.Scalar().empty()) return Fail(n, what + ": expected a non-empty text");
-    *v = n.Scalar();
-    return true;
-  }
-  bool Double(const YAML::Node& n, const std::string& what, double* v) {
-    if (!n.IsScalar() || !ParseDouble(n.Scalar(), v) || !std::isfinite(*v))
-      return Fail(n, what + ": expected a finite number, got '" + Text(n) + "'");
-    return true;
-  }
-  bool Int(const YAML::Node& n, const std::string& what, long lo, long hi, long* v) {
-    double d = 0.0;
-    if (!n.IsScalar() || !ParseDouble(n.Scalar(), &d) || d != std::round(d) || d < lo || d > hi)
-      return Fail(n, what + ": expected an integer in [" + std::to_string(lo) + ", " +
-                         std::to_string(hi) + "], got '" + Text(n) + "'");
-    *v = static_cast<long>(d);
-    return true;
-  }
-  bool Bool(const YAML::Node& n, const std::string& what, bool* v) {
-    try {
-      if (n.IsScalar()) {
-        *v = n.as<bool>();
-        return true;
-      }
-    } catch (const YAML::Exception&) {
-    }
-    return Fail(n, what + ": expected true or false, got '" + Text(n) + "'");
-  }
-
-  const std::string& source() const { return source_; }
-  bool Raw(const std::string& message) {
-    *error_ = message;
-    return false;
-  }
-
- private:
-  static std::string Text(const YAML::Node& n) { return n.IsScalar() ? n.Scalar() : FlowYaml(n); }
-
-  std::string source_;
-  std::string* error_;
-};
+using sim::YamlReader;
 
 // "train" / "validation" lists.
-bool ReadScenarios(Reader& r, const YAML::Node& root, const std::string& what,
+bool ReadScenarios(YamlReader& r, const YAML::Node& root, const std::string& what,
                    const std::string& base_dir, std::vector<TuneScenario>* out) {
   const YAML::Node list = root[what];
   if (!list.IsDefined() || list.IsNull() || (list.IsSequence() && list.size() == 0))
-    return r.Fail(list.IsDefined() ? list : root,
-                  "'" + what + "' needs at least one scenario (the " + what + " set is empty)");
-  if (!list.IsSequence()) return r.Fail(list, what + ": expected a list of scenarios");
+    return r.Fail(list.IsDefined() ? list : root, what,
+                  "needs at least one scenario (the " + what + " set is empty)");
+  if (!list.IsSequence()) return r.Fail(list, what, "expected a list of scenarios");
   for (size_t i = 0; i < list.size(); ++i) {
     const YAML::Node n = list[i];
-    const std::string where = what + "[" + std::to_string(i) + "]";
-    if (!r.Keys(n, where, {"name", "scenario", "set", "max_frames"})) return false;
+    const std::string where = YamlReader::Item(what, i);
+    if (!r.CheckKeys(n, where, {"name", "scenario", "set", "max_frames"})) return false;
     TuneScenario s;
     s.line = n.Mark().line + 1;
-    if (!n["scenario"].IsDefined()) return r.Fail(n, where + ": 'scenario' is required");
-    if (!r.String(n["scenario"], where + ".scenario", &s.scenario_arg)) return false;
+    if (!r.Require(n, where, "scenario", "a built-in scenario name or a scenario file") ||
+        !r.String(n, where, "scenario", &s.scenario_arg, false))
+      return false;
     const fs::path relative = fs::path(base_dir) / s.scenario_arg;
     const std::string arg = fs::path(s.scenario_arg).is_relative() && fs::exists(relative)
                                 ? relative.string()
                                 : s.scenario_arg;
     sim::Scenario base;
     std::string why;
-    if (!ResolveScenario(arg, &base, &why))
-      return r.Fail(n["scenario"], where + ".scenario: " + why);
+    if (!ResolveScenario(arg, &base, &why)) return r.Fail(n["scenario"], where + ".scenario", why);
     const YAML::Node set = n["set"];
     if (set.IsDefined() && !set.IsNull() && !set.IsMap())
-      return r.Fail(set, where + ".set: expected a mapping of scenario keys to values");
-    if (!ApplyScenarioOverrides(base, set, r.Loc(set.IsDefined() ? set : n) + ": " + where + ".set",
-                                &s.scenario, &why)) {
-      return r.Raw(why);  // the message starts with file:line already
-    }
+      return r.Fail(set, where + ".set", "expected a mapping of scenario keys to values");
+    if (!ApplyScenarioOverrides(base, set, kOverridesSource, &s.scenario, &why))
+      return r.SetError(OverrideErrorAt(r.Where(set.IsDefined() ? set : n), where + ".set", why));
     s.set_yaml = set.IsDefined() && !set.IsNull() ? FlowYaml(set) : "{}";
     s.name = what + "_" + std::to_string(i);
-    if (n["name"].IsDefined() && !r.String(n["name"], where + ".name", &s.name)) return false;
-    if (n["max_frames"].IsDefined()) {
-      long v = 0;
-      if (!r.Int(n["max_frames"], where + ".max_frames", 0, 1000000, &v)) return false;
-      s.max_frames = static_cast<int>(v);
+    if (!r.String(n, where, "name", &s.name, false)) return false;
+    if (YamlReader::Has(n, "max_frames")) {
+      if (!r.ReadWholeNumber(n["max_frames"], where + ".max_frames", 0, 1000000, &s.max_frames))
+        return false;
       if (s.max_frames == 1)
-        return r.Fail(n["max_frames"], where + ".max_frames: needs >= 2 frames (or 0 = all)");
+        return r.Fail(n["max_frames"], where + ".max_frames", "needs >= 2 frames (or 0 = all)");
     }
     s.scenario.name = s.name;
     out->push_back(s);
@@ -227,69 +156,71 @@ bool ApplyValues(const std::vector<Parameter>& parameters, const vo::OdometryOpt
   return true;
 }
 
-bool ReadParameters(Reader& r, const YAML::Node& root, TuneSpec* spec) {
+bool ReadParameters(YamlReader& r, const YAML::Node& root, TuneSpec* spec) {
   const YAML::Node list = root["parameters"];
   if (!list.IsDefined() || list.IsNull() || (list.IsSequence() && list.size() == 0))
-    return r.Fail(list.IsDefined() ? list : root, "'parameters' needs at least one parameter");
-  if (!list.IsSequence()) return r.Fail(list, "parameters: expected a list");
+    return r.Fail(list.IsDefined() ? list : root, "parameters", "needs at least one parameter");
+  if (!list.IsSequence()) return r.Fail(list, "parameters", "expected a list");
   const YAML::Node base_yaml = YAML::Load(VoConfigToYaml(spec->base_options));
   std::set<std::string> seen;
   for (size_t i = 0; i < list.size(); ++i) {
     const YAML::Node n = list[i];
-    const std::string where = "parameters[" + std::to_string(i) + "]";
-    if (!r.Keys(n, where, {"key", "min", "max", "type", "log", "step"})) return false;
-    for (const char* required : {"key", "min", "max"})
-      if (!n[required].IsDefined()) return r.Fail(n, where + ": '" + required + "' is required");
+    const std::string where = YamlReader::Item("parameters", i);
+    if (!r.CheckKeys(n, where, {"key", "min", "max", "type", "log", "step"})) return false;
     Parameter p;
-    if (!r.String(n["key"], where + ".key", &p.key) ||
-        !r.Double(n["min"], where + ".min", &p.min) ||
-        !r.Double(n["max"], where + ".max", &p.max)) {
+    if (!r.Require(n, where, "key", "the VO option's dotted key") ||
+        !r.Require(n, where, "min", "the lower end of the range") ||
+        !r.Require(n, where, "max", "the upper end of the range") ||
+        !r.String(n, where, "key", &p.key, false) || !r.Double(n, where, "min", &p.min) ||
+        !r.Double(n, where, "max", &p.max)) {
       return false;
     }
-    const std::string who = where + " '" + p.key + "'";
-    if (n["type"].IsDefined()) {
+    // Messages about the parameter as a whole: at the list item, naming its VO key.
+    const std::string who = "'" + p.key + "': ";
+    if (YamlReader::Has(n, "type")) {
       std::string type;
-      if (!r.String(n["type"], where + ".type", &type)) return false;
+      if (!r.String(n, where, "type", &type, false)) return false;
       if (!ParseParameterType(type, &p.type))
-        return r.Fail(n["type"], where + ".type: expected real, int or scale, got '" + type + "'");
+        return r.Fail(n["type"], where + ".type",
+                      "expected real, int or scale, got '" + type + "'");
     }
-    if (n["log"].IsDefined() && !r.Bool(n["log"], where + ".log", &p.log)) return false;
-    if (n["step"].IsDefined()) {
-      long step = 0;
-      if (!r.Int(n["step"], where + ".step", 1, 1000000, &step)) return false;
-      p.step = static_cast<int>(step);
-    }
+    if (!r.Bool(n, where, "log", &p.log)) return false;
+    if (YamlReader::Has(n, "step") &&
+        !r.ReadWholeNumber(n["step"], where + ".step", 1, 1000000, &p.step))
+      return false;
     std::string why;
-    if (!p.IsValid(&why)) return r.Fail(n, where + ": " + why);
-    if (!seen.insert(p.key).second) return r.Fail(n["key"], who + ": key given twice");
+    if (!p.IsValid(&why)) return r.Fail(n, where, why);  // names the parameter
+    if (!seen.insert(p.key).second) return r.Fail(n["key"], where + ".key", who + "given twice");
 
     // The key against the VO config reader: known, of the right kind, start value in range.
     const YAML::Node option = FindDotted(base_yaml, SplitDots(p.key), 0);
     if (!option.IsDefined())
-      return r.Fail(n["key"], who +
-                                  ": not a VO option key (see a run folder's vo_options.yaml "
-                                  "for the keys)");
+      return r.Fail(n["key"], where + ".key",
+                    who + "not a VO option key (see a run folder's vo_options.yaml for the keys)");
     double start = 1.0;
     if (p.type == ParameterType::kScale) {
       bool numeric_list = option.IsSequence() && option.size() > 0;
       for (const auto& x : option) numeric_list = numeric_list && ParseDouble(x.Scalar(), &start);
       if (!numeric_list)
-        return r.Fail(n["key"], who +
-                                    ": type scale needs a list-valued option (such as "
-                                    "matcher.gabor.wavelengths_px), this one holds " +
-                                    FlowYaml(option));
+        return r.Fail(n["key"], where + ".key",
+                      who +
+                          "type scale needs a list-valued option (such as "
+                          "matcher.gabor.wavelengths_px), this one holds " +
+                          FlowYaml(option));
       start = 1.0;
     } else if (!option.IsScalar() || !ParseDouble(option.Scalar(), &start)) {
-      return r.Fail(n["key"], who + ": not a numeric VO option (it holds " + FlowYaml(option) +
-                                  ")" + (option.IsSequence() ? "; use type: scale" : ""));
+      return r.Fail(n["key"], where + ".key",
+                    who + "not a numeric VO option (it holds " + FlowYaml(option) + ")" +
+                        (option.IsSequence() ? "; use type: scale" : ""));
     }
     if (!IsAttainable(p, start))
-      return r.Fail(n, who + ": the base configuration's value " + Short(start) + " is outside [" +
-                           Short(p.min) + ", " + Short(p.max) + "]" +
-                           (p.type == ParameterType::kInt
-                                ? " or off the grid of step " + std::to_string(p.step)
-                                : "") +
-                           "; the search starts there, widen the range");
+      return r.Fail(
+          n, where,
+          who + "the base configuration's value " + Short(start) + " is outside [" + Short(p.min) +
+              ", " + Short(p.max) + "]" +
+              (p.type == ParameterType::kInt ? " or off the grid of step " + std::to_string(p.step)
+                                             : "") +
+              "; the search starts there, widen the range");
 
     // Values the search can take, each alone on the base options.
     std::vector<double> probes;
@@ -304,8 +235,9 @@ bool ReadParameters(Reader& r, const YAML::Node& root, TuneSpec* spec) {
       if (!ApplyValues({p}, spec->base_options, {v}, r.source() + " " + where, &o, &why)) {
         const bool integer_option = p.type == ParameterType::kReal && v != std::round(v) &&
                                     why.find("integer") != std::string::npos;
-        return r.Fail(n, who + ": the VO options refuse the value " + Short(v) + " of the range: " +
-                             why + (integer_option ? " (an integer option needs type: int)" : ""));
+        return r.Fail(n, where,
+                      who + "the VO options refuse the value " + Short(v) + " of the range: " +
+                          why + (integer_option ? " (an integer option needs type: int)" : ""));
       }
     }
     spec->parameters.push_back(p);
@@ -314,62 +246,40 @@ bool ReadParameters(Reader& r, const YAML::Node& root, TuneSpec* spec) {
   return true;
 }
 
-bool ReadObjective(Reader& r, const YAML::Node& root, TuneObjective* objective) {
+bool ReadObjective(YamlReader& r, const YAML::Node& root, TuneObjective* objective) {
   const YAML::Node n = root["objective"];
   if (!n.IsDefined() || n.IsNull()) return true;
-  if (!r.Keys(n, "objective", {"metric", "lost_frame_penalty", "aggregate"})) return false;
-  if (n["metric"].IsDefined()) {
-    if (!r.String(n["metric"], "objective.metric", &objective->metric)) return false;
+  if (!r.CheckKeys(n, "objective", {"metric", "lost_frame_penalty", "aggregate"})) return false;
+  if (!r.String(n, "objective", "metric", &objective->metric, false)) return false;
+  if (YamlReader::Has(n, "metric")) {
     const MetricInfo* metric = FindMetric(objective->metric);
     if (metric == nullptr || !metric->tune_objective)
-      return r.Fail(n["metric"], "objective.metric: unknown metric '" + objective->metric +
-                                     "' (expected " + ListOfNames(TuneObjectiveMetrics()) + ")");
+      return r.Fail(n["metric"], "objective.metric",
+                    "unknown metric '" + objective->metric + "' (expected " +
+                        ListOfNames(TuneObjectiveMetrics()) + ")");
   }
-  if (n["lost_frame_penalty"].IsDefined()) {
-    if (!r.Double(n["lost_frame_penalty"], "objective.lost_frame_penalty",
-                  &objective->lost_frame_penalty))
-      return false;
-    if (objective->lost_frame_penalty < 0)
-      return r.Fail(n["lost_frame_penalty"], "objective.lost_frame_penalty: must be >= 0");
-  }
-  if (n["aggregate"].IsDefined()) {
-    if (!r.String(n["aggregate"], "objective.aggregate", &objective->aggregate)) return false;
-    if (objective->aggregate != "mean" && objective->aggregate != "max")
-      return r.Fail(n["aggregate"], "objective.aggregate: expected mean or max, got '" +
-                                        objective->aggregate + "'");
-  }
-  return true;
+  if (!r.Double(n, "objective", "lost_frame_penalty", &objective->lost_frame_penalty) ||
+      !r.Check(objective->lost_frame_penalty >= 0, n, "objective", "lost_frame_penalty",
+               "expected >= 0"))
+    return false;
+  return r.Enum<std::string>(n, "objective", "aggregate", {{"mean", "mean"}, {"max", "max"}},
+                             &objective->aggregate);
 }
 
-bool ReadOptimizer(Reader& r, const YAML::Node& root, OptimizerOptions* optimizer) {
+bool ReadOptimizer(YamlReader& r, const YAML::Node& root, OptimizerOptions* optimizer) {
   const YAML::Node n = root["optimizer"];
   if (!n.IsDefined() || n.IsNull()) return true;
-  if (!r.Keys(n, "optimizer", {"algorithm", "max_evals", "seed", "initial_step", "xtol_abs"}))
-    return false;
-  if (n["algorithm"].IsDefined() &&
-      !r.String(n["algorithm"], "optimizer.algorithm", &optimizer->algorithm))
-    return false;
-  long v = 0;
-  if (n["max_evals"].IsDefined()) {
-    if (!r.Int(n["max_evals"], "optimizer.max_evals", 1, 1000000, &v)) return false;
-    optimizer->max_evals = static_cast<int>(v);
-  }
-  if (n["seed"].IsDefined()) {
-    try {
-      optimizer->seed = n["seed"].as<uint64_t>();
-    } catch (const YAML::Exception&) {
-      return r.Fail(n["seed"], "optimizer.seed: expected an unsigned integer, got '" +
-                                   n["seed"].Scalar() + "'");
-    }
-  }
-  if (n["initial_step"].IsDefined() &&
-      !r.Double(n["initial_step"], "optimizer.initial_step", &optimizer->initial_step))
-    return false;
-  if (n["xtol_abs"].IsDefined() &&
-      !r.Double(n["xtol_abs"], "optimizer.xtol_abs", &optimizer->xtol_abs))
+  if (!r.CheckKeys(n, "optimizer",
+                   {"algorithm", "max_evals", "seed", "initial_step", "xtol_abs"}) ||
+      !r.String(n, "optimizer", "algorithm", &optimizer->algorithm, false) ||
+      (YamlReader::Has(n, "max_evals") && !r.ReadWholeNumber(n["max_evals"], "optimizer.max_evals",
+                                                             1, 1000000, &optimizer->max_evals)) ||
+      !r.Uint64(n, "optimizer", "seed", &optimizer->seed) ||
+      !r.Double(n, "optimizer", "initial_step", &optimizer->initial_step) ||
+      !r.Double(n, "optimizer", "xtol_abs", &optimizer->xtol_abs))
     return false;
   std::string why;
-  if (!optimizer->IsValid(&why)) return r.Fail(n, "optimizer: " + why);
+  if (!optimizer->IsValid(&why)) return r.Fail(n, "optimizer", why);
   return true;
 }
 
@@ -572,55 +482,65 @@ std::string ReportMarkdown(const TuneSpec& spec, const TuneSummary& s, const Opt
 
 bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
                    const std::string& base_dir, TuneSpec* spec, std::string* error) {
-  YAML::Node root;
-  if (!sim::LoadYamlDocument(yaml_text, source_name, &root, error)) return false;
-  Reader r(source_name, error);
+  YamlReader r(source_name);
+  if (!r.Parse(yaml_text)) return r.Report(error);
+  YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
   if (!root.IsMap()) {
     *error = source_name + ": expected a YAML mapping (name, train, validation, parameters, ...)";
     return false;
   }
-  if (!r.Keys(
-          root, "the tune file",
-          {"name", "base_config", "train", "validation", "parameters", "objective", "optimizer"}))
-    return false;
   TuneSpec s;
   s.text = yaml_text;
   s.name = fs::path(source_name).stem().string();
-  if (root["name"].IsDefined() && !r.String(root["name"], "name", &s.name)) return false;
+  if (!r.CheckKeys(
+          root, "",
+          {"name", "base_config", "train", "validation", "parameters", "objective", "optimizer"}) ||
+      !r.String(root, "", "name", &s.name, false))
+    return r.Report(error);
   std::string name_error;
-  if (!CheckPathName(s.name, "tune name", &name_error))
-    return r.Fail(root["name"].IsDefined() ? root["name"] : root, "name: " + name_error);
+  if (!CheckPathName(s.name, "tune name", &name_error)) {
+    r.Fail(root["name"].IsDefined() ? root["name"] : root, "name", name_error);
+    return r.Report(error);
+  }
   if (root["base_config"].IsDefined() && !root["base_config"].IsNull()) {
     std::string path;
-    if (!r.String(root["base_config"], "base_config", &path)) return false;
+    if (!r.String(root, "", "base_config", &path, false)) return r.Report(error);
     s.base_config_path = fs::path(path).is_relative() ? (fs::path(base_dir) / path).string() : path;
     std::string why;
-    if (!LoadVoConfig(s.base_config_path, &s.base_options, &why))
-      return r.Fail(root["base_config"], "base_config: " + why);
+    if (!LoadVoConfig(s.base_config_path, &s.base_options, &why)) {
+      r.Fail(root["base_config"], "base_config", why);
+      return r.Report(error);
+    }
   }
   if (!ReadScenarios(r, root, "train", base_dir, &s.train) ||
       !ReadScenarios(r, root, "validation", base_dir, &s.validation)) {
-    return false;
+    return r.Report(error);
   }
   // Names unique; validation scenarios differ from every training one.
+  const auto where = [&](const TuneScenario& sc, const std::string& list, size_t i) {
+    return source_name + ":" + std::to_string(sc.line) + ": key '" + YamlReader::Item(list, i) +
+           "': ";
+  };
   std::set<std::string> names;
-  for (const auto* list : {&s.train, &s.validation}) {
-    for (const TuneScenario& sc : *list) {
-      if (!names.insert(sc.name).second) {
-        *error = source_name + ":" + std::to_string(sc.line) + ": scenario name '" + sc.name +
+  for (const std::string list : {"train", "validation"}) {
+    const std::vector<TuneScenario>& scenarios = list == "train" ? s.train : s.validation;
+    for (size_t i = 0; i < scenarios.size(); ++i) {
+      if (!names.insert(scenarios[i].name).second) {
+        *error = where(scenarios[i], list, i) + "scenario name '" + scenarios[i].name +
                  "' is used twice (names must be unique across train and validation)";
         return false;
       }
     }
   }
-  for (const TuneScenario& v : s.validation) {
+  for (size_t i = 0; i < s.validation.size(); ++i) {
+    const TuneScenario& v = s.validation[i];
     sim::Scenario a = v.scenario;
     a.name.clear();
     for (const TuneScenario& t : s.train) {
       sim::Scenario b = t.scenario;
       b.name.clear();
       if (v.max_frames == t.max_frames && sim::ScenarioToYaml(a) == sim::ScenarioToYaml(b)) {
-        *error = source_name + ":" + std::to_string(v.line) + ": validation scenario '" + v.name +
+        *error = where(v, "validation", i) + "validation scenario '" + v.name +
                  "' is the same as training scenario '" + t.name +
                  "' (validation needs other scenarios, e.g. other textures.seed or seed)";
         return false;
@@ -629,7 +549,7 @@ bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
   }
   if (!ReadParameters(r, root, &s) || !ReadObjective(r, root, &s.objective) ||
       !ReadOptimizer(r, root, &s.optimizer)) {
-    return false;
+    return r.Report(error);
   }
   *spec = s;
   return true;

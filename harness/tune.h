@@ -2,7 +2,8 @@
 // set of scenarios, reports the chosen options' scores on a separate validation set and
 // writes the best configuration as a file `vobench run --config` accepts.
 //
-// Tune file (YAML; unknown keys, wrong types and bad values are refused with file:line):
+// Tune file (YAML; unknown keys, wrong types and bad values are refused as
+// "file:line: key 'a.b': ...", sim::YamlReader):
 //   name: tune_matcher          # names the output folder (default: the file's stem)
 //   base_config: base.yaml      # optional VO config, relative to this file (vo_config.h);
 //                               # default: the library defaults. It is the start of the search

@@ -1,59 +1,49 @@
 #include "harness/vo_config.h"
 
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
 #include <cmath>
 #include <fstream>
 #include <functional>
 #include <initializer_list>
 #include <map>
 #include <sstream>
+#include <type_traits>
 #include <vector>
-
-#include <Eigen/Core>
-#include <yaml-cpp/yaml.h>
 
 #include "sim/yaml_input.h"
 
 namespace harness {
 namespace {
 
-// One supported key: how to read it from a scalar and how to print it.
+using sim::YamlReader;
+
+// One supported key: how to read its value (failing through the reader, which names the file,
+// the line and the key) and how to print it.
 struct Entry {
-  std::function<bool(const YAML::Node&, std::string*)> read;  // false + what was expected
+  std::function<bool(YamlReader&, const YAML::Node&, const std::string&)> read;
   std::function<void(YAML::Emitter&)> write;
   bool sequence = false;  // the value is a YAML list (else a scalar)
 };
 
 template <typename T>
 Entry Number(T* field, T lo, T hi) {
-  return {[field, lo, hi](const YAML::Node& n, std::string* why) {
-            T v;
-            try {
-              v = n.as<T>();
-            } catch (const YAML::Exception&) {
-              *why = std::string("expected a ") + (std::is_integral<T>::value ? "integer" : "number") + ", got '" + n.Scalar() + "'";
-              return false;
+  return {[field, lo, hi](YamlReader& r, const YAML::Node& n, const std::string& key) {
+            if constexpr (std::is_same_v<T, uint64_t>) {
+              return r.ReadUint64(n, key, field);  // [lo, hi] is the whole of uint64_t
+            } else if constexpr (std::is_integral_v<T>) {
+              return r.ReadInt(n, key, lo, hi, field);
+            } else {
+              return r.ReadDoubleIn(n, key, lo, hi, field);
             }
-            if (!std::isfinite(static_cast<double>(v)) || v < lo || v > hi) {
-              std::ostringstream s;
-              s << "expected a finite value in [" << lo << ", " << hi << "], got " << n.Scalar();
-              *why = s.str();
-              return false;
-            }
-            *field = v;
-            return true;
           },
           [field](YAML::Emitter& e) { e << *field; }};
 }
 
 Entry Bool(bool* field) {
-  return {[field](const YAML::Node& n, std::string* why) {
-            try {
-              *field = n.as<bool>();
-              return true;
-            } catch (const YAML::Exception&) {
-              *why = "expected true or false, got '" + n.Scalar() + "'";
-              return false;
-            }
+  return {[field](YamlReader& r, const YAML::Node& n, const std::string& key) {
+            return r.ReadBool(n, key, field);
           },
           [field](YAML::Emitter& e) { e << *field; }};
 }
@@ -61,38 +51,20 @@ Entry Bool(bool* field) {
 // An enum by its vo::ToString names (the name tables live in vo/).
 template <typename E>
 Entry Enum(E* field, std::initializer_list<E> values) {
-  const std::vector<E> all(values);
-  return {[field, all](const YAML::Node& n, std::string* why) {
-            std::string names;
-            for (E v : all) {
-              if (n.Scalar() == vo::ToString(v)) {
-                *field = v;
-                return true;
-              }
-              names += (names.empty() ? "" : ", ") + std::string(vo::ToString(v));
-            }
-            *why = "expected one of " + names + "; got '" + n.Scalar() + "'";
-            return false;
+  std::vector<std::pair<std::string, E>> table;
+  for (E v : values) table.emplace_back(vo::ToString(v), v);
+  return {[field, table](YamlReader& r, const YAML::Node& n, const std::string& key) {
+            return r.ReadEnum(n, key, table, field);
           },
           [field](YAML::Emitter& e) { e << vo::ToString(*field); }};
 }
 
 // A 3-vector as a list [x, y, z] of finite numbers.
 Entry Vector3(Eigen::Vector3d* field) {
-  Entry entry{[field](const YAML::Node& n, std::string* why) {
-                Eigen::Vector3d v;
-                try {
-                  if (!n.IsSequence() || n.size() != 3) throw YAML::Exception(n.Mark(), "");
-                  for (int i = 0; i < 3; ++i) v[i] = n[i].as<double>();
-                } catch (const YAML::Exception&) {
-                  *why = "expected a list of 3 numbers [x, y, z]";
-                  return false;
-                }
-                if (!v.allFinite()) {
-                  *why = "expected finite numbers";
-                  return false;
-                }
-                *field = v;
+  Entry entry{[field](YamlReader& r, const YAML::Node& n, const std::string& key) {
+                std::vector<double> v;
+                if (!r.ReadNumbers(n, key, 3, &v, "a list of 3 numbers [x, y, z]")) return false;
+                *field = Eigen::Vector3d(v[0], v[1], v[2]);
                 return true;
               },
               [field](YAML::Emitter& e) {
@@ -104,32 +76,21 @@ Entry Vector3(Eigen::Vector3d* field) {
 }
 
 Entry Wavelengths(std::vector<double>* field) {
-  Entry entry{[field](const YAML::Node& n, std::string* why) {
-            std::vector<double> v;
-            try {
-              if (!n.IsSequence()) throw YAML::Exception(n.Mark(), "");
-              for (const auto& x : n) v.push_back(x.as<double>());
-            } catch (const YAML::Exception&) {
-              *why = "expected a list of wavelengths in pixels";
-              return false;
-            }
-            for (double x : v)
-              if (!(std::isfinite(x) && x >= 2.0 && x <= 64.0)) {
-                *why = "expected wavelengths in [2, 64] pixels";
-                return false;
-              }
-            if (v.empty()) {
-              *why = "expected at least one wavelength";
-              return false;
-            }
-            *field = v;
-            return true;
-          },
-          [field](YAML::Emitter& e) {
-            e << YAML::Flow << YAML::BeginSeq;
-            for (double x : *field) e << x;
-            e << YAML::EndSeq;
-          }};
+  Entry entry{[field](YamlReader& r, const YAML::Node& n, const std::string& key) {
+                std::vector<double> v;
+                if (!r.ReadNumbers(n, key, 0, &v, "a list of wavelengths in pixels")) return false;
+                for (double x : v)
+                  if (!(x >= 2.0 && x <= 64.0))
+                    return r.Fail(n, key, "expected wavelengths in [2, 64] pixels");
+                if (v.empty()) return r.Fail(n, key, "expected at least one wavelength");
+                *field = v;
+                return true;
+              },
+              [field](YAML::Emitter& e) {
+                e << YAML::Flow << YAML::BeginSeq;
+                for (double x : *field) e << x;
+                e << YAML::EndSeq;
+              }};
   entry.sequence = true;
   return entry;
 }
@@ -363,42 +324,39 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
   };
 }
 
-// Walks the mapping; leaves (scalars and the wavelength list) are applied by dotted key.
+// Walks the mapping; leaves (scalars and the list-valued options) are read by dotted key.
 // `seen` holds the line of every key applied so far: the same option given twice, once dotted
 // and once nested ("matcher.type: a" and "matcher: {type: b}"), is a duplicate too.
-bool Apply(const YAML::Node& node, const std::string& prefix, const std::string& source,
-           std::map<std::string, Entry>& entries, std::map<std::string, int>* seen,
-           std::string* error) {
+bool Apply(YamlReader& r, const YAML::Node& node, const std::string& prefix,
+           std::map<std::string, Entry>& entries, std::map<std::string, int>* seen) {
   for (const auto& kv : node) {
-    const std::string key = prefix.empty() ? kv.first.Scalar() : prefix + "." + kv.first.Scalar();
+    const std::string key = YamlReader::Join(prefix, kv.first.Scalar());
     const YAML::Node& v = kv.second;
     const int line = kv.first.Mark().line + 1;
-    const std::string where = source + ":" + std::to_string(line) + ": key '" + key + "': ";
     auto it = entries.find(key);
     if (it != entries.end()) {
       const auto [first, inserted] = seen->emplace(key, line);
-      if (!inserted) {
-        *error = where + "duplicate (first at line " + std::to_string(first->second) + ")";
-        return false;
-      }
+      if (!inserted)
+        return r.Fail(kv.first, key,
+                      "duplicate (first at line " + std::to_string(first->second) + ")");
     }
     if (it == entries.end()) {
       if (v.IsMap()) {
         bool any = false;
         for (const auto& e : entries) any |= e.first.rfind(key + ".", 0) == 0;
         if (any) {
-          if (!Apply(v, key, source, entries, seen, error)) return false;
+          if (!Apply(r, v, key, entries, seen)) return false;
           continue;
         }
       }
-      *error = where + "unknown key (see `vobench run --help` and results' vo_options.yaml for the supported keys)";
-      return false;
+      return r.Fail(kv.first, key,
+                    "unknown key (see `vobench run --help` and results' vo_options.yaml for the "
+                    "supported keys)");
     }
-    std::string why;
-    if (!(it->second.sequence ? v.IsSequence() : v.IsScalar()) || !it->second.read(v, &why)) {
-      *error = where + (why.empty() ? "expected a single value" : why);
-      return false;
-    }
+    if (it->second.sequence && !v.IsSequence()) return r.Fail(kv.first, key, "expected a list");
+    if (!it->second.sequence && !v.IsScalar())
+      return r.Fail(kv.first, key, "expected a single value");
+    if (!it->second.read(r, v, key)) return false;
   }
   return true;
 }
@@ -407,8 +365,9 @@ bool Apply(const YAML::Node& node, const std::string& prefix, const std::string&
 
 bool ParseVoConfig(const std::string& yaml_text, const std::string& source_name,
                    vo::OdometryOptions* options, std::string* error) {
-  YAML::Node root;
-  if (!sim::LoadYamlDocument(yaml_text, source_name, &root, error)) return false;
+  YamlReader r(source_name);
+  if (!r.Parse(yaml_text)) return r.Report(error);
+  YAML::Node root = r.root();      // not const: a missing key reads as undefined, not invalid
   if (root.IsNull()) return true;  // an empty file: defaults
   if (!root.IsMap()) {
     *error = source_name + ": expected a YAML mapping of VO options";
@@ -418,7 +377,7 @@ bool ParseVoConfig(const std::string& yaml_text, const std::string& source_name,
   std::map<std::string, Entry> entries;
   for (auto& e : Registry(&o)) entries.emplace(e.first, e.second);
   std::map<std::string, int> seen;
-  if (!Apply(root, "", source_name, entries, &seen, error)) return false;
+  if (!Apply(r, root, "", entries, &seen)) return r.Report(error);
   std::string why;
   if (!o.IsValid(&why)) {
     *error = source_name + ": invalid VO options: " + why;

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <set>
+#include <limits>
+#include <utility>
+#include <vector>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -15,114 +17,6 @@ namespace sim {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Strict reader over one YAML document: checks types, ranges and unknown keys, and turns
-// every problem into one message "FILE:LINE: key 'a.b': expected ..., got ...".
-class StrictReader {
- public:
-  explicit StrictReader(std::string source) : source_(std::move(source)) {}
-
-  bool ok() const { return error_.empty(); }
-  const std::string& error() const { return error_; }
-
-  void Fail(const YAML::Node& node, const std::string& key, const std::string& what) {
-    if (!error_.empty()) return;  // keep the first error
-    std::ostringstream msg;
-    msg << source_;
-    if (node.IsDefined() && node.Mark().line >= 0) msg << ":" << node.Mark().line + 1;
-    if (!key.empty()) msg << ": key '" << key << "'";
-    msg << ": " << what;
-    error_ = msg.str();
-  }
-
-  // Fails on any key of `map` not in `allowed`.
-  void CheckKeys(const YAML::Node& map, const std::string& prefix,
-                 const std::set<std::string>& allowed) {
-    if (!map.IsMap()) {
-      Fail(map, prefix, "expected a mapping");
-      return;
-    }
-    for (const auto& kv : map) {
-      const std::string key = kv.first.Scalar();
-      if (allowed.count(key) == 0) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        Fail(kv.first, Join(prefix, key), "unknown key (expected one of: " + list + ")");
-      }
-    }
-  }
-
-  static std::string Join(const std::string& prefix, const std::string& key) {
-    return prefix.empty() ? key : prefix + "." + key;
-  }
-
-  void Double(const YAML::Node& map, const std::string& prefix, const std::string& key,
-              double* out) {
-    // A scalar or sequence where a mapping belongs was refused by CheckKeys; operator[] on it
-    // would throw (YAML::BadSubscript), so stop here.
-    if (!ok() || !map.IsMap()) return;
-    const YAML::Node n = map[key];
-    if (!n.IsDefined()) return;
-    if (!n.IsScalar()) return Fail(n, Join(prefix, key), "expected a number");
-    try {
-      const double v = n.as<double>();
-      if (!std::isfinite(v)) return Fail(n, Join(prefix, key), "expected a finite number, got " + n.Scalar());
-      *out = v;
-    } catch (const YAML::Exception&) {
-      Fail(n, Join(prefix, key), "expected a number, got '" + n.Scalar() + "'");
-    }
-  }
-
-  void Int(const YAML::Node& map, const std::string& prefix, const std::string& key, int* out) {
-    // A scalar or sequence where a mapping belongs was refused by CheckKeys; operator[] on it
-    // would throw (YAML::BadSubscript), so stop here.
-    if (!ok() || !map.IsMap()) return;
-    const YAML::Node n = map[key];
-    if (!n.IsDefined()) return;
-    try {
-      if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
-      *out = n.as<int>();
-    } catch (const YAML::Exception&) {
-      Fail(n, Join(prefix, key), "expected an integer, got '" + n.Scalar() + "'");
-    }
-  }
-
-  void Uint64(const YAML::Node& map, const std::string& prefix, const std::string& key,
-              uint64_t* out) {
-    // A scalar or sequence where a mapping belongs was refused by CheckKeys; operator[] on it
-    // would throw (YAML::BadSubscript), so stop here.
-    if (!ok() || !map.IsMap()) return;
-    const YAML::Node n = map[key];
-    if (!n.IsDefined()) return;
-    try {
-      if (!n.IsScalar() || n.Scalar().empty() || n.Scalar()[0] == '-') throw YAML::Exception(n.Mark(), "");
-      *out = n.as<uint64_t>();
-    } catch (const YAML::Exception&) {
-      Fail(n, Join(prefix, key), "expected a non-negative integer, got '" + n.Scalar() + "'");
-    }
-  }
-
-  void String(const YAML::Node& map, const std::string& prefix, const std::string& key,
-              std::string* out) {
-    // A scalar or sequence where a mapping belongs was refused by CheckKeys; operator[] on it
-    // would throw (YAML::BadSubscript), so stop here.
-    if (!ok() || !map.IsMap()) return;
-    const YAML::Node n = map[key];
-    if (!n.IsDefined()) return;
-    if (!n.IsScalar()) return Fail(n, Join(prefix, key), "expected a string");
-    *out = n.Scalar();
-  }
-
-  // Range checks on already-read values; `node` gives the line.
-  void Require(bool condition, const YAML::Node& map, const std::string& prefix,
-               const std::string& key, const std::string& what) {
-    if (!condition && ok()) Fail(map.IsMap() && map[key].IsDefined() ? map[key] : map, Join(prefix, key), what);
-  }
-
- private:
-  std::string source_;
-  std::string error_;
-};
 
 std::string Num(double v) {
   std::ostringstream s;
@@ -207,24 +101,23 @@ bool Scenario::IsValid(std::string* error) const {
 
 bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
                    const std::string& base_dir, Scenario* scenario, std::string* error) {
-  YAML::Node root;
-  std::string yaml_error;
-  if (!LoadYamlDocument(yaml_text, source_name, &root, &yaml_error)) {
-    if (error) *error = yaml_error;
-    return false;
-  }
-  StrictReader r(source_name);
+  YamlReader r(source_name);
+  if (!r.Parse(yaml_text)) return r.Report(error);
+  YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
   Scenario s;
   if (!root.IsMap()) {
     if (error) *error = source_name + ": expected a YAML mapping at the top level";
     return false;
   }
-  r.CheckKeys(root, "", {"name", "scene", "seed", "rate_hz", "physics_dt_s", "max_duration_s",
-                         "settle_s", "path", "robot", "camera", "noise", "textures"});
+  constexpr int kIntMin = std::numeric_limits<int>::min();
+  constexpr int kIntMax = std::numeric_limits<int>::max();
+  r.CheckKeys(root, "", {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s",
+                         "rate_hz", "robot", "scene", "seed", "settle_s", "textures"});
   r.String(root, "", "name", &s.name);
   std::string scene;
   r.String(root, "", "scene", &scene);
-  if (r.ok() && scene.empty()) r.Fail(root, "scene", "required: the MJCF scene file (relative to the scenario file)");
+  r.Check(!scene.empty(), root, "", "scene",
+          "required: the MJCF scene file (relative to the scenario file)");
   r.Uint64(root, "", "seed", &s.seed);
   r.Double(root, "", "rate_hz", &s.rate_hz);
   r.Double(root, "", "physics_dt_s", &s.physics_dt_s);
@@ -232,82 +125,65 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   r.Double(root, "", "settle_s", &s.settle_s);
 
   // path: a sequence of [x, y] pairs.
-  const YAML::Node path = root["path"];
-  if (r.ok()) {
-    if (!path.IsDefined()) r.Fail(root, "path", "required: a list of at least 2 waypoints [x, y] (m)");
-    else if (!path.IsSequence()) r.Fail(path, "path", "expected a list of waypoints [x, y] (m)");
-    else {
-      for (size_t i = 0; i < path.size() && r.ok(); ++i) {
-        const YAML::Node wp = path[i];
-        const std::string key = "path[" + std::to_string(i) + "]";
-        if (!wp.IsSequence() || wp.size() != 2) { r.Fail(wp, key, "expected a pair [x, y] (m)"); break; }
-        Eigen::Vector2d p;
-        for (int k = 0; k < 2; ++k) {
-          try {
-            p[k] = wp[k].as<double>();
-          } catch (const YAML::Exception&) {
-            r.Fail(wp, key, "expected numbers, got '" + wp[k].Scalar() + "'");
-            break;
-          }
-          if (!std::isfinite(p[k])) r.Fail(wp, key, "expected finite numbers, got " + wp[k].Scalar());
-        }
-        s.path.push_back(p);
-      }
-      if (r.ok() && s.path.size() < 2)
-        r.Fail(path, "path", "expected at least 2 waypoints, got " + std::to_string(s.path.size()));
-    }
+  std::vector<std::pair<double, double>> path;
+  if (r.Require(root, "", "path", "a list of at least 2 waypoints [x, y] (m)") &&
+      r.ReadPairs(root["path"], "path", &path, "a list of waypoints [x, y] (m)",
+                  "a pair [x, y] (m)")) {
+    for (const auto& [x, y] : path) s.path.emplace_back(x, y);
+    r.Check(s.path.size() >= 2, root, "", "path",
+            "expected at least 2 waypoints, got " + std::to_string(s.path.size()));
   }
 
   if (const YAML::Node n = root["robot"]; n.IsDefined() && r.ok()) {
-    r.CheckKeys(n, "robot", {"speed_mps", "max_accel_mps2", "turn_rate_dps", "lookahead_m",
-                             "corner_mode", "goal_tolerance_m"});
+    r.CheckKeys(n, "robot", {"corner_mode", "goal_tolerance_m", "lookahead_m", "max_accel_mps2",
+                             "speed_mps", "turn_rate_dps"});
     RobotOptions& o = s.robot;
     r.Double(n, "robot", "speed_mps", &o.speed_mps);
-    r.Require(o.speed_mps > 0 && o.speed_mps <= 3, n, "robot", "speed_mps", "expected in (0, 3] m/s, got " + Num(o.speed_mps));
+    r.Check(o.speed_mps > 0 && o.speed_mps <= 3, n, "robot", "speed_mps", "expected in (0, 3] m/s, got " + Num(o.speed_mps));
     r.Double(n, "robot", "max_accel_mps2", &o.max_accel_mps2);
-    r.Require(o.max_accel_mps2 > 0, n, "robot", "max_accel_mps2", "expected > 0");
+    r.Check(o.max_accel_mps2 > 0, n, "robot", "max_accel_mps2", "expected > 0");
     r.Double(n, "robot", "turn_rate_dps", &o.turn_rate_dps);
-    r.Require(o.turn_rate_dps > 0 && o.turn_rate_dps <= 360, n, "robot", "turn_rate_dps", "expected in (0, 360] deg/s");
+    r.Check(o.turn_rate_dps > 0 && o.turn_rate_dps <= 360, n, "robot", "turn_rate_dps", "expected in (0, 360] deg/s");
     r.Double(n, "robot", "lookahead_m", &o.lookahead_m);
-    r.Require(o.lookahead_m > 0, n, "robot", "lookahead_m", "expected > 0");
+    r.Check(o.lookahead_m > 0, n, "robot", "lookahead_m", "expected > 0");
     r.String(n, "robot", "corner_mode", &o.corner_mode);
-    r.Require(o.corner_mode == "in_place" || o.corner_mode == "arc", n, "robot", "corner_mode", "expected 'in_place' or 'arc', got '" + o.corner_mode + "'");
+    r.Check(o.corner_mode == "in_place" || o.corner_mode == "arc", n, "robot", "corner_mode", "expected 'in_place' or 'arc', got '" + o.corner_mode + "'");
     r.Double(n, "robot", "goal_tolerance_m", &o.goal_tolerance_m);
-    r.Require(o.goal_tolerance_m > 0, n, "robot", "goal_tolerance_m", "expected > 0");
+    r.Check(o.goal_tolerance_m > 0, n, "robot", "goal_tolerance_m", "expected > 0");
   }
   if (const YAML::Node n = root["camera"]; n.IsDefined() && r.ok()) {
-    r.CheckKeys(n, "camera", {"width", "height", "fovy_deg", "baseline_m", "height_m", "forward_m", "pitch_deg"});
+    r.CheckKeys(n, "camera", {"baseline_m", "forward_m", "fovy_deg", "height", "height_m", "pitch_deg", "width"});
     CameraOptions& o = s.camera;
-    r.Int(n, "camera", "width", &o.width);
-    r.Require(o.width >= 16 && o.width <= 4096, n, "camera", "width", "expected 16..4096 pixels, got " + std::to_string(o.width));
-    r.Int(n, "camera", "height", &o.height);
-    r.Require(o.height >= 16 && o.height <= 4096, n, "camera", "height", "expected 16..4096 pixels, got " + std::to_string(o.height));
+    r.Int(n, "camera", "width", kIntMin, kIntMax, &o.width);
+    r.Check(o.width >= 16 && o.width <= 4096, n, "camera", "width", "expected 16..4096 pixels, got " + std::to_string(o.width));
+    r.Int(n, "camera", "height", kIntMin, kIntMax, &o.height);
+    r.Check(o.height >= 16 && o.height <= 4096, n, "camera", "height", "expected 16..4096 pixels, got " + std::to_string(o.height));
     r.Double(n, "camera", "fovy_deg", &o.fovy_deg);
-    r.Require(o.fovy_deg > kMinFovDeg && o.fovy_deg < kMaxFovDeg, n, "camera", "fovy_deg", "expected in (1, 170) degrees, got " + Num(o.fovy_deg));
+    r.Check(o.fovy_deg > kMinFovDeg && o.fovy_deg < kMaxFovDeg, n, "camera", "fovy_deg", "expected in (1, 170) degrees, got " + Num(o.fovy_deg));
     r.Double(n, "camera", "baseline_m", &o.baseline_m);
-    r.Require(o.baseline_m >= kMinBaselineM && o.baseline_m <= kMaxBaselineM, n, "camera", "baseline_m",
-              "expected a positive baseline of " + Num(kMinBaselineM) + " .. " + Num(kMaxBaselineM) + " m (1 mm to 5 m), got " + Num(o.baseline_m));
+    r.Check(o.baseline_m >= kMinBaselineM && o.baseline_m <= kMaxBaselineM, n, "camera", "baseline_m",
+            "expected a positive baseline of " + Num(kMinBaselineM) + " .. " + Num(kMaxBaselineM) + " m (1 mm to 5 m), got " + Num(o.baseline_m));
     r.Double(n, "camera", "height_m", &o.height_m);
-    r.Require(o.height_m > 0, n, "camera", "height_m", "expected > 0 m, got " + Num(o.height_m));
+    r.Check(o.height_m > 0, n, "camera", "height_m", "expected > 0 m, got " + Num(o.height_m));
     r.Double(n, "camera", "forward_m", &o.forward_m);
     r.Double(n, "camera", "pitch_deg", &o.pitch_deg);
-    r.Require(o.pitch_deg > -80 && o.pitch_deg < 80, n, "camera", "pitch_deg", "expected in (-80, 80) degrees");
+    r.Check(o.pitch_deg > -80 && o.pitch_deg < 80, n, "camera", "pitch_deg", "expected in (-80, 80) degrees");
   }
   if (const YAML::Node n = root["noise"]; n.IsDefined() && r.ok()) {
-    r.CheckKeys(n, "noise", {"pixel_sigma", "gain_sigma", "bias_sigma", "motion_blur_exposure_s", "motion_blur_samples"});
+    r.CheckKeys(n, "noise", {"bias_sigma", "gain_sigma", "motion_blur_exposure_s", "motion_blur_samples", "pixel_sigma"});
     NoiseOptions& o = s.noise;
     r.Double(n, "noise", "pixel_sigma", &o.pixel_sigma);
-    r.Require(o.pixel_sigma >= 0, n, "noise", "pixel_sigma", "expected >= 0 grey levels");
+    r.Check(o.pixel_sigma >= 0, n, "noise", "pixel_sigma", "expected >= 0 grey levels");
     r.Double(n, "noise", "gain_sigma", &o.gain_sigma);
-    r.Require(o.gain_sigma >= 0 && o.gain_sigma < 0.5, n, "noise", "gain_sigma", "expected in [0, 0.5)");
+    r.Check(o.gain_sigma >= 0 && o.gain_sigma < 0.5, n, "noise", "gain_sigma", "expected in [0, 0.5)");
     r.Double(n, "noise", "bias_sigma", &o.bias_sigma);
-    r.Require(o.bias_sigma >= 0, n, "noise", "bias_sigma", "expected >= 0 grey levels");
+    r.Check(o.bias_sigma >= 0, n, "noise", "bias_sigma", "expected >= 0 grey levels");
     r.Double(n, "noise", "motion_blur_exposure_s", &o.motion_blur_exposure_s);
-    r.Require(o.motion_blur_exposure_s >= 0, n, "noise", "motion_blur_exposure_s", "expected >= 0 s");
-    r.Int(n, "noise", "motion_blur_samples", &o.motion_blur_samples);
-    r.Require(o.motion_blur_samples >= 1 && o.motion_blur_samples <= kMaxMotionBlurSamples, n, "noise",
-              "motion_blur_samples", "expected 1 .. " + std::to_string(kMaxMotionBlurSamples) +
-              " renders per frame, got " + std::to_string(o.motion_blur_samples));
+    r.Check(o.motion_blur_exposure_s >= 0, n, "noise", "motion_blur_exposure_s", "expected >= 0 s");
+    r.Int(n, "noise", "motion_blur_samples", kIntMin, kIntMax, &o.motion_blur_samples);
+    r.Check(o.motion_blur_samples >= 1 && o.motion_blur_samples <= kMaxMotionBlurSamples, n, "noise",
+            "motion_blur_samples", "expected 1 .. " + std::to_string(kMaxMotionBlurSamples) +
+            " renders per frame, got " + std::to_string(o.motion_blur_samples));
   }
   if (const YAML::Node n = root["textures"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(n, "textures", {"seed"});
@@ -324,10 +200,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
       r.Fail(at.IsDefined() ? at : root, key, physics);
     }
   }
-  if (!r.ok()) {
-    if (error) *error = r.error();
-    return false;
-  }
+  if (!r.Report(error)) return false;
   // Resolve the scene relative to the scenario's folder.
   fs::path scene_path(scene);
   if (scene_path.is_relative()) scene_path = fs::path(base_dir) / scene_path;

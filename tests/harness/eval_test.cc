@@ -415,8 +415,9 @@ TEST_F(EvalBadInputTest, EurocMissingOrBadCalibration) {
   const size_t start = at + std::string("intrinsics: [").size();
   yaml.replace(start, yaml.find(',', start) - start, ".nan");  // fu = NaN
   WriteText(data + "/mav0/cam1/sensor.yaml", yaml);
+  ExpectCliFailure("--dataset " + data + " --format euroc", data + "/mav0/cam1/sensor.yaml:");
   ExpectCliFailure("--dataset " + data + " --format euroc",
-                   data + "/mav0/cam1/sensor.yaml: 'intrinsics': value 1 is not finite");
+                   "key 'intrinsics[0]': expected a finite number, got .nan");
   fs::remove(data + "/mav0/cam0/sensor.yaml");
   ExpectCliFailure("--dataset " + data + " --format euroc",
                    data + "/mav0/cam0/sensor.yaml: file not found");

@@ -78,4 +78,27 @@ TEST(OverridesTest, VoOverridesApplyOnTopOfTheGivenOptions) {
   EXPECT_NE(error.find("tune.yaml"), std::string::npos) << error;
 }
 
+// Overrides from a file are told in the readers' one format, at the override map's line.
+TEST(OverridesTest, ErrorsOfFileOverridesNameTheFileLineAndFullKey) {
+  vo::OdometryOptions options;
+  std::string error;
+  EXPECT_FALSE(harness::ApplyVoOverrides(YAML::Load("{matcher.type: nonsense}"),
+                                         harness::kOverridesSource, &options, &error));
+  EXPECT_EQ(harness::OverrideErrorAt("s.yaml:6", "configs[0].set", error)
+                .rfind("s.yaml:6: key 'configs[0].set.matcher.type': expected one of ", 0),
+            0u)
+      << error;
+  sim::Scenario base, s;
+  ASSERT_TRUE(harness::ResolveScenario("l_hallway", &base, &error)) << error;
+  EXPECT_FALSE(harness::ApplyScenarioOverrides(base, YAML::Load("{camera: {width: 8}}"),
+                                               harness::kOverridesSource, &s, &error));
+  EXPECT_EQ(harness::OverrideErrorAt("s.yaml:4", "scenarios[0].set", error),
+            "s.yaml:4: key 'scenarios[0].set.camera.width': expected 16..4096 pixels, got 8");
+  EXPECT_FALSE(harness::ApplyScenarioOverrides(base, YAML::Load("{a..b: 1}"),
+                                               harness::kOverridesSource, &s, &error));
+  EXPECT_EQ(harness::OverrideErrorAt("s.yaml:4", "scenarios[0].set", error),
+            "s.yaml:4: key 'scenarios[0].set': override key 'a..b' has an empty path component");
+  EXPECT_EQ(harness::OverrideErrorAt("s.yaml:4", "x", "other.yaml:2: boom"), "other.yaml:2: boom");
+}
+
 }  // namespace

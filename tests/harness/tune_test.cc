@@ -336,7 +336,7 @@ std::vector<BadFile> BadFiles() {
       {"unknown top-level key", good + "paramters: []\n", {":13:", "'paramters'"}},
       {"unknown scenario key",
        replace("max_frames: 6}", "max_frame: 6}"),
-       {":3:", "'max_frame'", "train[0]"}},
+       {":3:", "key 'train[0].max_frame': unknown key"}},
       {"unknown VO key",
        replace("matcher.svd.sigma_px", "matcher.svd.sigmaa"),
        {":7:", "'matcher.svd.sigmaa'", "not a VO option"}},
