@@ -59,12 +59,15 @@ FrameSource FramesInMemory(const std::vector<DatasetFrame>& frames) {
   };
 }
 
+bool RunFramesOptions::IsValid(std::string* error) const {
+  if (frame_stride >= 1) return true;
+  *error = "frame stride must be >= 1, got " + std::to_string(frame_stride);
+  return false;
+}
+
 bool RunFrames(const std::string& name, const FrameSource& source, vo::StereoOdometry& odometry,
                const RunFramesOptions& options, RunRecords* records, std::string* error) {
-  if (options.frame_stride < 1) {
-    *error = "frame stride must be >= 1, got " + std::to_string(options.frame_stride);
-    return false;
-  }
+  if (!options.IsValid(error)) return false;
   RunRecords& r = *records;
   r = RunRecords();
   r.name = name;
@@ -146,12 +149,13 @@ bool Summarize(const RunRecords& records, RunSummary* summary, std::string* erro
              (first > 0 ? " after the first " + std::to_string(first) + " (not initialised)" : "");
     return false;
   }
-  const std::vector<FrameRecord> frames(all.begin() + static_cast<std::ptrdiff_t>(first), all.end());
+  const FrameRecord& first_frame = all[first];  // the frames from it on are summarised
   RunSummary& s = *summary;
   s = RunSummary();
   s.name = records.name;
   std::vector<Eigen::Isometry3d> est_at_gt, gt_at_gt;  // the frames with ground truth
-  for (const FrameRecord& f : frames) {
+  for (size_t i = first; i < all.size(); ++i) {
+    const FrameRecord& f = all[i];
     if (!f.has_gt) continue;
     est_at_gt.push_back(f.result.T_world_cam0);
     gt_at_gt.push_back(f.T_world_cam0_gt);
@@ -160,12 +164,12 @@ bool Summarize(const RunRecords& records, RunSummary* summary, std::string* erro
   s.ground_truth_frames = static_cast<int>(gt_at_gt.size());
   if (s.has_ground_truth) s.metrics = ComputeTrajectoryMetrics(est_at_gt, gt_at_gt);
   s.frame_stride = records.frame_stride;
-  s.metrics.frames = static_cast<int>(frames.size());
+  s.metrics.frames = static_cast<int>(all.size() - first);
   s.frames_not_initialised = static_cast<int>(first);
   std::vector<double> total, feats, inl;
   std::map<std::string, std::vector<double>> stages;
-  for (const FrameRecord& f : frames) {
-    const vo::OdometryResult& r = f.result;
+  for (size_t i = first; i < all.size(); ++i) {
+    const vo::OdometryResult& r = all[i].result;
     if (vo::IsLostFrame(r)) ++s.lost_frames;
     if (r.reinitialised) ++s.reinitialisations;
     total.push_back(r.times.total_ms);
@@ -187,10 +191,10 @@ bool Summarize(const RunRecords& records, RunSummary* summary, std::string* erro
   s.features_median = Median(feats);
   s.match_stats = records.match_stats;
   s.inliers_median = Median({inl.begin() + 1, inl.end()});
-  s.initial_orientation_ok = frames.front().result.initial_orientation_ok;
-  if (s.has_ground_truth && frames.front().has_gt && s.initial_orientation_ok) {
-    s.initial_orientation_error_deg = RotationAngle(frames.front().result.T_world_cam0.linear(),
-                                                    frames.front().T_world_cam0_gt.linear()) *
+  s.initial_orientation_ok = first_frame.result.initial_orientation_ok;
+  if (s.has_ground_truth && first_frame.has_gt && s.initial_orientation_ok) {
+    s.initial_orientation_error_deg = RotationAngle(first_frame.result.T_world_cam0.linear(),
+                                                    first_frame.T_world_cam0_gt.linear()) *
                                       180.0 / M_PI;
   }
   return true;

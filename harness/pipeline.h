@@ -75,6 +75,9 @@ struct RunFramesOptions {
   bool progress = true;     // progress display on stderr ("vo <name>")
   bool match_stats = true;  // check the VO's matches against the ground-truth depth and poses
   std::string out_dir;      // named in the message of an interrupted run
+
+  // False (with the message) for a frame stride below 1.
+  bool IsValid(std::string* error) const;
 };
 
 // Runs `odometry` over `source` (SIGINT/SIGTERM stop it with InterruptedMessage). No I/O other

@@ -8,10 +8,13 @@ namespace harness {
 bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameSource source,
                  int expected_frames, const vo::OdometryOptions& vo_options, const RunOptions& options,
                  const std::string& scenario_yaml, RunSummary* summary, std::string* error) {
-  if (options.frame_stride < 1) {
-    *error = "frame stride must be >= 1, got " + std::to_string(options.frame_stride);
-    return false;
-  }
+  RunFramesOptions frames_options;
+  frames_options.max_frames = options.max_frames;
+  frames_options.frame_stride = options.frame_stride;
+  frames_options.expected_frames = expected_frames;
+  frames_options.progress = options.progress;
+  frames_options.out_dir = options.out_dir;
+  if (!frames_options.IsValid(error)) return false;  // before the folder: fail fast
   auto odometry = vo::StereoOdometry::Create(camera, vo_options, error);
   if (!odometry) {
     *error = "invalid VO options or camera: " + *error;
@@ -19,12 +22,6 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   }
   OutputFolder folder;  // written as a marked DIR.partial-<pid>-<random>, moved into place
   if (!OpenRunFolder(options.out_dir, &folder, error)) return false;
-  RunFramesOptions frames_options;
-  frames_options.max_frames = options.max_frames;
-  frames_options.frame_stride = options.frame_stride;
-  frames_options.expected_frames = expected_frames;
-  frames_options.progress = options.progress;
-  frames_options.out_dir = options.out_dir;
   RunRecords records;
   if (!RunFrames(name, source, *odometry, frames_options, &records, error) ||
       !Summarize(records, summary, error))

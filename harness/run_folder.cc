@@ -93,9 +93,12 @@ std::vector<Eigen::Isometry3d> AnchoredEstimate(const Trajectories& t) {
 
 }  // namespace
 
-std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary) {
+namespace {
+
+// PerFrameCsv on the trajectories WriteRunFolder has already made.
+std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
+                        const Trajectories& t) {
   const size_t first = static_cast<size_t>(summary.frames_not_initialised);
-  const Trajectories t = InitialisedTrajectories(records, first);
   const size_t n = t.times.size();
   // Errors per frame relative to the first frame with ground truth; "nan" for frames without.
   std::vector<double> dist(n, std::nan("")), te_m(n, std::nan("")), re_deg(n, std::nan(""));
@@ -146,6 +149,14 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary) {
   return csv.str();
 }
 
+}  // namespace
+
+std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary) {
+  return PerFrameCsv(records, summary,
+                     InitialisedTrajectories(records,
+                                             static_cast<size_t>(summary.frames_not_initialised)));
+}
+
 bool OpenRunFolder(const std::string& dir, OutputFolder* folder, std::string* error) {
   return folder->Create(dir, "run", error);
 }
@@ -170,7 +181,7 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s, const RunFol
   const Trajectories t = InitialisedTrajectories(records, static_cast<size_t>(s.frames_not_initialised));
   if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(t.times, t.est), error) ||
       !WriteKittiPoses((p / "trajectory_kitti.txt").string(), t.est, error) ||
-      !WriteTextFile((p / "per_frame.csv").string(), PerFrameCsv(records, s), error) ||
+      !WriteTextFile((p / "per_frame.csv").string(), PerFrameCsv(records, s, t), error) ||
       !WriteTextFile((p / "vo_options.yaml").string(), contents.options_yaml, error) ||
       !WriteTextFile((p / "metrics.json").string(), MetricsJson(s), error))
     return false;

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -51,6 +52,17 @@ inline pid_t StartVobench(const std::vector<std::string>& args, const std::strin
   const int rc = posix_spawn(&pid, c_argv[0], &actions, nullptr, c_argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   return rc == 0 ? pid : -1;
+}
+
+// Names of the entries of `dir` that start with `prefix` (none when `dir` cannot be read).
+inline std::vector<std::string> EntriesStartingWith(const std::string& dir,
+                                                    const std::string& prefix) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec))
+    if (e.path().filename().string().rfind(prefix, 0) == 0)
+      names.push_back(e.path().filename().string());
+  return names;
 }
 
 // The whole file as bytes ("" when it cannot be read).

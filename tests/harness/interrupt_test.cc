@@ -24,6 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+using vobench_test::EntriesStartingWith;
 using vobench_test::ReadAll;
 using vobench_test::TempDir;
 using vobench_test::WriteText;
@@ -49,21 +50,11 @@ int Wait(pid_t pid) {
   return -1;
 }
 
-// Entries of `dir` whose names start with `prefix`.
-std::vector<std::string> EntriesStartingWith(const fs::path& dir, const std::string& prefix) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec))
-    if (e.path().filename().string().rfind(prefix, 0) == 0)
-      names.push_back(e.path().filename().string());
-  return names;
-}
-
 // Waits until `dir` holds an entry starting with `prefix` (the command's work folder).
 bool WaitForEntry(const fs::path& dir, const std::string& prefix) {
   const auto end = Clock::now() + kStartTimeout;
   while (Clock::now() < end) {
-    if (!EntriesStartingWith(dir, prefix).empty()) return true;
+    if (!EntriesStartingWith(dir.string(), prefix).empty()) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return false;

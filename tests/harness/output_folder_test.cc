@@ -32,19 +32,10 @@ using harness::FolderMarker;
 using harness::OutputFolder;
 using ::testing::HasSubstr;
 using vobench_test::ReadAll;
+using vobench_test::EntriesStartingWith;
 using vobench_test::RunVobench;
 using vobench_test::TempDir;
 using vobench_test::WriteText;
-
-// Entries of `dir` whose names start with `prefix`.
-std::vector<std::string> EntriesStartingWith(const std::string& dir, const std::string& prefix) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec))
-    if (e.path().filename().string().rfind(prefix, 0) == 0)
-      names.push_back(e.path().filename().string());
-  return names;
-}
 
 // A pid that no process has: a child that has exited and been reaped.
 pid_t DeadPid() {

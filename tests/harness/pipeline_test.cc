@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "harness/run_folder.h"
+#include "tests/vo/vo_test_util.h"
 
 namespace {
 
@@ -15,24 +16,14 @@ using harness::FrameRecord;
 using harness::RunRecords;
 using harness::RunSummary;
 
-vo::StereoCamera SmallCamera() {
-  vo::StereoCamera c;
-  c.width = 64;
-  c.height = 48;
-  c.fx_px = c.fy_px = 50.0;
-  c.cx_px = 32.0;
-  c.cy_px = 24.0;
-  c.baseline_m = 0.1;
-  return c;
-}
-
-// `n` black frames 0.1 s apart with ground truth moving 0.1 m along z per frame.
+// `n` black frames of the test camera 0.1 s apart, ground truth moving 0.1 m along z per frame.
 harness::FrameSource BlackFrames(int n, int* given) {
-  return [n, given](harness::DatasetFrame* f, std::string*) {
+  const vo::StereoCamera cam = vo::test::TestCamera();
+  return [n, given, cam](harness::DatasetFrame* f, std::string*) {
     if (*given >= n) return false;
     f->time_s = 0.1 * *given;
-    f->left = cv::Mat::zeros(48, 64, CV_8UC1);
-    f->right = cv::Mat::zeros(48, 64, CV_8UC1);
+    f->left = cv::Mat::zeros(cam.height, cam.width, CV_8UC1);
+    f->right = cv::Mat::zeros(cam.height, cam.width, CV_8UC1);
     f->has_gt = true;
     f->T_world_cam0 = Eigen::Isometry3d::Identity();
     f->T_world_cam0.translation() = Eigen::Vector3d(0, 0, 0.1 * *given);
@@ -42,7 +33,7 @@ harness::FrameSource BlackFrames(int n, int* given) {
 }
 
 TEST(PipelineTest, RunFramesTakesEveryKthFrameUpToMaxFrames) {
-  vo::StereoOdometry odometry(SmallCamera(), vo::OdometryOptions());
+  vo::StereoOdometry odometry(vo::test::TestCamera(), vo::OdometryOptions());
   int given = 0;
   harness::RunFramesOptions options;
   options.progress = false;
@@ -71,7 +62,7 @@ TEST(PipelineTest, RunFramesTakesEveryKthFrameUpToMaxFrames) {
 }
 
 TEST(PipelineTest, RunFramesRefusesAStrideBelowOne) {
-  vo::StereoOdometry odometry(SmallCamera(), vo::OdometryOptions());
+  vo::StereoOdometry odometry(vo::test::TestCamera(), vo::OdometryOptions());
   int given = 0;
   harness::RunFramesOptions options;
   options.frame_stride = 0;
