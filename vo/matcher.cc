@@ -81,6 +81,8 @@ bool SvdMatcherOptions::IsValid(std::string* error) const {
     msg << "SvdMatcherOptions::min_pairing must be in [0, 1], got " << min_pairing;
   } else if (!(min_ncc >= 0.0 && min_ncc <= 1.0)) {
     msg << "SvdMatcherOptions::min_ncc must be in [0, 1], got " << min_ncc;
+  } else if (!(gabor_min_ncc >= 0.0 && gabor_min_ncc <= 1.0)) {
+    msg << "SvdMatcherOptions::gabor_min_ncc must be in [0, 1], got " << gabor_min_ncc;
   } else if (!(max_phase_diff_rad >= 0.0 && max_phase_diff_rad <= 3.14159265358979323846)) {
     msg << "SvdMatcherOptions::max_phase_diff_rad must be in [0, pi], got " << max_phase_diff_rad;
   } else if (max_component_size < 2) {
@@ -91,6 +93,17 @@ bool SvdMatcherOptions::IsValid(std::string* error) const {
     msg << "SvdMatcherOptions::guard_max_entry must be in (0, 1], got " << guard_max_entry;
   } else if (jacobi_max_size < 2) {
     msg << "SvdMatcherOptions::jacobi_max_size must be >= 2, got " << jacobi_max_size;
+  } else if (!(coherence_sigmas >= 0.0) || !std::isfinite(coherence_sigmas)) {
+    msg << "SvdMatcherOptions::coherence_sigmas must be finite and >= 0, got "
+        << coherence_sigmas;
+  } else if (!(coherence_min_px >= 0.0) || !std::isfinite(coherence_min_px)) {
+    msg << "SvdMatcherOptions::coherence_min_px must be finite and >= 0, got "
+        << coherence_min_px;
+  } else if (!(coherence_radius_px > 0.0) || !std::isfinite(coherence_radius_px)) {
+    msg << "SvdMatcherOptions::coherence_radius_px must be finite and > 0, got "
+        << coherence_radius_px;
+  } else if (coherence_neighbours < 2) {
+    msg << "SvdMatcherOptions::coherence_neighbours must be >= 2, got " << coherence_neighbours;
   }
   return Fail(msg, error);
 }
@@ -264,6 +277,83 @@ PointGrid::PointGrid(std::vector<Eigen::Vector2d> points, double cell_px)
   order_.resize(points_.size());
   std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
   for (size_t i = 0; i < points_.size(); ++i) order_[fill[cell_of[i]]++] = static_cast<int>(i);
+}
+
+std::vector<Match> RejectIncoherentMatches(const std::vector<Feature>& prev,
+                                           const std::vector<Feature>& curr,
+                                           const MatchPrediction& prediction,
+                                           const std::vector<Match>& matches, double radius_px,
+                                           int neighbours, double max_px, int* num_rejected) {
+  const size_t n = matches.size();
+  std::vector<Eigen::Vector2d> from(n), displacement(n);
+  for (size_t m = 0; m < n; ++m) {
+    const Eigen::Vector2d& uv_prev = prev[matches[m].prev].uv_px;
+    from[m] = uv_prev;
+    displacement[m] = curr[matches[m].curr].uv_px - prediction.Centre(matches[m].prev, uv_prev);
+  }
+  // The k nearest other matches within the radius, by (squared distance, index): a sweep over
+  // the matches sorted by x that stops once |dx| exceeds the k-th distance found so far.
+  std::vector<int> by_x(n);
+  std::iota(by_x.begin(), by_x.end(), 0);
+  std::sort(by_x.begin(), by_x.end(), [&](int a, int b) {
+    return from[a].x() < from[b].x() || (from[a].x() == from[b].x() && a < b);
+  });
+  std::vector<double> sx(n), sy(n);  // positions in that order
+  std::vector<size_t> rank(n);
+  for (size_t r = 0; r < n; ++r) {
+    rank[by_x[r]] = r;
+    sx[r] = from[by_x[r]].x();
+    sy[r] = from[by_x[r]].y();
+  }
+  std::vector<Match> kept;
+  kept.reserve(n);
+  const size_t k_max = static_cast<size_t>(std::max(neighbours, 2));
+  const double radius_sq = radius_px * radius_px;
+  std::vector<std::pair<double, int>> near(k_max + 1);  // sorted (d², index), `count` used
+  std::vector<double> xs(k_max), ys(k_max);
+  for (size_t m = 0; m < n; ++m) {
+    size_t count = 0;
+    double bound = radius_sq;  // the k-th distance once k are found
+    const size_t p = rank[m];
+    auto consider = [&](size_t r, double dx) {
+      const double dy = sy[r] - sy[p];
+      const double d2 = dx * dx + dy * dy;
+      if (d2 > bound) return;
+      const std::pair<double, int> entry(d2, by_x[r]);
+      size_t q = count;
+      while (q > 0 && entry < near[q - 1]) {
+        near[q] = near[q - 1];
+        --q;
+      }
+      near[q] = entry;
+      if (count < k_max) ++count;
+      if (count == k_max) bound = near[k_max - 1].first;
+    };
+    for (size_t r = p + 1; r < n; ++r) {
+      const double dx = sx[r] - sx[p];
+      if (dx * dx > bound) break;
+      consider(r, dx);
+    }
+    for (size_t r = p; r-- > 0;) {
+      const double dx = sx[r] - sx[p];
+      if (dx * dx > bound) break;
+      consider(r, dx);
+    }
+    if (count < 2) {
+      kept.push_back(matches[m]);
+      continue;
+    }
+    for (size_t q = 0; q < count; ++q) {
+      xs[q] = displacement[near[q].second].x();
+      ys[q] = displacement[near[q].second].y();
+    }
+    std::sort(xs.begin(), xs.begin() + count);
+    std::sort(ys.begin(), ys.begin() + count);
+    const Eigen::Vector2d median(xs[count / 2], ys[count / 2]);
+    if ((displacement[m] - median).norm() <= max_px) kept.push_back(matches[m]);
+  }
+  if (num_rejected != nullptr) *num_rejected = static_cast<int>(n - kept.size());
+  return kept;
 }
 
 std::vector<Eigen::Vector2d> FeaturePositions(const std::vector<Feature>& features) {

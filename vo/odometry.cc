@@ -630,6 +630,7 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
     MatchPrediction guided;
     guided.uv_px = PredictPositions(best.ransac.T_prev_curr);
     guided.radius_scale = o.guided_radius_scale;
+    guided.coherence_test = false;
     double match_ms = 0.0, motion_ms = 0.0;
     MotionAttempt attempt;
     const bool ok = pass(guided, PredictionSource::kGuided, &match_ms, &motion_ms, &attempt);

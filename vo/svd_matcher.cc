@@ -294,6 +294,7 @@ std::vector<Match> SvdMatcher::DoMatch(const MatchFrame& prev, const MatchFrame&
   // previous feature (its previous position without a prediction), σ scaled with the gate.
   const double sigma = options_.sigma_px * prediction.radius_scale;
   const double inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
+  const double min_ncc = use_gabor ? options_.gabor_min_ncc : options_.min_ncc;
   const double min_phase_similarity =
       use_gabor ? std::exp(-bank_->options().phase_exponent * options_.max_phase_diff_rad) : 0.0;
   // G_ij of one pair: proximity × C_ij (eq. (1)) × S_ij (eq. (5)); stops early (returns 0)
@@ -305,7 +306,7 @@ std::vector<Match> SvdMatcher::DoMatch(const MatchFrame& prev, const MatchFrame&
     if (g < bound) return 0.0;
     if (use_ncc) {
       const double c = ncc_prev->Score(i, *ncc_curr, j);  // eq. (2)
-      *acceptable = c >= options_.min_ncc;
+      *acceptable = c >= min_ncc;
       g *= c;
       if (g < bound || g <= 0.0) return 0.0;
     }
@@ -353,6 +354,12 @@ std::vector<Match> SvdMatcher::DoMatch(const MatchFrame& prev, const MatchFrame&
                          });
     }
     matches = SvdPairSparse(s.num_prev, s.num_curr, std::move(entries), options_, &s);
+  }
+  if (options_.coherence_sigmas > 0.0 && prediction.coherence_test) {
+    const double max_px = std::max(options_.coherence_min_px, options_.coherence_sigmas * sigma);
+    matches = RejectIncoherentMatches(prev.features, curr.features, prediction, matches,
+                                      options_.coherence_radius_px, options_.coherence_neighbours,
+                                      max_px, &s.num_incoherent);
   }
   s.match_time_ms = MsSince(t0);
   s.num_matches = static_cast<int>(matches.size());

@@ -10,11 +10,14 @@
 // largest element of its row AND of its column, plus the minimum-weight acceptance
 // G_ij >= min_weight and P_ij >= min_pairing (an outlier with no true partner stays
 // unmatched). Beyond the paper, the appearance cues must also pass their own thresholds:
-// C_ij >= min_ncc (kProximityNcc, kProximityNccGabor) and a mean wrapped phase difference
-// <= max_phase_diff_rad, i.e. S_ij >= exp(−β · max_phase_diff_rad) (kProximityNccGabor).
+// C_ij >= min_ncc (kProximityNcc; gabor_min_ncc for kProximityNccGabor) and a mean wrapped
+// phase difference <= max_phase_diff_rad, i.e. S_ij >= exp(−β · max_phase_diff_rad)
+// (kProximityNccGabor).
 // G mixes proximity in, so a feature whose true partner was not detected is otherwise paired
 // with a near neighbour that merely looks unlike it; the cue thresholds remove most of these
-// (set them to 0 and π for the paper's rule alone). They do not change G or P.
+// (set them to 0 and π for the paper's rule alone). They do not change G or P. Then the
+// motion-coherence test (RejectIncoherentMatches, matcher.h; coherence_sigmas = 0 turns it
+// off) drops a match that moves unlike its neighbouring matches.
 // Match::score = P_ij.
 //
 // Sparse solution (the default). The Gaussian makes G nearly block-diagonal, so:

@@ -8,10 +8,11 @@
 # run anew (suites/robustness.yaml) at a tenth of the time.
 #   results/robustness/sweep.sh [WORK_DIR]      # default /tmp/vobench_robustness; ~40 min at -j2
 #   CONFIGS="default paper" results/robustness/sweep.sh   # a subset of the configurations
+#   BIN=/path/to/vobench JOBS=1 results/robustness/sweep.sh   # another build, one job
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 ROOT=$(pwd)
-BIN="$ROOT/build/vobench"
+BIN="${BIN:-$ROOT/build/vobench}"  # BIN=... another build
 WORK="${1:-/tmp/vobench_robustness}"
 JOBS="${JOBS:-2}"
 mkdir -p "$WORK"

@@ -44,16 +44,16 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
   std::map<std::string, int> counts;
   CountLeaves(yaml, "", &counts);
   const Covered covered[] = {
-      {"", "OdometryOptions", sizeof(vo::OdometryOptions), 1256, 22},
+      {"", "OdometryOptions", sizeof(vo::OdometryOptions), 1296, 22},
       {"detector", "DetectorOptions", sizeof(vo::DetectorOptions), 128, 6},
       {"detector.harris", "HarrisOptions", sizeof(vo::HarrisOptions), 64, 10},
       {"detector.sift", "SiftOptions", sizeof(vo::SiftOptions), 40, 5},
       {"disparity", "DisparityOptions", sizeof(vo::DisparityOptions), 72, 14},
       {"depth", "DepthSamplingOptions", sizeof(vo::DepthSamplingOptions), 32, 5},
-      {"matcher", "MatcherOptions", sizeof(vo::MatcherOptions), 384, 2},
+      {"matcher", "MatcherOptions", sizeof(vo::MatcherOptions), 424, 2},
       {"matcher.ncc", "NccOptions", sizeof(vo::NccOptions), 16, 2},
       {"matcher.gabor", "GaborOptions", sizeof(vo::GaborOptions), 96, 11},
-      {"matcher.svd", "SvdMatcherOptions", sizeof(vo::SvdMatcherOptions), 88, 12},
+      {"matcher.svd", "SvdMatcherOptions", sizeof(vo::SvdMatcherOptions), 128, 17},
       {"matcher.ncc_mutual", "NccMutualMatcherOptions", sizeof(vo::NccMutualMatcherOptions), 16, 2},
       {"matcher.lucas_kanade", "LucasKanadeMatcherOptions", sizeof(vo::LucasKanadeMatcherOptions),
        48, 7},

@@ -311,6 +311,87 @@ TEST(SvdMatcherTest, OptionsValidation) {
   o = SvdMatcherOptions();
   o.max_phase_diff_rad = 4.0;
   EXPECT_FALSE(o.IsValid(&error));
+  o = SvdMatcherOptions();
+  o.gabor_min_ncc = 1.5;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("gabor_min_ncc"), std::string::npos);
+  o = SvdMatcherOptions();
+  o.coherence_neighbours = 1;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("coherence_neighbours"), std::string::npos);
+  o = SvdMatcherOptions();
+  o.coherence_sigmas = -1.0;
+  EXPECT_FALSE(o.IsValid(&error));
+}
+
+// A 6x6 grid of features 30 px apart moving by (7, -3) px; the current frame also holds a
+// decoy 6 px beside the true partner of two of them. Matches: all true pairs except those two,
+// which are paired with their decoys.
+struct CoherenceScene {
+  std::vector<Feature> prev, curr;
+  std::vector<Match> matches;
+  std::set<int> wrong;  // indices into matches
+};
+
+CoherenceScene MakeCoherenceScene(const Eigen::Vector2d& motion) {
+  CoherenceScene s;
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) {
+      Feature f;
+      f.uv_px = Eigen::Vector2d(40.0 + 30.0 * c, 30.0 + 30.0 * r);
+      s.prev.push_back(f);
+      f.uv_px += motion;
+      s.curr.push_back(f);
+    }
+  }
+  for (int i : {8, 21}) {
+    Feature decoy = s.curr[i];
+    decoy.uv_px += Eigen::Vector2d(6.0, 0.0);
+    s.curr.push_back(decoy);
+  }
+  for (int i = 0; i < 36; ++i) {
+    const int j = i == 8 ? 36 : (i == 21 ? 37 : i);
+    if (j != i) s.wrong.insert(static_cast<int>(s.matches.size()));
+    s.matches.push_back(Match{i, j, 1.0});
+  }
+  return s;
+}
+
+TEST(CoherenceTest, DropsTheMatchesThatMoveUnlikeTheirNeighbours) {
+  const CoherenceScene s = MakeCoherenceScene(Eigen::Vector2d(7.0, -3.0));
+  int rejected = -1;
+  const std::vector<Match> kept =
+      RejectIncoherentMatches(s.prev, s.curr, MatchPrediction(), s.matches, 60.0, 6, 3.0, &rejected);
+  EXPECT_EQ(rejected, 2);
+  ASSERT_EQ(kept.size(), 34u);
+  for (const Match& m : kept) EXPECT_EQ(m.prev, m.curr);  // only the true pairs, in order
+  for (size_t k = 1; k < kept.size(); ++k) EXPECT_LT(kept[k - 1].prev, kept[k].prev);
+  // A tolerance above the decoys' 6 px keeps everything.
+  EXPECT_EQ(RejectIncoherentMatches(s.prev, s.curr, MatchPrediction(), s.matches, 60.0, 6, 6.5,
+                                    &rejected)
+                .size(),
+            36u);
+  EXPECT_EQ(rejected, 0);
+}
+
+TEST(CoherenceTest, MeasuresDisplacementsFromThePredictionAndKeepsLoneMatches) {
+  // A large motion and a prediction that is off by the same 20 px for every feature: the
+  // displacements from it agree, so only the decoys go.
+  const Eigen::Vector2d motion(60.0, 5.0);
+  const CoherenceScene s = MakeCoherenceScene(motion);
+  MatchPrediction off;
+  for (const Feature& f : s.prev) off.uv_px.push_back(f.uv_px + motion + Eigen::Vector2d(-20, 0));
+  int rejected = -1;
+  std::vector<Match> kept = RejectIncoherentMatches(s.prev, s.curr, off, s.matches, 60.0, 6, 3.0,
+                                                    &rejected);
+  EXPECT_EQ(rejected, 2);
+  for (const Match& m : kept) EXPECT_EQ(m.prev, m.curr);
+  // Neighbours farther than the radius do not count: with 20 px, every feature (30 px apart)
+  // is alone and kept, decoys included.
+  kept = RejectIncoherentMatches(s.prev, s.curr, off, s.matches, 20.0, 6, 3.0, &rejected);
+  EXPECT_EQ(kept.size(), 36u);
+  EXPECT_EQ(rejected, 0);
+  EXPECT_TRUE(RejectIncoherentMatches(s.prev, s.curr, off, {}, 60.0, 6, 3.0, &rejected).empty());
 }
 
 }  // namespace
