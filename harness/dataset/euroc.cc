@@ -16,11 +16,12 @@ namespace harness {
 namespace fs = std::filesystem;
 namespace {
 
+using dataset_internal::AssociateWithFrames;
+using dataset_internal::CheckFrameIndex;
 using dataset_internal::CountAssociated;
 using dataset_internal::Fail;
 using dataset_internal::IsRotation;
 using dataset_internal::Join;
-using dataset_internal::NoAssociationMessage;
 using dataset_internal::NormalizeDir;
 using dataset_internal::NsToSeconds;
 using dataset_internal::ReadGreyImage;
@@ -227,11 +228,8 @@ bool EurocReader::Open(const std::string& dir, const Options& options, std::stri
   }
   std::vector<double> frame_s;
   for (int64_t t : t_ns_) frame_s.push_back(NsToSeconds(t));
-  gt_index_ = AssociateGroundTruth(frame_s, gt_body_, options_.gt_max_difference_s);
-  if (CountAssociated(gt_index_) == 0)
-    return Fail(error,
-                NoAssociationMessage(gt_path_, frame_s, gt_body_, options_.gt_max_difference_s));
-  return true;
+  return AssociateWithFrames(gt_path_, frame_s, gt_body_, options_.gt_max_difference_s, &gt_index_,
+                             error);
 }
 
 size_t EurocReader::ground_truth_frames() const { return CountAssociated(gt_index_); }
@@ -242,9 +240,7 @@ bool EurocReader::Rectification(const RectificationOptions& options,
 }
 
 bool EurocReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const {
-  if (index >= size())
-    return Fail(error, dir_ + ": frame " + std::to_string(index) + " out of range (" +
-                           std::to_string(size()) + " frames)");
+  if (!CheckFrameIndex(dir_, index, size(), error)) return false;
   cv::Mat images[2];
   for (int cam = 0; cam < 2; ++cam) {
     if (!ReadGreyImage(files_[cam][index], cv::Size(cam_[cam].width, cam_[cam].height),

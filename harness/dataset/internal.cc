@@ -73,6 +73,12 @@ std::string NormalizeDir(const std::string& dir) {
 
 double NsToSeconds(int64_t t_ns) { return static_cast<double>(t_ns) / 1e9; }
 
+bool CheckFrameIndex(const std::string& dir, size_t index, size_t size, std::string* error) {
+  if (index < size) return true;
+  return Fail(error, dir + ": frame " + std::to_string(index) + " out of range (" +
+                         std::to_string(size) + " frames)");
+}
+
 bool ReadGreyImage(const std::string& path, const cv::Size& expected, const std::string& origin,
                    cv::Mat* image, std::string* error) {
   std::error_code ec;
@@ -86,10 +92,32 @@ bool ReadGreyImage(const std::string& path, const cv::Size& expected, const std:
   return true;
 }
 
+bool TakeImageSizeFromFirstPair(const std::string& left_path, const std::string& right_path,
+                                const std::string& calib_path, vo::StereoCamera* camera,
+                                std::string* error) {
+  const cv::Mat left = cv::imread(left_path, cv::IMREAD_GRAYSCALE);
+  const cv::Mat right = cv::imread(right_path, cv::IMREAD_GRAYSCALE);
+  if (left.empty()) return Fail(error, left_path + ": cannot decode the image");
+  if (right.empty()) return Fail(error, right_path + ": cannot decode the image");
+  if (left.size() != right.size())
+    return Fail(error, right_path + ": size " + SizeText(right) +
+                           " differs from the left image's " + SizeText(left) + " (" + left_path +
+                           ")");
+  camera->width = left.cols;
+  camera->height = left.rows;
+  std::string why;
+  if (!camera->IsValid(&why)) return Fail(error, calib_path + ": " + why);
+  if (const std::string problem = RigProblem(*camera); !problem.empty())
+    return Fail(error, calib_path + ": " + problem);
+  return true;
+}
+
 size_t CountAssociated(const std::vector<long>& index) {
   return static_cast<size_t>(
       std::count_if(index.begin(), index.end(), [](long i) { return i >= 0; }));
 }
+
+namespace {
 
 // Error for a ground truth that no frame associates with (different clocks, wrong file).
 std::string NoAssociationMessage(const std::string& gt_path, const std::vector<double>& frame_s,
@@ -105,6 +133,17 @@ std::string NoAssociationMessage(const std::string& gt_path, const std::vector<d
     m += " (the file has no poses)";
   }
   return m;
+}
+
+}  // namespace
+
+bool AssociateWithFrames(const std::string& gt_path, const std::vector<double>& frame_s,
+                         const std::vector<StampedPose>& gt, double max_difference_s,
+                         std::vector<long>* index, std::string* error) {
+  *index = AssociateGroundTruth(frame_s, gt, max_difference_s);
+  if (CountAssociated(*index) == 0)
+    return Fail(error, NoAssociationMessage(gt_path, frame_s, gt, max_difference_s));
+  return true;
 }
 
 }  // namespace harness::dataset_internal

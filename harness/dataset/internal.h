@@ -37,14 +37,26 @@ std::string NormalizeDir(const std::string& dir);
 // EuRoC's nanosecond stamps in seconds.
 double NsToSeconds(int64_t t_ns);
 
+// --- The readers' common steps.
+
+// Fails, naming `dir`, when `index` is not below `size` (the frames of the reader).
+bool CheckFrameIndex(const std::string& dir, size_t index, size_t size, std::string* error);
 // Reads one grey image of a stereo frame and checks its size against `expected`; `origin` says
 // where the expected size comes from (e.g. "the size of frame 0"). Error names the file.
 bool ReadGreyImage(const std::string& path, const cv::Size& expected, const std::string& origin,
                    cv::Mat* image, std::string* error);
+// The image size of a layout whose calibration (calib_path) has none: reads the first pair,
+// which must decode and agree in size, sets camera->width and height, and checks the camera
+// (vo::StereoCamera::IsValid, RigProblem). Errors name the image files or calib_path.
+bool TakeImageSizeFromFirstPair(const std::string& left_path, const std::string& right_path,
+                                const std::string& calib_path, vo::StereoCamera* camera,
+                                std::string* error);
 // Frames with an associated ground-truth pose (index >= 0).
 size_t CountAssociated(const std::vector<long>& index);
-// Error for a ground truth that no frame associates with (different clocks, wrong file).
-std::string NoAssociationMessage(const std::string& gt_path, const std::vector<double>& frame_s,
-                                 const std::vector<StampedPose>& gt, double max_difference_s);
+// *index = AssociateGroundTruth(frame_s, gt, max_difference_s); fails when no frame has a pose
+// (different clocks, wrong file), naming gt_path and the two time ranges.
+bool AssociateWithFrames(const std::string& gt_path, const std::vector<double>& frame_s,
+                         const std::vector<StampedPose>& gt, double max_difference_s,
+                         std::vector<long>* index, std::string* error);
 
 }  // namespace harness::dataset_internal

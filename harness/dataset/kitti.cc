@@ -11,6 +11,7 @@ namespace harness {
 namespace fs = std::filesystem;
 namespace {
 
+using dataset_internal::CheckFrameIndex;
 using dataset_internal::Fail;
 using dataset_internal::FrameName;
 using dataset_internal::Join;
@@ -18,6 +19,7 @@ using dataset_internal::NormalizeDir;
 using dataset_internal::ReadGreyImage;
 using dataset_internal::RigProblem;
 using dataset_internal::SizeText;
+using dataset_internal::TakeImageSizeFromFirstPair;
 using dataset_internal::Where;
 
 }  // namespace
@@ -119,20 +121,9 @@ bool KittiReader::Open(const std::string& dir, const Options& options, std::stri
       if (!fs::is_regular_file(ImagePath(cam, i), ec))
         return Fail(error, ImagePath(cam, i) + ": missing image file (frame " + std::to_string(i) +
                                " of " + std::to_string(times_s_.size()) + " in times.txt)");
-  const cv::Mat left = cv::imread(ImagePath(0, 0), cv::IMREAD_GRAYSCALE);
-  const cv::Mat right = cv::imread(ImagePath(1, 0), cv::IMREAD_GRAYSCALE);
-  if (left.empty()) return Fail(error, ImagePath(0, 0) + ": cannot decode the image");
-  if (right.empty()) return Fail(error, ImagePath(1, 0) + ": cannot decode the image");
-  if (left.size() != right.size())
-    return Fail(error, ImagePath(1, 0) + ": size " + SizeText(right) +
-                           " differs from the left image's " + SizeText(left) + " (" +
-                           ImagePath(0, 0) + ")");
-  camera_.width = left.cols;
-  camera_.height = left.rows;
-  std::string why;
-  if (!camera_.IsValid(&why)) return Fail(error, Join(dir_, "calib.txt") + ": " + why);
-  if (const std::string problem = RigProblem(camera_); !problem.empty())
-    return Fail(error, Join(dir_, "calib.txt") + ": " + problem);
+  if (!TakeImageSizeFromFirstPair(ImagePath(0, 0), ImagePath(1, 0), Join(dir_, "calib.txt"),
+                                  &camera_, error))
+    return false;
   has_depth_ = options_.load_depth && fs::is_directory(Join(dir_, "depth"), ec);
   return true;
 }
@@ -145,9 +136,7 @@ std::vector<StampedPose> KittiReader::GroundTruth() const {
 }
 
 bool KittiReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const {
-  if (index >= size())
-    return Fail(error, dir_ + ": frame " + std::to_string(index) + " out of range (" +
-                           std::to_string(size()) + " frames)");
+  if (!CheckFrameIndex(dir_, index, size(), error)) return false;
   const cv::Size size(camera_.width, camera_.height);
   cv::Mat images[2];
   for (int cam = 0; cam < 2; ++cam) {

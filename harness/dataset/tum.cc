@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "harness/dataset/internal.h"
@@ -13,14 +12,14 @@ namespace harness {
 namespace fs = std::filesystem;
 namespace {
 
+using dataset_internal::AssociateWithFrames;
+using dataset_internal::CheckFrameIndex;
 using dataset_internal::CountAssociated;
 using dataset_internal::Fail;
 using dataset_internal::Join;
-using dataset_internal::NoAssociationMessage;
 using dataset_internal::NormalizeDir;
 using dataset_internal::ReadGreyImage;
-using dataset_internal::RigProblem;
-using dataset_internal::SizeText;
+using dataset_internal::TakeImageSizeFromFirstPair;
 using dataset_internal::Where;
 
 // Reads a TUM rgb.txt-style list: "timestamp filename" lines, '#' comments.
@@ -92,20 +91,9 @@ bool TumReader::Open(const std::string& dir, const Options& options, std::string
     for (int cam = 0; cam < 2; ++cam)
       if (!fs::is_regular_file(files_[cam][i], ec))
         return Fail(error, files_[cam][i] + ": missing image file (listed in " + lists[cam] + ")");
-  const cv::Mat left = cv::imread(files_[0][0], cv::IMREAD_GRAYSCALE);
-  const cv::Mat right = cv::imread(files_[1][0], cv::IMREAD_GRAYSCALE);
-  if (left.empty()) return Fail(error, files_[0][0] + ": cannot decode the image");
-  if (right.empty()) return Fail(error, files_[1][0] + ": cannot decode the image");
-  if (left.size() != right.size())
-    return Fail(error, files_[1][0] + ": size " + SizeText(right) +
-                           " differs from the left image's " + SizeText(left) + " (" +
-                           files_[0][0] + ")");
-  camera_.width = left.cols;
-  camera_.height = left.rows;
-  std::string why;
-  if (!camera_.IsValid(&why)) return Fail(error, Join(dir_, "calib.txt") + ": " + why);
-  if (const std::string problem = RigProblem(camera_); !problem.empty())
-    return Fail(error, Join(dir_, "calib.txt") + ": " + problem);
+  if (!TakeImageSizeFromFirstPair(files_[0][0], files_[1][0], Join(dir_, "calib.txt"), &camera_,
+                                  error))
+    return false;
 
   // Ground truth (optional).
   gt_index_.assign(times_s_.size(), -1);
@@ -114,18 +102,14 @@ bool TumReader::Open(const std::string& dir, const Options& options, std::string
     gt_path_ = Join(dir_, "groundtruth.txt");
   if (gt_path_.empty()) return true;
   if (!ReadTum(gt_path_, &gt_, error)) return false;
-  gt_index_ = AssociateGroundTruth(times_s_, gt_, options_.gt_max_difference_s);
-  if (CountAssociated(gt_index_) == 0)
-    return Fail(error, NoAssociationMessage(gt_path_, times_s_, gt_, options_.gt_max_difference_s));
-  return true;
+  return AssociateWithFrames(gt_path_, times_s_, gt_, options_.gt_max_difference_s, &gt_index_,
+                             error);
 }
 
 size_t TumReader::ground_truth_frames() const { return CountAssociated(gt_index_); }
 
 bool TumReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error) const {
-  if (index >= size())
-    return Fail(error, dir_ + ": frame " + std::to_string(index) + " out of range (" +
-                           std::to_string(size()) + " frames)");
+  if (!CheckFrameIndex(dir_, index, size(), error)) return false;
   const cv::Size size(camera_.width, camera_.height);
   cv::Mat images[2];
   for (int cam = 0; cam < 2; ++cam) {
