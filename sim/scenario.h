@@ -23,7 +23,7 @@ struct RobotOptions {
   double track_m = 0.33;           // distance between the driven wheels (m), as in the MJCF robot
 };
 
-// Plausible ranges, shared by the scenario reader and the dataset readers (harness/dataset.cc):
+// Plausible ranges, shared by the scenario reader and the dataset readers (harness/dataset/):
 // a stereo rig from a phone's 1 mm to a car's or a tower's 5 m, and a field of view a pinhole
 // model describes (the reader also checks the focal length that gives).
 constexpr double kMinBaselineM = 0.001;  // 1 mm

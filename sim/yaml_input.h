@@ -2,8 +2,8 @@
 // is an error that names it), a YAML document whose mappings have no duplicate keys, and
 // YamlReader, the one strict reader over such a document. Every YAML reader of vobench is built
 // on YamlReader: scenarios (sim/scenario.cc), VO configs (harness/vo_config.cc), suites
-// (harness/suite.cc), tune files (harness/tune.cc) and the EuRoC sensor.yaml
-// (harness/dataset.cc). It lives in sim/ because harness/ depends on sim/.
+// (harness/suite/spec.cc), tune files (harness/tune.cc) and the EuRoC sensor.yaml
+// (harness/dataset/euroc.cc). It lives in sim/ because harness/ depends on sim/.
 #pragma once
 
 #include <yaml-cpp/yaml.h>

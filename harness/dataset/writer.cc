@@ -1,0 +1,351 @@
+#include "harness/dataset/writer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "harness/dataset/internal.h"
+#include "harness/trajectory_io.h"
+
+namespace harness {
+namespace fs = std::filesystem;
+namespace {
+
+using dataset_internal::Fail;
+using dataset_internal::FrameName;
+using dataset_internal::IsRotation;
+using dataset_internal::Join;
+using dataset_internal::NormalizeDir;
+using dataset_internal::SizeText;
+
+// Tolerance for "is this a rotation" on the options.
+constexpr double kRotationTolerance = 1e-6;  // max |R^T R - I| entry
+
+constexpr const char* kEurocGroundTruthHeader =
+    "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
+    "q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], "
+    "b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], "
+    "b_a_RS_S_z [m s^-2]";
+
+bool WriteBytes(const std::string& path, const std::vector<uchar>& bytes, std::string* error) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return Fail(error, path + ": cannot open for writing");
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  if (!out) return Fail(error, path + ": write error");
+  return true;
+}
+
+bool MakeDir(const std::string& path, std::string* error) {
+  std::error_code ec;
+  fs::create_directories(path, ec);
+  if (ec) return Fail(error, path + ": cannot create folder: " + ec.message());
+  return true;
+}
+
+// z-depth (metres, float) -> millimetres (uint16); 0 where there is no representable depth.
+cv::Mat DepthToMillimetres(const cv::Mat& depth_m) {
+  cv::Mat mm(depth_m.size(), CV_16UC1);
+  for (int r = 0; r < depth_m.rows; ++r) {
+    const float* src = depth_m.ptr<float>(r);
+    uint16_t* dst = mm.ptr<uint16_t>(r);
+    for (int c = 0; c < depth_m.cols; ++c) {
+      const double d = src[c];
+      long long v = 0;
+      if (std::isfinite(d) && d > 0.0) v = std::llround(d * 1000.0);
+      dst[c] = (v > 0 && v <= 65535) ? static_cast<uint16_t>(v) : 0;
+    }
+  }
+  return mm;
+}
+
+std::string CalibRow(const char* key, const double p[12]) {
+  std::string row = key;
+  for (int i = 0; i < 12; ++i) row += ' ' + FormatDouble(p[i]);
+  return row + '\n';
+}
+
+std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d& T_body_cam,
+                            const vo::StereoCamera& camera, double rate_hz) {
+  const Eigen::Matrix4d& T = T_body_cam.matrix();
+  std::string s;
+  s += "# General sensor definitions.\n";
+  s += "sensor_type: camera\n";
+  s += "comment: " + comment + "\n\n";
+  s += "# Sensor extrinsics wrt. the body-frame.\n";
+  s += "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
+  for (int r = 0; r < 4; ++r) {
+    if (r > 0) s += "         ";
+    for (int c = 0; c < 4; ++c) {
+      s += FormatDouble(r == 3 ? (c == 3 ? 1.0 : 0.0) : T(r, c));
+      s += (c < 3) ? ", " : (r < 3 ? ",\n" : "]\n");
+    }
+  }
+  s += "\n# Camera specific definitions.\n";
+  s += "rate_hz: " + FormatDouble(rate_hz) + "\n";
+  s +=
+      "resolution: [" + std::to_string(camera.width) + ", " + std::to_string(camera.height) + "]\n";
+  s += "camera_model: pinhole\n";
+  s += "intrinsics: [" + FormatDouble(camera.fx_px) + ", " + FormatDouble(camera.fy_px) + ", " +
+       FormatDouble(camera.cx_px) + ", " + FormatDouble(camera.cy_px) + "] #fu, fv, cu, cv\n";
+  s += "distortion_model: radial-tangential\n";
+  s += "distortion_coefficients: [0, 0, 0, 0]\n";
+  return s;
+}
+
+// File name stem of a TUM-style image: the stamp with 9 decimals (the decimal value of the
+// double, correctly rounded; t_ns = llround(t * 1e9) is off by ~100 ns at 1.3e9 s).
+std::string TumStampName(double time_s) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "%.9f", time_s);
+  return name;
+}
+
+}  // namespace
+
+bool DatasetWriter::Options::IsValid(std::string* error) const {
+  if (format != DatasetFormat::kKitti && format != DatasetFormat::kEuroc &&
+      format != DatasetFormat::kTum)
+    return Fail(error, "format must be kitti, euroc or tum");
+  if (png_compression < 0 || png_compression > 9)
+    return Fail(error, "png_compression must be in [0, 9], got " + std::to_string(png_compression));
+  if (!T_body_cam0.matrix().allFinite() || !IsRotation(T_body_cam0.linear(), kRotationTolerance))
+    return Fail(error, "T_body_cam0 must be finite with a rotation in its linear part");
+  if (!std::isfinite(rate_hz) || rate_hz < 0.0)
+    return Fail(error, "rate_hz must be finite and >= 0, got " + FormatDouble(rate_hz));
+  return true;
+}
+
+DatasetWriter::~DatasetWriter() { RemovePartial(); }
+
+void DatasetWriter::RemovePartial() {
+  if (finished_ || partial_dir_.empty()) return;
+  folder_.Discard();
+  partial_dir_.clear();
+}
+
+bool DatasetWriter::Open(const std::string& dir, const vo::StereoCamera& camera,
+                         std::string* error) {
+  if (is_open() || finished_) return Fail(error, "DatasetWriter::Open: writer already used");
+  std::string why;
+  if (!options_.IsValid(&why)) return Fail(error, "DatasetWriter options: " + why);
+  if (!camera.IsValid(&why)) return Fail(error, "DatasetWriter camera: " + why);
+  if (dir.empty()) return Fail(error, "DatasetWriter: empty output folder name");
+  dir_ = NormalizeDir(dir);
+  camera_ = camera;
+
+  // The partial folder: a marked, locked, unique sibling (output_folder.h); an existing DIR is
+  // replaced only with overwrite, and only when it is a vobench dataset.
+  OutputFolder::Options folder_options;
+  folder_options.replace_existing = options_.overwrite;
+  folder_options.replace_flag = "--overwrite";
+  if (!folder_.Create(dir_, "dataset", folder_options, error)) return false;
+  partial_dir_ = folder_.path();
+
+  std::vector<std::string> folders = {"image_0", "image_1"};
+  if (options_.format == DatasetFormat::kEuroc) {
+    folders.push_back("mav0/cam0/data");
+    folders.push_back("mav0/cam1/data");
+  }
+  if (options_.format == DatasetFormat::kTum) {
+    folders.push_back("left");
+    folders.push_back("right");
+  }
+  for (const std::string& f : folders) {
+    if (!MakeDir(Join(partial_dir_, f), error)) {
+      RemovePartial();
+      return false;
+    }
+  }
+  compression_params_ = {cv::IMWRITE_PNG_COMPRESSION, options_.png_compression,
+                         cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT};
+  return true;
+}
+
+bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
+  if (!is_open()) return Fail(error, "DatasetWriter::Add: writer is not open");
+  const size_t index = times_s_.size();
+  const std::string what = dir_ + ": frame " + std::to_string(index) + ": ";
+  const cv::Size size(camera_.width, camera_.height);
+  if (!std::isfinite(frame.time_s)) return Fail(error, what + "time is not finite");
+  const int64_t t_ns = TimeToNs(frame.time_s);
+  if (index > 0 && t_ns <= times_ns_.back())
+    return Fail(error, what + "time " + FormatDouble(frame.time_s) +
+                           " s is not after the previous frame's (need strictly increasing ns)");
+  if (options_.format == DatasetFormat::kTum && index > 0 &&
+      TumStampName(frame.time_s) == TumStampName(times_s_.back()))
+    return Fail(error,
+                what + "time " + FormatDouble(frame.time_s) +
+                    " s gives the previous frame's TUM image name (stamps closer than 1 ns)");
+  if (frame.left.type() != CV_8UC1 || frame.left.size() != size)
+    return Fail(error, what + "left image must be CV_8UC1 " + std::to_string(size.width) + "x" +
+                           std::to_string(size.height) + ", got type " +
+                           std::to_string(frame.left.type()) + " " + SizeText(frame.left));
+  if (frame.right.type() != CV_8UC1 || frame.right.size() != size)
+    return Fail(error, what + "right image must be CV_8UC1 " + std::to_string(size.width) + "x" +
+                           std::to_string(size.height) + ", got type " +
+                           std::to_string(frame.right.type()) + " " + SizeText(frame.right));
+  const bool frame_depth = options_.write_depth && !frame.depth_m.empty();
+  if (frame_depth && (frame.depth_m.type() != CV_32FC1 || frame.depth_m.size() != size))
+    return Fail(error, what + "depth must be CV_32FC1 of the image size, got type " +
+                           std::to_string(frame.depth_m.type()) + " " + SizeText(frame.depth_m));
+  if (index == 0) {
+    has_gt_ = frame.has_gt;
+    has_depth_ = frame_depth;
+    if (has_depth_ && !MakeDir(Join(partial_dir_, "depth"), error)) return false;
+  } else {
+    if (frame.has_gt != has_gt_)
+      return Fail(error, what + (has_gt_ ? "has no ground truth but frame 0 has"
+                                         : "has ground truth but frame 0 has none"));
+    if (frame_depth != has_depth_)
+      return Fail(error, what + (has_depth_ ? "has no depth but frame 0 has"
+                                            : "has depth but frame 0 has none"));
+  }
+  if (has_gt_ && !frame.T_world_cam0.matrix().allFinite())
+    return Fail(error, what + "ground-truth pose is not finite");
+
+  // Images: encode once, write the same bytes to every layout.
+  const std::string png_ns = std::to_string(t_ns) + ".png";
+  for (int cam = 0; cam < 2; ++cam) {
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", cam == 0 ? frame.left : frame.right, png, compression_params_))
+      return Fail(error, what + "PNG encoding failed");
+    const std::string cam_name = std::to_string(cam);
+    if (!WriteBytes(Join(partial_dir_, "image_" + cam_name + "/" + FrameName(index, ".png")), png,
+                    error))
+      return false;
+    if (options_.format == DatasetFormat::kEuroc &&
+        !WriteBytes(Join(partial_dir_, "mav0/cam" + cam_name + "/data/" + png_ns), png, error))
+      return false;
+    if (options_.format == DatasetFormat::kTum &&
+        !WriteBytes(Join(partial_dir_,
+                         (cam == 0 ? "left/" : "right/") + TumStampName(frame.time_s) + ".png"),
+                    png, error))
+      return false;
+  }
+  if (has_depth_) {
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", DepthToMillimetres(frame.depth_m), png, compression_params_))
+      return Fail(error, what + "depth PNG encoding failed");
+    if (!WriteBytes(Join(partial_dir_, "depth/" + FrameName(index, ".png")), png, error))
+      return false;
+  }
+  times_s_.push_back(frame.time_s);
+  times_ns_.push_back(t_ns);
+  if (has_gt_) T_world_cam0_.push_back(frame.T_world_cam0);
+  return true;
+}
+
+bool DatasetWriter::WriteEurocText(std::string* error) const {
+  const size_t n = times_s_.size();
+  double rate_hz = options_.rate_hz;
+  if (rate_hz == 0.0 && n >= 2) {
+    std::vector<double> dt;
+    for (size_t i = 1; i < n; ++i) dt.push_back(times_s_[i] - times_s_[i - 1]);
+    std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+    rate_hz = std::round(1e3 / dt[dt.size() / 2]) / 1e3;  // to 1 mHz: 30, not 29.99999999997
+  }
+  Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
+  T_cam0_cam1.translation() = Eigen::Vector3d(camera_.baseline_m, 0.0, 0.0);
+  const Eigen::Isometry3d T_body_cam[2] = {options_.T_body_cam0,
+                                           options_.T_body_cam0 * T_cam0_cam1};
+  const char* comments[2] = {"vobench cam0 (left)", "vobench cam1 (right)"};
+  for (int cam = 0; cam < 2; ++cam) {
+    const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));
+    std::string csv = "#timestamp [ns],filename\n";
+    for (int64_t t_ns : times_ns_)
+      csv += std::to_string(t_ns) + "," + std::to_string(t_ns) + ".png\n";
+    if (!WriteTextFile(Join(base, "data.csv"), csv, error)) return false;
+    if (!WriteTextFile(Join(base, "sensor.yaml"),
+                       EurocSensorYaml(comments[cam], T_body_cam[cam], camera_, rate_hz), error))
+      return false;
+  }
+  if (!has_gt_) return true;
+
+  // Ground truth: body pose in the world, velocity by finite differences, zero biases.
+  const std::string gt_dir = Join(partial_dir_, "mav0/state_groundtruth_estimate0");
+  if (!MakeDir(gt_dir, error)) return false;
+  const Eigen::Isometry3d T_cam0_body = options_.T_body_cam0.inverse();
+  std::vector<Eigen::Isometry3d> T_world_body(n);
+  for (size_t i = 0; i < n; ++i) T_world_body[i] = T_world_cam0_[i] * T_cam0_body;
+  std::string csv = std::string(kEurocGroundTruthHeader) + "\n";
+  for (size_t i = 0; i < n; ++i) {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    if (n >= 2) {
+      const size_t a = i == 0 ? 0 : i - 1, b = i + 1 == n ? n - 1 : i + 1;
+      v = (T_world_body[b].translation() - T_world_body[a].translation()) /
+          (times_s_[b] - times_s_[a]);
+    }
+    const Eigen::Vector3d p = T_world_body[i].translation();
+    const Eigen::Quaterniond q = CanonicalQuaternion(T_world_body[i].linear());
+    csv += std::to_string(times_ns_[i]);
+    for (double x : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z()})
+      csv += "," + FormatDouble(x);
+    csv += ",0,0,0,0,0,0\n";
+  }
+  return WriteTextFile(Join(gt_dir, "data.csv"), csv, error);
+}
+
+bool DatasetWriter::WriteTumText(std::string* error) const {
+  const char* names[2] = {"left", "right"};
+  for (int cam = 0; cam < 2; ++cam) {
+    std::string list = std::string("# ") + names[cam] +
+                       " images (vobench TUM-style stereo layout)\n# timestamp filename\n";
+    for (size_t i = 0; i < times_s_.size(); ++i)
+      list +=
+          FormatDouble(times_s_[i]) + " " + names[cam] + "/" + TumStampName(times_s_[i]) + ".png\n";
+    if (!WriteTextFile(Join(partial_dir_, std::string(names[cam]) + ".txt"), list, error))
+      return false;
+  }
+  if (!has_gt_) return true;
+  std::vector<StampedPose> gt;
+  for (size_t i = 0; i < times_s_.size(); ++i) gt.push_back({times_s_[i], T_world_cam0_[i]});
+  return WriteTum(Join(partial_dir_, "groundtruth.txt"), gt, error);
+}
+
+bool DatasetWriter::Finish(std::string* error) {
+  if (!is_open()) return Fail(error, "DatasetWriter::Finish: writer is not open");
+  if (times_s_.empty()) return Fail(error, dir_ + ": no frames were added");
+
+  // calib.txt: rectified projection matrices, P1 = K [I | (-baseline_m, 0, 0)].
+  const double P0[12] = {
+      camera_.fx_px, 0, camera_.cx_px, 0, 0, camera_.fy_px, camera_.cy_px, 0, 0, 0, 1, 0};
+  double P1[12];
+  std::copy(P0, P0 + 12, P1);
+  P1[3] = -(camera_.fx_px * camera_.baseline_m);
+  if (!WriteTextFile(Join(partial_dir_, "calib.txt"), CalibRow("P0:", P0) + CalibRow("P1:", P1),
+                     error) ||
+      !WriteKittiTimes(Join(partial_dir_, "times.txt"), times_s_, error))
+    return false;
+
+  if (has_gt_) {
+    // Ground truth relative to the first left camera, as KITTI's poses.txt.
+    const Eigen::Isometry3d T_cam0first_world = T_world_cam0_.front().inverse();
+    std::vector<Eigen::Isometry3d> poses;
+    std::vector<StampedPose> tum;
+    for (size_t i = 0; i < times_s_.size(); ++i) {
+      poses.push_back(i == 0 ? Eigen::Isometry3d::Identity()
+                             : T_cam0first_world * T_world_cam0_[i]);
+      tum.push_back({times_s_[i], poses.back()});
+    }
+    if (!WriteKittiPoses(Join(partial_dir_, "poses.txt"), poses, error) ||
+        !WriteTum(Join(partial_dir_, "groundtruth_tum.txt"), tum, error) ||
+        !WriteKittiPoses(Join(partial_dir_, "T_world_cam0first.txt"), {T_world_cam0_.front()},
+                         error))
+      return false;
+  }
+  if (options_.format == DatasetFormat::kEuroc && !WriteEurocText(error)) return false;
+  if (options_.format == DatasetFormat::kTum && !WriteTumText(error)) return false;
+
+  // Publish: rename the partial folder to DIR (replacing an old vobench dataset when allowed).
+  if (!folder_.Publish(error)) return false;
+  finished_ = true;
+  partial_dir_.clear();
+  return true;
+}
+
+}  // namespace harness

@@ -1,0 +1,90 @@
+// DatasetWriter: a stereo sequence onto disk in the KITTI odometry layout (kitti.h), and when
+// asked also in the EuRoC/ASL layout (euroc.h) or the TUM-style stereo layout (tum.h), so
+// simulated sequences (`vobench render`) run through the same readers as real ones.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "harness/dataset/common.h"
+#include "harness/output_folder.h"
+#include "vo/camera.h"
+
+namespace harness {
+
+// Writes a sequence atomically: everything goes into a marked, locked work folder
+// "DIR.partial-<pid>-<random>" (an OutputFolder of kind "dataset", output_folder.h) that is
+// renamed to DIR only by Finish(). Destroying the writer before Finish() (error, exception)
+// removes the partial folder, so a half-written DIR never exists. A process killed outright
+// (SIGKILL, Ctrl-C without a handler) leaves the ".partial-" folder, never DIR; Open() removes
+// such leftovers of dead processes when they carry vobench's marker. Identical input gives
+// byte-identical files (fixed PNG parameters, FormatDouble numbers, no "now" anywhere), except
+// the marker .vobench.json (command line, time, pid).
+//
+// Usage:  DatasetWriter writer(options);
+//         if (!writer.Open(dir, camera, &error)) ...;
+//         for (...) if (!writer.Add(frame, &error)) ...;
+//         if (!writer.Finish(&error)) ...;
+class DatasetWriter {
+ public:
+  struct Options {
+    DatasetFormat format = DatasetFormat::kKitti;  // kEuroc also writes the mav0/ layout, kTum
+                                                   // the TUM-style one
+    bool overwrite = false;   // replace an existing DIR (on Finish) when it is a vobench
+                              // dataset (.vobench.json kind "dataset"); otherwise refuse
+    bool write_depth = true;  // write depth/%06d.png for frames that carry depth
+    int png_compression = 3;  // zlib level of every PNG, 0 (none) .. 9 (smallest, slowest)
+    // EuRoC body frame: the left camera's pose in the body (rotation, metres).
+    Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();
+    double rate_hz = 0.0;  // rate written to sensor.yaml (Hz, >= 0); 0 = from the median
+                           // frame interval, rounded to 1 mHz
+
+    bool IsValid(std::string* error) const;
+  };
+
+  DatasetWriter() = default;
+  explicit DatasetWriter(Options options) : options_(std::move(options)) {}
+  ~DatasetWriter();  // removes the partial folder unless Finish() succeeded
+  DatasetWriter(const DatasetWriter&) = delete;
+  DatasetWriter& operator=(const DatasetWriter&) = delete;
+
+  // Checks options and camera, refuses an existing DIR unless options.overwrite (and then any
+  // DIR vobench did not write as a dataset), creates the partial folder (and DIR's parent
+  // folders) under the lock DIR.lock.
+  bool Open(const std::string& dir, const vo::StereoCamera& camera, std::string* error);
+  // Writes the frame's images at once. Frames must come in strictly increasing time (distinct
+  // t_ns); images must be CV_8UC1 of the camera's size, depth empty or CV_32FC1 of that size.
+  // Ground truth and depth are all-or-nothing: the first frame decides for the sequence.
+  bool Add(const DatasetFrame& frame, std::string* error);
+  // Writes the text files and renames the partial folder to DIR. At least one frame needed.
+  bool Finish(std::string* error);
+
+  bool is_open() const { return !partial_dir_.empty(); }
+  bool finished() const { return finished_; }
+  size_t num_frames() const { return times_s_.size(); }
+  const std::string& partial_dir() const { return partial_dir_; }  // empty when not open
+
+ private:
+  void RemovePartial();
+  bool WriteEurocText(std::string* error) const;
+  bool WriteTumText(std::string* error) const;
+
+  Options options_;
+  vo::StereoCamera camera_;
+  std::string dir_;
+  OutputFolder folder_;      // the marked, locked work folder and its publishing
+  std::string partial_dir_;  // folder_.path() while open
+  bool finished_ = false;
+  bool has_gt_ = false;
+  bool has_depth_ = false;
+  std::vector<double> times_s_;
+  std::vector<int64_t> times_ns_;
+  std::vector<Eigen::Isometry3d> T_world_cam0_;  // one per frame when has_gt_
+  std::vector<int> compression_params_;
+};
+
+}  // namespace harness

@@ -1,0 +1,171 @@
+#include "harness/suite/folder.h"
+
+#include <unistd.h>
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "harness/output_folder.h"
+#include "harness/path_names.h"
+#include "harness/trajectory_io.h"
+
+namespace harness {
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+bool WriteFileAtomically(const std::string& path, const std::string& text, std::string* error) {
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  if (!WriteTextFile(tmp, text, error)) return false;
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    *error = path + ": cannot write: " + ec.message();
+    return false;
+  }
+  return true;
+}
+
+namespace suite_internal {
+
+std::string ReadWholeFile(const fs::path& path, bool* ok) {
+  std::ifstream in(path, std::ios::binary);
+  *ok = static_cast<bool>(in);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+json Manifest(const Suite& suite, const std::vector<SuiteRun>& runs, const Shard& shard) {
+  json j;
+  j["suite"] = suite.name;
+  j["source"] = suite.source_path;
+  j["shard"] = std::to_string(shard.index) + "/" + std::to_string(shard.count);
+  j["runs"] = json::array();
+  for (const auto& r : runs) {
+    json e;
+    e["index"] = r.index;
+    e["id"] = r.id;
+    e["scenario"] = r.scenario;
+    e["config"] = r.config;
+    e["seed"] = r.seed;
+    e["stride"] = r.stride;
+    e["max_frames"] = r.max_frames;
+    e["spec_hash"] = r.spec_hash;
+    j["runs"].push_back(e);
+  }
+  return j;
+}
+
+bool ReadJsonFile(const fs::path& path, json* out, std::string* error) {
+  bool ok = false;
+  const std::string text = ReadWholeFile(path, &ok);
+  if (!ok) {
+    *error = path.string() + ": cannot read";
+    return false;
+  }
+  try {
+    *out = json::parse(text);
+  } catch (const json::exception& e) {
+    *error = path.string() + ": malformed JSON: " + e.what();
+    return false;
+  }
+  return true;
+}
+
+bool ReadManifest(const fs::path& dir, std::string* name, std::vector<SuiteRun>* runs,
+                  std::string* error) {
+  json j;
+  if (!ReadJsonFile(dir / "suite.json", &j, error)) return false;
+  try {
+    *name = j.at("suite").get<std::string>();
+    runs->clear();
+    for (const auto& e : j.at("runs")) {
+      SuiteRun r;
+      r.index = e.at("index").get<int>();
+      r.id = e.at("id").get<std::string>();
+      r.scenario = e.at("scenario").get<std::string>();
+      r.config = e.at("config").get<std::string>();
+      r.seed = e.at("seed").get<uint64_t>();
+      r.stride = e.at("stride").get<int>();
+      r.max_frames = e.at("max_frames").get<int>();
+      r.spec_hash = e.at("spec_hash").get<std::string>();
+      std::string why;
+      if (r.index != static_cast<int>(runs->size()) ||
+          !CheckRunIdPart(r.scenario, "scenario name", &why) ||
+          !CheckRunIdPart(r.config, "configuration name", &why) ||
+          !CheckPathName(r.id, "run id", &why))
+        throw std::runtime_error("run " + r.id + " is out of order or malformed" +
+                                 (why.empty() ? "" : ": " + why));
+      runs->push_back(r);
+    }
+  } catch (const std::exception& e) {
+    *error = (dir / "suite.json").string() + ": not a vobench suite manifest: " + e.what();
+    return false;
+  }
+  return true;
+}
+
+bool CheckOutDir(const fs::path& dir, const std::string& name, std::string* error) {
+  if (!CheckReplaceable(dir.string(), "suite", error)) return false;
+  if (!fs::exists(dir / "suite.json")) return true;
+  std::string other;
+  std::vector<SuiteRun> runs;
+  if (!ReadManifest(dir, &other, &runs, error)) return false;
+  if (other != name) {
+    *error =
+        dir.string() + ": holds suite '" + other + "', not '" + name + "'; choose another --out";
+    return false;
+  }
+  return true;
+}
+
+bool IsFinished(const fs::path& run_dir, const std::string& spec_hash, json* stamp) {
+  if (!fs::is_regular_file(run_dir / "metrics.json")) return false;
+  json j;
+  std::string error;
+  if (!ReadJsonFile(run_dir / "suite_run.json", &j, &error)) return false;
+  if (!j.contains("spec_hash") || j["spec_hash"] != spec_hash) return false;
+  if (stamp) *stamp = j;
+  return true;
+}
+
+fs::path WorkDir(const fs::path& out, const std::string& tag) { return out / "tmp" / tag; }
+std::string ShardTag(const Shard& shard) {
+  return "shard" + std::to_string(shard.index) + "of" + std::to_string(shard.count);
+}
+
+void RemoveLeftovers(const fs::path& out, const fs::path& work) {
+  std::error_code ec;
+  fs::remove_all(work, ec);
+  fs::remove(out / "tmp", ec);    // only if empty
+  std::vector<fs::path> partial;  // only folders vobench marked as its own
+  for (fs::directory_iterator it(out / "runs", ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().filename().string().find(".partial") != std::string::npos &&
+        HasFolderMarker(it->path().string()))
+      partial.push_back(it->path());
+  for (const auto& p : partial) fs::remove_all(p, ec);
+}
+
+bool MakeDirs(const fs::path& out, std::string* error) {
+  std::error_code ec;
+  for (const char* sub : {"runs", "specs", "logs"}) {
+    fs::create_directories(out / sub, ec);
+    if (ec) {
+      *error = (out / sub).string() + ": cannot create: " + ec.message();
+      return false;
+    }
+  }
+  return true;
+}
+
+bool WriteSpecs(const fs::path& out, const SuiteRun& r, std::string* error) {
+  return WriteFileAtomically((out / "specs" / (r.id + ".scenario.yaml")).string(), r.scenario_yaml,
+                             error) &&
+         WriteFileAtomically((out / "specs" / (r.id + ".vo.yaml")).string(), r.vo_yaml, error);
+}
+
+}  // namespace suite_internal
+}  // namespace harness
