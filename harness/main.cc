@@ -18,7 +18,7 @@
 #include "harness/match_eval.h"
 #include "harness/output_folder.h"
 #include "harness/path_names.h"
-#include "harness/plots.h"
+#include "harness/plots/plots.h"
 #include "harness/progress.h"
 #include "harness/render.h"
 #include "harness/run.h"

@@ -30,7 +30,7 @@
 #include "harness/output_folder.h"
 #include "harness/overrides.h"
 #include "harness/path_names.h"
-#include "harness/plots.h"
+#include "harness/plots/plots.h"
 #include "harness/progress.h"
 #include "harness/trajectory_io.h"
 #include "harness/vo_config.h"
