@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "harness/cli.h"
+#include "harness/cli/command.h"
 #include "harness/eval.h"
 #include "harness/path_names.h"
 #include "harness/vo_config.h"

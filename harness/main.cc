@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "harness/cli.h"
+#include "harness/cli/command.h"
 #include "harness/eval.h"
 #include "harness/eval_command.h"
 #include "harness/interrupt.h"

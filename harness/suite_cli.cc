@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "harness/check.h"
-#include "harness/cli.h"  // kExitBadInput: bad suite, baseline or flags; nothing written
+#include "harness/cli/command.h"  // kExitBadInput: bad suite, baseline or flags; nothing written
 #include "harness/overrides.h"
 #include "harness/suite.h"
 #include "harness/vo_config.h"

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "harness/cli.h"
+#include "harness/cli/command.h"
 #include "harness/tune.h"
 
 namespace harness {

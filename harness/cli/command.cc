@@ -1,9 +1,15 @@
-#include "harness/cli.h"
+#include "harness/cli/command.h"
 
 #include <cstdio>
 #include <string>
 
 namespace harness {
+
+int RunGivenCommand(const std::vector<Command>& commands) {
+  for (const Command& c : commands)
+    if (c.app->parsed()) return c.run();
+  return kExitOk;
+}
 
 CLI::Validator AtLeast(long min) {
   const std::string bound = std::to_string(min);
