@@ -5,10 +5,10 @@
 #include <spdlog/spdlog.h>
 
 #include "harness/cli/command.h"
+#include "harness/cli/eval_command.h"
 #include "harness/cli/match_eval_command.h"
 #include "harness/cli/render_command.h"
 #include "harness/cli/run_command.h"
-#include "harness/eval_command.h"
 #include "harness/interrupt.h"
 #include "harness/suite_cli.h"
 #include "harness/tune_command.h"
@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   const harness::Command render = harness::AddRenderCommand(app);
   const harness::Command match_eval = harness::AddMatchEvalCommand(app);
   const harness::Command run = harness::AddRunCommand(app);
-  const auto eval = harness::AddEvalCommand(app);
+  const harness::Command eval = harness::AddEvalCommand(app);
   harness::TuneCommandArgs tune_args;
   CLI::App* tune = harness::AddTuneCommand(app, &tune_args);
   harness::AddSuiteCommands(app);  // suite, suite merge, check
@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
   if (rc < 0) {
     if (render.app->parsed()) rc = render.run();
     else if (run.app->parsed()) rc = run.run();
-    else if (*eval->app) rc = eval->Run(harness::PrintRunTable);
+    else if (eval.app->parsed()) rc = eval.run();
     else if (*tune) rc = harness::RunTuneCommand(tune_args);
     else if (match_eval.app->parsed()) rc = match_eval.run();
     else rc = 0;
