@@ -9,9 +9,9 @@
 #include "harness/cli/match_eval_command.h"
 #include "harness/cli/render_command.h"
 #include "harness/cli/run_command.h"
+#include "harness/cli/tune_command.h"
 #include "harness/interrupt.h"
 #include "harness/suite_cli.h"
-#include "harness/tune_command.h"
 
 int main(int argc, char** argv) {
   // The VO runs on one thread (the timings vobench reports are single-threaded, as the speed
@@ -29,8 +29,7 @@ int main(int argc, char** argv) {
   const harness::Command match_eval = harness::AddMatchEvalCommand(app);
   const harness::Command run = harness::AddRunCommand(app);
   const harness::Command eval = harness::AddEvalCommand(app);
-  harness::TuneCommandArgs tune_args;
-  CLI::App* tune = harness::AddTuneCommand(app, &tune_args);
+  const harness::Command tune = harness::AddTuneCommand(app);
   harness::AddSuiteCommands(app);  // suite, suite merge, check
 
   // Argument errors exit with 2 (one line on stderr); suite, suite merge and check run inside
@@ -42,7 +41,7 @@ int main(int argc, char** argv) {
     if (render.app->parsed()) rc = render.run();
     else if (run.app->parsed()) rc = run.run();
     else if (eval.app->parsed()) rc = eval.run();
-    else if (*tune) rc = harness::RunTuneCommand(tune_args);
+    else if (tune.app->parsed()) rc = tune.run();
     else if (match_eval.app->parsed()) rc = match_eval.run();
     else rc = 0;
   }
