@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace harness {
@@ -28,6 +29,13 @@ struct Command {
   std::function<int()> run;  // runs it on the parsed arguments; returns the exit code
 };
 
+// Prints "vobench COMMAND: MESSAGE" on stderr (one line) and returns exit_code: the end of an
+// action that fails, `return PrintFailure("suite", kExitBadInput, error);`.
+int PrintFailure(const char* command, int exit_code, const std::string& message);
+
+// The default of -j (suite, check): the hardware threads, at least 1.
+int DefaultJobs();
+
 // Runs the command the parsed command line gave (the first of `commands` whose app was
 // parsed) and returns its exit code; kExitOk when none was given.
 int RunGivenCommand(const std::vector<Command>& commands);
@@ -39,8 +47,7 @@ CLI::Validator AtLeast(long min);
 
 // Parses the command line. Returns -1 when the command should run; otherwise the exit code to
 // return at once: 0 after --help, 2 after any argument error (printed as one line on stderr,
-// "vobench SUBCOMMAND: MESSAGE (see vobench SUBCOMMAND --help)"), or the code of a
-// CLI::RuntimeError thrown by a subcommand callback (its message is already printed).
+// "vobench SUBCOMMAND: MESSAGE (see vobench SUBCOMMAND --help)").
 int ParseCommandLine(CLI::App& app, int argc, char** argv);
 
 }  // namespace harness
