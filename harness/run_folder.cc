@@ -7,7 +7,7 @@
 
 #include "harness/interrupt.h"
 #include "harness/metric_registry.h"
-#include "harness/plots.h"
+#include "harness/plots/plots.h"
 
 namespace harness {
 namespace {

@@ -1,6 +1,6 @@
 #include "harness/tune.h"
 
-#include "harness/plots.h"
+#include "harness/plots/plots.h"
 
 #include <sys/wait.h>
 #include <yaml-cpp/yaml.h>
@@ -283,7 +283,7 @@ bool ReadOptimizer(YamlReader& r, const YAML::Node& root, OptimizerOptions* opti
   return true;
 }
 
-// harness/tune_plot.py DIR PNG with Debian's python3 (python3-matplotlib is installed for it).
+// harness/plots/tune_plot.py DIR PNG with Debian's python3 (the one python3-matplotlib is for).
 bool RunTunePlot(const std::string& dir, const std::string& png, std::string* error) {
   return RunPythonScript("tune_plot.py", {dir, png}, error);
 }

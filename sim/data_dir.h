@@ -1,6 +1,6 @@
-// Where vobench finds the files it ships: scenes/, suites/, the plot scripts (harness/*.py) and
-// results/baseline.json. The data folder has the same layout as the source tree, so one relative
-// path names a file in both:
+// Where vobench finds the files it ships: scenes/, suites/, the plot scripts
+// (harness/plots/*.py) and results/baseline.json. The data folder has the same layout as the
+// source tree, so one relative path names a file in both:
 //   installed   <prefix>/share/vobench/   (`cmake --install`; found from the running executable,
 //                                          <prefix>/bin/vobench -> <prefix>/share/vobench)
 //   build tree  the source tree            (compiled in; the build's executables are not under a

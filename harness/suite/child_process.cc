@@ -11,7 +11,7 @@
 #include <cstring>
 #include <sstream>
 
-#include "harness/plots.h"
+#include "harness/plots/plots.h"
 #include "harness/suite/folder.h"
 
 namespace harness::suite_internal {

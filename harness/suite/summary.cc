@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "harness/metric_registry.h"
-#include "harness/plots.h"
+#include "harness/plots/plots.h"
 #include "harness/suite/folder.h"
 #include "harness/trajectory_io.h"
 
@@ -186,7 +186,7 @@ std::string SummaryMarkdown(const std::string& name, const SuiteResult& result, 
   return md.str();
 }
 
-// harness/suite_plot.py SUMMARY_CSV PNG (Debian's python3 with matplotlib).
+// harness/plots/suite_plot.py SUMMARY_CSV PNG (Debian's python3 with matplotlib).
 bool RunSuitePlot(const std::string& csv, const std::string& png, std::string* error) {
   std::vector<std::string> args = {csv, png};
   for (const char* key : {"end_pose_error_pct", "ate_rmse_m"}) {  // the two panels

@@ -1,6 +1,6 @@
 // The summary of a suite across its runs: one row per run (status, axes, metrics.json), written
 // as summary.csv (every metric), summary.md (per-configuration medians, a pivot by scenario and
-// configuration, the runs) and summary.png (harness/suite_plot.py), and printed as a table.
+// configuration, the runs) and summary.png (harness/plots/suite_plot.py), and printed as a table.
 #pragma once
 
 #include <filesystem>

@@ -1,7 +1,7 @@
-// The plot scripts (harness/*.py) run on the committed results/ fixtures, through the same
+// The plot scripts (harness/plots/*.py) run on the committed results/ fixtures, through the same
 // runner the commands use (RunPlot / RunPythonScript: Debian's /usr/bin/python3), and the
 // trajectory plot's outline comes from the scene's walls. Skipped without python3-matplotlib.
-#include "harness/plots.h"
+#include "harness/plots/plots.h"
 
 #include <gtest/gtest.h>
 
@@ -117,8 +117,8 @@ TEST(PlotScriptsTest, EveryScriptWritesAPngFromTheCommittedResults) {
   ExpectPng(dir / "objective.png");
   ran.insert("tune_plot.py");
 
-  // A new script in harness/ needs a case here.
-  for (const auto& e : fs::directory_iterator(kSource + "/harness")) {
+  // A new script in harness/plots/ needs a case here.
+  for (const auto& e : fs::directory_iterator(kSource + "/harness/plots")) {
     if (e.path().extension() == ".py") {
       EXPECT_TRUE(ran.count(e.path().filename().string()))
           << e.path() << " is not run by this smoke test: add it";

@@ -1,9 +1,24 @@
-#include "harness/cli.h"
+#include "harness/cli/command.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
+#include <thread>
 
 namespace harness {
+
+int PrintFailure(const char* command, int exit_code, const std::string& message) {
+  std::fprintf(stderr, "vobench %s: %s\n", command, message.c_str());
+  return exit_code;
+}
+
+int DefaultJobs() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+int RunGivenCommand(const std::vector<Command>& commands) {
+  for (const Command& c : commands)
+    if (c.app->parsed()) return c.run();
+  return kExitOk;
+}
 
 CLI::Validator AtLeast(long min) {
   const std::string bound = std::to_string(min);
@@ -30,8 +45,6 @@ int ParseCommandLine(CLI::App& app, int argc, char** argv) {
     return -1;
   } catch (const CLI::Success& e) {  // --help
     return app.exit(e);
-  } catch (const CLI::RuntimeError& e) {  // a subcommand callback's result; already reported
-    return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     // The subcommands parsed so far name the command in the message ("vobench suite merge").
     std::string command = "vobench";

@@ -1,31 +1,23 @@
-#include "harness/tune_command.h"
+#include "harness/cli/tune_command.h"
 
 #include <cstdio>
+#include <memory>
+#include <string>
 
-#include "harness/cli.h"
 #include "harness/tune.h"
 
 namespace harness {
+namespace {
 
-CLI::App* AddTuneCommand(CLI::App& app, TuneCommandArgs* args) {
-  CLI::App* tune = app.add_subcommand(
-      "tune",
-      "Search VO parameters against ground truth on training scenarios, score the best on "
-      "validation scenarios, write it as a --config file");
-  tune->add_option("file", args->file, "Tune file (YAML; see README, section Tuning)")->required();
-  tune->add_option(
-      "--out,-o", args->out,
-      "Output folder (default out/tune/<name>); an earlier tune result there is replaced");
-  tune->add_option(
-          "--max-evals", args->max_evals,
-          "Evaluations budget, the start included (default: the file's optimizer.max_evals)")
-      ->check(AtLeast(1));
-  tune->add_flag("--no-plots", args->no_plots, "Skip objective.png");
-  tune->add_flag("-q,--quiet", args->quiet, "No progress display");
-  return tune;
-}
+struct TuneArgs {
+  std::string file;   // the tune file (YAML, see tune.h)
+  std::string out;    // output folder; "" = out/tune/<name>
+  int max_evals = 0;  // > 0: replaces the file's optimizer.max_evals
+  bool no_plots = false;
+  bool quiet = false;
+};
 
-int RunTuneCommand(const TuneCommandArgs& args) {
+int RunTuneCommand(const TuneArgs& args) {
   std::string error;
   TuneSpec spec;
   if (!LoadTuneSpec(args.file, &spec, &error)) {
@@ -53,6 +45,27 @@ int RunTuneCommand(const TuneCommandArgs& args) {
   std::printf("best config     %s/best_vo.yaml (vobench run --config)\n", options.out_dir.c_str());
   std::printf("report          %s/report.md\n", options.out_dir.c_str());
   return 0;
+}
+
+}  // namespace
+
+Command AddTuneCommand(CLI::App& app) {
+  auto a = std::make_shared<TuneArgs>();
+  CLI::App* tune = app.add_subcommand(
+      "tune",
+      "Search VO parameters against ground truth on training scenarios, score the best on "
+      "validation scenarios, write it as a --config file");
+  tune->add_option("file", a->file, "Tune file (YAML; see README, section Tuning)")->required();
+  tune->add_option(
+      "--out,-o", a->out,
+      "Output folder (default out/tune/<name>); an earlier tune result there is replaced");
+  tune->add_option(
+          "--max-evals", a->max_evals,
+          "Evaluations budget, the start included (default: the file's optimizer.max_evals)")
+      ->check(AtLeast(1));
+  tune->add_flag("--no-plots", a->no_plots, "Skip objective.png");
+  tune->add_flag("-q,--quiet", a->quiet, "No progress display");
+  return {tune, [a] { return RunTuneCommand(*a); }};
 }
 
 }  // namespace harness

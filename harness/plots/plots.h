@@ -1,4 +1,5 @@
-// Plots through harness/plot.py (python3-matplotlib from Debian, run with /usr/bin/python3).
+// Plots through the matplotlib scripts beside this file, harness/plots/*.py (python3-matplotlib
+// from Debian, run with /usr/bin/python3; installed under <prefix>/share/vobench/harness/plots).
 #pragma once
 
 #include <string>
@@ -12,9 +13,9 @@ namespace harness {
 // script fails. Plots are an extra: callers warn and go on.
 bool RunPlot(const std::vector<std::string>& args, std::string* error);
 
-// Runs harness/SCRIPT (a matplotlib script of ours) with ARGS under Debian's python3 (the one
-// python3-matplotlib is installed for, not another python on PATH); false with *error (the
-// script's output) when it cannot start or fails.
+// Runs harness/plots/SCRIPT (a matplotlib script of ours, in sim::DataDir()) with ARGS under
+// Debian's python3 (the one python3-matplotlib is installed for, not another python on PATH);
+// false with *error (the script's output) when it cannot start or fails.
 bool RunPythonScript(const std::string& script, const std::vector<std::string>& args,
                      std::string* error);
 

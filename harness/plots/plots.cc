@@ -1,4 +1,4 @@
-#include "harness/plots.h"
+#include "harness/plots/plots.h"
 
 #include <sys/wait.h>
 
@@ -22,7 +22,7 @@ std::string ShellQuoted(const std::string& s) {
 
 bool RunPythonScript(const std::string& script, const std::vector<std::string>& args,
                      std::string* error) {
-  const std::string path = sim::DataDir() + "/harness/" + script;
+  const std::string path = sim::DataDir() + "/harness/plots/" + script;
   const std::string python =
       std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   std::string cmd = python + " " + ShellQuoted(path);

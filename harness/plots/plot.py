@@ -5,7 +5,7 @@
   plot.py trajectory GT_TUM EST_TUM PNG [--outline-file CSV]
                                       top-down trajectory, estimate vs ground truth; CSV: the
                                       scene's walls (wall,x0_m,y0_m,x1_m,y1_m), written by the
-                                      harness from the MJCF (harness/plots.h, SceneOutlineCsv)
+                                      harness from the MJCF (harness/plots/plots.h, SceneOutlineCsv)
   plot.py errors RUN_DIR PNG          translation / rotation error along the path (per_frame.csv)
   plot.py timing RUN_DIR PNG          per-stage time per frame (per_frame.csv)
 """

@@ -1,0 +1,125 @@
+#include "harness/cli/eval_command.h"
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "harness/cli/run_command.h"
+#include "harness/eval.h"
+#include "harness/path_names.h"
+#include "harness/vo_config.h"
+
+namespace harness {
+namespace {
+
+struct EvalArgs {
+  std::string dataset;
+  std::string format;
+  std::string gt;
+  std::string config;
+  std::string out;  // default out/eval/<dataset folder name>
+  int max_frames = 0;
+  double max_difference_s = 0.0;
+  bool no_plots = false;
+  bool quiet = false;
+};
+
+// Runs the parsed command; max_difference_given: --max-difference was on the command line.
+int RunEval(const EvalArgs& a, bool max_difference_given) {
+  std::string error;
+  EvalOptions options;
+  if (!ParseDatasetFormat(a.format, &options.format)) {
+    std::fprintf(stderr, "vobench eval: --format: expected kitti, euroc or tum, got '%s'\n",
+                 a.format.c_str());
+    return 2;
+  }
+  options.gt_path = a.gt;
+  if (max_difference_given && !(a.max_difference_s > 0.0)) {
+    std::fprintf(stderr, "vobench eval: --max-difference: expected seconds > 0, got %g\n",
+                 a.max_difference_s);
+    return 2;
+  }
+  options.max_difference_s = a.max_difference_s;
+  if (a.max_frames < 0) {
+    std::fprintf(stderr, "vobench eval: --max-frames: must be >= 0, got %d\n", a.max_frames);
+    return 2;
+  }
+  if (!options.IsValid(&error)) {
+    std::fprintf(stderr, "vobench eval: %s\n", error.c_str());
+    return 2;
+  }
+  vo::OdometryOptions vo_options;
+  if (!a.config.empty() && !LoadVoConfig(a.config, &vo_options, &error)) {
+    std::fprintf(stderr, "vobench eval: %s\n", error.c_str());
+    return 2;
+  }
+  RunOptions run_options;
+  if (a.out.empty() && !CheckPathName(DatasetName(a.dataset), "dataset folder name", &error)) {
+    std::fprintf(stderr, "vobench eval: %s (give --out)\n", error.c_str());
+    return 2;
+  }
+  run_options.out_dir = a.out.empty() ? "out/eval/" + DatasetName(a.dataset) : a.out;
+  run_options.progress = !a.quiet;
+  run_options.plots = !a.no_plots;
+  run_options.max_frames = a.max_frames;
+  RunSummary summary;
+  EvalInfo info;
+  if (!EvalDataset(a.dataset, options, vo_options, run_options, &summary, &info, &error)) {
+    std::fprintf(stderr, "vobench eval: %s\n", error.c_str());
+    return 1;
+  }
+  std::printf("dataset         %s (%s layout), %zu stereo frames", a.dataset.c_str(),
+              a.format.c_str(), info.dataset_frames);
+  if (info.unpaired_frames > 0) std::printf(", %zu unpaired images left out", info.unpaired_frames);
+  std::printf("\n");
+  const vo::StereoCamera& cam = info.camera;
+  std::printf("camera          %dx%d, fx %.2f fy %.2f cx %.2f cy %.2f px, baseline %.4f m%s\n",
+              cam.width, cam.height, cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px, cam.baseline_m,
+              info.rectified ? " (rectified from the raw calibration)" : "");
+  if (info.ground_truth_path.empty()) {
+    std::printf("ground truth    none: trajectory and per-frame log only, no accuracy metrics\n");
+  } else {
+    std::printf("ground truth    %s: %zu of %zu frames associated (max difference %g s)",
+                info.ground_truth_path.c_str(), info.ground_truth_frames, info.dataset_frames,
+                info.max_difference_s);
+    if (summary.has_ground_truth)
+      std::printf("; metrics over the %d run frames with ground truth\n",
+                  summary.ground_truth_frames);
+    else
+      std::printf("; %d run frame(s) with ground truth: too few, no accuracy metrics\n",
+                  summary.ground_truth_frames);
+  }
+  PrintRunTable(summary, run_options.out_dir);
+  std::printf("report          %s/report.md\n", run_options.out_dir.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command AddEvalCommand(CLI::App& app) {
+  auto a = std::make_shared<EvalArgs>();
+  CLI::App* eval = app.add_subcommand(
+      "eval",
+      "Run the VO on a recorded stereo sequence (KITTI, EuRoC or TUM-style layout) and, "
+      "where ground truth is present, compute the same metrics as `run`");
+  eval->add_option("--dataset", a->dataset, "Dataset folder")->required();
+  eval->add_option("--format", a->format, "Dataset layout: kitti, euroc or tum")->required();
+  eval->add_option("--gt", a->gt,
+                   "Ground truth, TUM format (t tx ty tz qx qy qz qw): the left camera for "
+                   "kitti/tum, the body/IMU for euroc; for kitti also KITTI poses (12 numbers "
+                   "per line). Default: the dataset's own, if any");
+  eval->add_option("--config", a->config, "VO options (YAML; see a run folder's vo_options.yaml)");
+  eval->add_option("--out,-o", a->out,
+                   "Run folder (default out/eval/<dataset folder name>); an earlier run there is "
+                   "replaced");
+  eval->add_option("--max-frames", a->max_frames, "Stop after N frames (0 = all)")
+      ->check(AtLeast(0));
+  eval->add_option("--max-difference", a->max_difference_s,
+                   "Largest ground-truth to frame time difference associated (s; default 0.02 "
+                   "for kitti and tum, 0.003 for euroc)");
+  eval->add_flag("--no-plots", a->no_plots, "Skip the PNG plots");
+  eval->add_flag("-q,--quiet", a->quiet, "No progress display");
+  return {eval, [a, eval] { return RunEval(*a, eval->count("--max-difference") > 0); }};
+}
+
+}  // namespace harness

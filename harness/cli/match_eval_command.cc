@@ -1,0 +1,183 @@
+#include "harness/cli/match_eval_command.h"
+
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "harness/interrupt.h"
+#include "harness/match_eval.h"
+#include "harness/output_folder.h"
+#include "harness/path_names.h"
+#include "harness/pipeline.h"
+#include "harness/plots/plots.h"
+#include "harness/progress.h"
+#include "harness/render.h"
+#include "harness/trajectory_io.h"
+
+namespace harness {
+namespace {
+
+struct MatchEvalArgs {
+  std::string scenario = "l_hallway";
+  std::string strides = "1,2,3,5,8";
+  std::string matchers;  // "" = all
+  std::string prediction = "motion_prior";
+  std::string out;  // "" = out/match_eval/<scenario>
+  int max_frames = 0;
+  bool quiet = false;
+};
+
+// Comma-separated integers ("1,2,3,5,8").
+bool ParseIntList(const std::string& text, std::vector<int>* out) {
+  out->clear();
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      size_t used = 0;
+      const int v = std::stoi(item, &used);
+      if (used != item.size()) return false;
+      out->push_back(v);
+    } catch (...) {
+      return false;
+    }
+  }
+  return !out->empty();
+}
+
+int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg,
+                 const std::string& matchers_arg, const std::string& prediction_arg,
+                 std::string out, int max_frames, bool quiet) {
+  std::string error;
+  sim::Scenario scenario;
+  if (!ResolveScenario(scenario_arg, &scenario, &error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 2;
+  }
+  MatchEvalOptions options;
+  if (!ParseIntList(strides_arg, &options.strides)) {
+    std::fprintf(stderr,
+                 "vobench match-eval: --strides: expected comma-separated integers, got '%s'\n",
+                 strides_arg.c_str());
+    return 2;
+  }
+  if (!matchers_arg.empty()) {
+    options.matchers.clear();
+    std::stringstream ss(matchers_arg);
+    std::string name;
+    while (std::getline(ss, name, ',')) {
+      vo::MatcherType t;
+      if (!vo::ParseMatcherType(name, &t)) {
+        std::fprintf(stderr,
+                     "vobench match-eval: --matchers: unknown matcher '%s' (svd_proximity, "
+                     "svd_ncc, svd_ncc_gabor, ncc_mutual, lucas_kanade, kalman, sift_ratio)\n",
+                     name.c_str());
+        return 2;
+      }
+      options.matchers.push_back(t);
+    }
+  }
+  if (!vo::ParsePredictionMode(prediction_arg, &options.prediction)) {
+    std::fprintf(stderr,
+                 "vobench match-eval: --prediction: expected none or motion_prior, got '%s'\n",
+                 prediction_arg.c_str());
+    return 2;
+  }
+  if (!options.IsValid(&error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 2;
+  }
+  if (out.empty()) {
+    if (!CheckPathName(scenario.name, "scenario name", &error)) {
+      std::fprintf(stderr, "vobench match-eval: %s (give --out)\n", error.c_str());
+      return 2;
+    }
+    out = "out/match_eval/" + scenario.name;
+  }
+  OutputFolder folder;  // marked and locked now, published when complete
+  if (!folder.Create(out, "match-eval", &error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
+
+  // Simulate the scenario into memory: images, ground-truth depth and poses.
+  StereoSequence sequence;
+  std::vector<DatasetFrame> simulated;
+  if (!OpenScenarioSequence(scenario, &sequence, &error) ||
+      !ReadAllFrames(sequence.next, max_frames, sequence.expected_frames,
+                     "simulate " + scenario.name, !quiet, out, &simulated, &error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
+  std::vector<GroundTruthFrame> frames;
+  for (const DatasetFrame& f : simulated)
+    frames.push_back({f.left, f.right, f.depth_m, f.T_world_cam0});
+  simulated.clear();
+  std::vector<MatchEvalRow> rows;
+  Progress progress("match-eval", 1, !quiet);
+  if (!EvaluateMatchers(frames, sequence.camera, options, &rows, &error, [&](int done, int total) {
+        progress.set_total(total);
+        progress.Update(done);
+      })) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
+  progress.Finish(static_cast<int>(rows.size()));
+  if (InterruptSignal() != 0) {
+    std::fprintf(stderr, "vobench match-eval: %s\n",
+                 InterruptedMessage(static_cast<int>(frames.size()),
+                                    static_cast<int>(frames.size()), "frames", out)
+                     .c_str());
+    return 1;
+  }
+  const std::string work = folder.path(), csv = out + "/match_eval.csv";
+  if (!WriteMatchEvalCsv(work + "/match_eval.csv", rows, &error) ||
+      !WriteTextFile(work + "/scenario.yaml", sim::ScenarioToYaml(scenario), &error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
+  if (!RunPlot({"match-eval", work + "/match_eval.csv", work + "/match_eval.png"}, &error))
+    std::fprintf(stderr, "vobench match-eval: warning: no plot: %s\n", error.c_str());
+  if (!folder.Publish(&error)) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+    return 1;
+  }
+  std::printf("%-14s %6s %6s %8s %8s %9s %7s %7s %9s\n", "matcher", "stride", "pairs", "matches",
+              "correct", "precision", "recall", "F1", "ms/pair");
+  for (const auto& r : rows)
+    std::printf("%-14s %6d %6d %8ld %8ld %9.4f %7.4f %7.4f %9.2f\n", r.matcher.c_str(), r.stride,
+                r.pairs, r.matches, r.correct, r.precision, r.recall, r.f1, r.ms_per_pair);
+  std::printf("wrote %s and %s/match_eval.png\n", csv.c_str(), out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command AddMatchEvalCommand(CLI::App& app) {
+  auto a = std::make_shared<MatchEvalArgs>();
+  CLI::App* match_eval = app.add_subcommand(
+      "match-eval", "Matcher precision/recall/F1 per stride against the simulator's ground truth");
+  match_eval->add_option("scenario", a->scenario, "Scenario YAML file or built-in name")
+      ->capture_default_str();
+  match_eval->add_option("--strides", a->strides, "Frame strides, comma-separated")
+      ->capture_default_str();
+  match_eval->add_option("--matchers", a->matchers,
+                         "Matchers, comma-separated (default: all seven)");
+  match_eval
+      ->add_option("--prediction", a->prediction,
+                   "Search centre of every matcher: motion_prior (constant velocity from the "
+                   "previous pair's ground truth, as the VO predicts) or none (the paper's form)")
+      ->capture_default_str();
+  match_eval->add_option("--out,-o", a->out, "Output folder (default out/match_eval/<scenario>)");
+  match_eval->add_option("--max-frames", a->max_frames, "Use only the first N frames (0 = all)")
+      ->check(AtLeast(0));
+  match_eval->add_flag("-q,--quiet", a->quiet, "No progress display");
+  return {match_eval, [a] {
+            return RunMatchEval(a->scenario, a->strides, a->matchers, a->prediction, a->out,
+                                a->max_frames, a->quiet);
+          }};
+}
+
+}  // namespace harness
