@@ -14,8 +14,9 @@
 //       }, ...
 //     }
 //   }
-// Only accuracy metrics are checked (CheckedMetrics() of the metric registry), never timing. Tolerances may be edited
-// by hand; --update keeps the rule (relative, absolute) of the existing file.
+// Only accuracy metrics are checked (CheckedMetrics() of the metric registry), never timing.
+// Tolerances may be edited by hand; --update keeps the rule (relative, absolute) of the existing
+// file.
 #pragma once
 
 #include <map>

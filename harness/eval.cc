@@ -72,7 +72,7 @@ bool OpenKitti(const std::string& dir, const EvalOptions& options, StereoSequenc
   sequence->camera = reader->camera();
   sequence->expected_frames = static_cast<int>(reader->size());
   sequence->next = [reader, external, gt_index, next = size_t{0}](DatasetFrame* frame,
-                                                                   std::string* err) mutable {
+                                                                  std::string* err) mutable {
     if (next >= reader->size()) return false;
     const size_t i = next++;
     if (!reader->ReadFrame(i, frame, err)) return false;

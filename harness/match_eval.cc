@@ -88,8 +88,8 @@ bool ProjectGroundTruth(const vo::StereoCamera& camera, const GroundTruthFrame& 
 }
 
 bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::StereoCamera& camera,
-                      const MatchEvalOptions& o, std::vector<MatchEvalRow>* rows, std::string* error,
-                      const std::function<void(int, int)>& progress) {
+                      const MatchEvalOptions& o, std::vector<MatchEvalRow>* rows,
+                      std::string* error, const std::function<void(int, int)>& progress) {
   if (!o.IsValid(error)) return false;
   if (frames.size() < 2) {
     *error = "need at least 2 frames";
@@ -100,7 +100,8 @@ bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::Ste
   bool need_sift = false;
   for (auto m : o.matchers) need_sift |= m == vo::MatcherType::kSiftRatio;
   int total = static_cast<int>(frames.size()) * (need_sift ? 2 : 1);
-  for (int s : o.strides) total += static_cast<int>(o.matchers.size()) * static_cast<int>((frames.size() - 1) / s);
+  for (int s : o.strides)
+    total += static_cast<int>(o.matchers.size()) * static_cast<int>((frames.size() - 1) / s);
   int done = 0;
   vo::DisparityEstimator disparity(o.disparity);
   for (int pass = 0; pass < (need_sift ? 2 : 1); ++pass) {
@@ -111,7 +112,9 @@ bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::Ste
     std::vector<FrameFeatures>& out = pass == 0 ? harris : sift;
     out.resize(frames.size());
     for (size_t k = 0; k < frames.size(); ++k) {
-      if (!Prepare(frames[k], static_cast<int64_t>(k), detector.get(), &disparity, camera, o, &out[k], error)) return false;
+      if (!Prepare(frames[k], static_cast<int64_t>(k), detector.get(), &disparity, camera, o,
+                   &out[k], error))
+        return false;
       if (progress) progress(++done, total);
     }
   }
@@ -137,18 +140,23 @@ bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::Ste
           prediction.radius_scale = o.prediction_radius_scale;
           const Eigen::Isometry3d T_ref_curr =
               frames[k - s].T_world_cam0.inverse() * frames[k].T_world_cam0;
-          prediction.uv_px = vo::PredictFeaturePositions(camera, a.frame.features, T_ref_curr, 1e-6);
+          prediction.uv_px =
+              vo::PredictFeaturePositions(camera, a.frame.features, T_ref_curr, 1e-6);
         }
         const auto t0 = std::chrono::steady_clock::now();
         const std::vector<vo::Match> matches = matcher->MatchFrames(a.frame, b.frame, prediction);
-        ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                  .count();
         // Ground-truth position in frame k+s of each evaluated feature of frame k.
         std::vector<Eigen::Vector2d> gt(a.frame.features.size());
         std::vector<int> status(a.frame.features.size(), 0);  // 0 left out, 1 invisible, 2 visible
         for (size_t i = 0; i < a.frame.features.size(); ++i) {
           if (a.gt_depth[i] <= 0) continue;
-          status[i] = ProjectGroundTruth(camera, frames[k], frames[k + s], a.frame.features[i].uv_px,
-                                         a.gt_depth[i], o.depth_agree_rel, &gt[i]) ? 2 : 1;
+          status[i] =
+              ProjectGroundTruth(camera, frames[k], frames[k + s], a.frame.features[i].uv_px,
+                                 a.gt_depth[i], o.depth_agree_rel, &gt[i])
+                  ? 2
+                  : 1;
           if (status[i] == 2) {
             for (const auto& f : b.frame.features)
               if ((f.uv_px - gt[i]).norm() <= o.correct_px) {
@@ -160,14 +168,18 @@ bool EvaluateMatchers(const std::vector<GroundTruthFrame>& frames, const vo::Ste
         for (const vo::Match& m : matches) {
           if (status[m.prev] == 0) continue;
           ++row.matches;
-          if (status[m.prev] == 2 && (b.frame.features[m.curr].uv_px - gt[m.prev]).norm() <= o.correct_px) ++row.correct;
+          if (status[m.prev] == 2 &&
+              (b.frame.features[m.curr].uv_px - gt[m.prev]).norm() <= o.correct_px)
+            ++row.correct;
         }
         ++row.pairs;
         if (progress) progress(++done, total);
       }
       row.precision = row.matches > 0 ? static_cast<double>(row.correct) / row.matches : 0.0;
       row.recall = row.possible > 0 ? static_cast<double>(row.correct) / row.possible : 0.0;
-      row.f1 = row.precision + row.recall > 0 ? 2 * row.precision * row.recall / (row.precision + row.recall) : 0.0;
+      row.f1 = row.precision + row.recall > 0
+                   ? 2 * row.precision * row.recall / (row.precision + row.recall)
+                   : 0.0;
       row.ms_per_pair = row.pairs > 0 ? ms / row.pairs : 0.0;
       rows->push_back(row);
     }
@@ -206,13 +218,15 @@ void AccumulateVoMatchStats(const vo::StereoCamera& camera, const GroundTruthFra
   stats->frames += any;
 }
 
-bool WriteMatchEvalCsv(const std::string& path, const std::vector<MatchEvalRow>& rows, std::string* error) {
+bool WriteMatchEvalCsv(const std::string& path, const std::vector<MatchEvalRow>& rows,
+                       std::string* error) {
   std::ostringstream out;
   out << "matcher,stride,pairs,matches,correct,possible,precision,recall,f1,ms_per_pair\n";
   char buf[256];
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof(buf), "%s,%d,%d,%ld,%ld,%ld,%.4f,%.4f,%.4f,%.3f\n", r.matcher.c_str(), r.stride,
-                  r.pairs, r.matches, r.correct, r.possible, r.precision, r.recall, r.f1, r.ms_per_pair);
+    std::snprintf(buf, sizeof(buf), "%s,%d,%d,%ld,%ld,%ld,%.4f,%.4f,%.4f,%.3f\n", r.matcher.c_str(),
+                  r.stride, r.pairs, r.matches, r.correct, r.possible, r.precision, r.recall, r.f1,
+                  r.ms_per_pair);
     out << buf;
   }
   return WriteTextFile(path, out.str(), error);

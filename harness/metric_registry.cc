@@ -24,9 +24,9 @@ MetricInfo Metric(std::string key, std::string unit, Better better, MetricGroup 
 // by `check` when `tolerance` >= 0.
 MetricInfo Accuracy(std::string key, std::string unit, std::string meaning,
                     double TrajectoryMetrics::*field, double tolerance = -1.0) {
-  MetricInfo m = Metric(std::move(key), std::move(unit), Better::kLower, MetricGroup::kAccuracy,
-                        std::move(meaning),
-                        [field](const RunSummary& s) { return json(s.metrics.*field); });
+  MetricInfo m =
+      Metric(std::move(key), std::move(unit), Better::kLower, MetricGroup::kAccuracy,
+             std::move(meaning), [field](const RunSummary& s) { return json(s.metrics.*field); });
   m.tune_objective = true;
   m.check_tolerance = tolerance;
   return m;
@@ -40,12 +40,12 @@ MetricInfo Checked(MetricInfo m, double tolerance) {
 
 // The median time of a pipeline stage (the keys of RunSummary::stage_ms_median).
 MetricInfo StageMedian(const std::string& stage, const std::string& what) {
-  MetricInfo m = Metric("stage_ms_median." + stage, "ms", Better::kLower, MetricGroup::kTiming,
-                        "median time per frame of the " + what + " stage",
-                        [stage](const RunSummary& s) {
-                          const auto it = s.stage_ms_median.find(stage);
-                          return it == s.stage_ms_median.end() ? json(0.0) : json(it->second);
-                        });
+  MetricInfo m =
+      Metric("stage_ms_median." + stage, "ms", Better::kLower, MetricGroup::kTiming,
+             "median time per frame of the " + what + " stage", [stage](const RunSummary& s) {
+               const auto it = s.stage_ms_median.find(stage);
+               return it == s.stage_ms_median.end() ? json(0.0) : json(it->second);
+             });
   return m;
 }
 
@@ -57,8 +57,7 @@ std::vector<MetricInfo> MakeRegistry() {
       Metric("frames", "frames", kNeither, kRun,
              "frames the VO saw from its first initialised one (after the frame stride)",
              [](const RunSummary& s) { return json(s.metrics.frames); }),
-      Metric("frame_stride", "frames", kNeither, kRun,
-             "the VO saw every k-th frame of the source",
+      Metric("frame_stride", "frames", kNeither, kRun, "the VO saw every k-th frame of the source",
              [](const RunSummary& s) { return json(s.frame_stride); }),
       Metric("has_ground_truth", "", kNeither, kRun,
              "at least 2 frames had a ground-truth pose (the accuracy metrics are written)",
@@ -92,9 +91,10 @@ std::vector<MetricInfo> MakeRegistry() {
       Accuracy("rpe_distance_rot_rmse_deg", "deg",
                "relative pose error over rpe_distance_step_m of path: rotation RMSE",
                &M::rpe_distance_rot_rmse_deg),
-      Metric("rpe_distance_pairs", "", kNeither, kAcc,
-             "frame pairs the rpe_distance_* metrics averaged (0: the path is shorter than the step)",
-             [](const RunSummary& s) { return json(s.metrics.rpe_distance_pairs); }),
+      Metric(
+          "rpe_distance_pairs", "", kNeither, kAcc,
+          "frame pairs the rpe_distance_* metrics averaged (0: the path is shorter than the step)",
+          [](const RunSummary& s) { return json(s.metrics.rpe_distance_pairs); }),
       Accuracy("drift_pct", "%",
                "KITTI-style translation drift, sub-paths of 1/8 ... 8/8 of the path, averaged",
                &M::drift_pct, 0.25),

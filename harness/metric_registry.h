@@ -5,10 +5,9 @@
 #pragma once
 
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "harness/pipeline.h"
 
@@ -28,15 +27,15 @@ enum class MetricGroup {
 };
 
 struct MetricInfo {
-  std::string key;      // metrics.json key; "a.b" is nested ({"a": {"b": ...}}) in metrics.json
-                        // and the column "a.b" in summary.csv
-  std::string unit;     // "m", "%", "deg", "deg/m", "mm", "ms", "frames", "" (a ratio or flag)
+  std::string key;   // metrics.json key; "a.b" is nested ({"a": {"b": ...}}) in metrics.json
+                     // and the column "a.b" in summary.csv
+  std::string unit;  // "m", "%", "deg", "deg/m", "mm", "ms", "frames", "" (a ratio or flag)
   Better better = Better::kNeither;
   MetricGroup group = MetricGroup::kRun;
-  std::string meaning;  // how to read it, one line (messages, the README)
-  std::string label;    // short axis label of plots ("" = key and unit, see PlotLabel)
-  bool csv = true;             // a column of the suite's summary.csv
-  bool tune_objective = false;  // may be `tune`'s objective.metric
+  std::string meaning;            // how to read it, one line (messages, the README)
+  std::string label;              // short axis label of plots ("" = key and unit, see PlotLabel)
+  bool csv = true;                // a column of the suite's summary.csv
+  bool tune_objective = false;    // may be `tune`'s objective.metric
   double check_tolerance = -1.0;  // >= 0: compared by `vobench check`, with this absolute
                                   // tolerance floor (in the metric's unit)
   std::function<nlohmann::ordered_json(const RunSummary&)> value;  // the value of a run

@@ -1,16 +1,16 @@
 #include "harness/metrics.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Geometry>
 
 namespace harness {
 
 double RotationAngle(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
   const Eigen::Matrix3d R = R_a.transpose() * R_b;
   const double c = (R.trace() - 1.0) / 2.0;
-  const double s = 0.5 * Eigen::Vector3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1)).norm();
+  const double s =
+      0.5 * Eigen::Vector3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1)).norm();
   return std::atan2(s, c);
 }
 
@@ -57,8 +57,10 @@ TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>&
   const size_t n = std::min(estimate.size(), ground_truth.size());
   m.frames = static_cast<int>(n);
   if (n < 2) return m;
-  const std::vector<Eigen::Isometry3d> est = RelativeToFirst({estimate.begin(), estimate.begin() + n});
-  const std::vector<Eigen::Isometry3d> gt = RelativeToFirst({ground_truth.begin(), ground_truth.begin() + n});
+  const std::vector<Eigen::Isometry3d> est =
+      RelativeToFirst({estimate.begin(), estimate.begin() + n});
+  const std::vector<Eigen::Isometry3d> gt =
+      RelativeToFirst({ground_truth.begin(), ground_truth.begin() + n});
   const std::vector<double> dist = CumulativeDistance(gt);
   m.path_length_m = dist.back();
 
@@ -75,7 +77,8 @@ TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>&
   }
   m.ate_rmse_unaligned_m = std::sqrt((P_est - P_gt).colwise().squaredNorm().mean());
   const Eigen::Matrix4d S = Eigen::umeyama(P_est, P_gt, false);
-  const Eigen::Matrix3Xd aligned = (S.topLeftCorner<3, 3>() * P_est).colwise() + S.topRightCorner<3, 1>();
+  const Eigen::Matrix3Xd aligned =
+      (S.topLeftCorner<3, 3>() * P_est).colwise() + S.topRightCorner<3, 1>();
   m.ate_rmse_m = std::sqrt((aligned - P_gt).colwise().squaredNorm().mean());
 
   // RPE over one frame step.

@@ -36,8 +36,8 @@ bool NestInto(const YAML::Node& overrides, const std::string& prefix,
     for (size_t i = 0; i + 1 < parts.size(); ++i) {
       YAML::Node child = node[parts[i]];
       if (child.IsDefined() && !child.IsMap()) {
-        *error = source_name + ": override key '" + prefix + key + "' conflicts with '" +
-                 parts[i] + "' given as a value";
+        *error = source_name + ": override key '" + prefix + key + "' conflicts with '" + parts[i] +
+                 "' given as a value";
         return false;
       }
       if (!child.IsDefined()) node[parts[i]] = YAML::Node(YAML::NodeType::Map);
@@ -66,8 +66,8 @@ bool NestInto(const YAML::Node& overrides, const std::string& prefix,
 
 }  // namespace
 
-bool NestDottedKeys(const YAML::Node& overrides, const std::string& source_name,
-                    YAML::Node* nested, std::string* error) {
+bool NestDottedKeys(const YAML::Node& overrides, const std::string& source_name, YAML::Node* nested,
+                    std::string* error) {
   *nested = YAML::Node(YAML::NodeType::Map);
   if (!overrides.IsDefined() || overrides.IsNull()) return true;
   if (!overrides.IsMap()) {
@@ -99,12 +99,12 @@ bool ApplyScenarioOverrides(const sim::Scenario& base, const YAML::Node& overrid
   YAML::Emitter out;
   out << doc;
   // ScenarioToYaml writes the scene as an absolute path, so no base folder is needed.
-  const std::string base_dir =
-      base.source_path.empty() ? std::string(".")
-                               : std::filesystem::path(base.source_path).parent_path().string();
+  const std::string base_dir = base.source_path.empty()
+                                   ? std::string(".")
+                                   : std::filesystem::path(base.source_path).parent_path().string();
   sim::Scenario result;
-  if (!sim::ParseScenario(out.c_str(), source_name + " (overrides of " + base.name + ")",
-                          base_dir, &result, error)) {
+  if (!sim::ParseScenario(out.c_str(), source_name + " (overrides of " + base.name + ")", base_dir,
+                          &result, error)) {
     return false;
   }
   result.source_path = base.source_path;

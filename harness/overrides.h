@@ -4,9 +4,9 @@
 // by the strict readers, so an unknown key or a bad value is refused with its name.
 #pragma once
 
-#include <string>
-
 #include <yaml-cpp/yaml.h>
+
+#include <string>
 
 #include "sim/scenario.h"
 #include "vo/odometry.h"
@@ -16,8 +16,8 @@ namespace harness {
 // Turns dotted keys into nested maps ("a.b: 1" -> {a: {b: 1}}), recursively; nested maps and
 // dotted keys may be mixed. Fails (with `source_name` in the message) on a non-map input, an
 // empty path component, or a key given twice.
-bool NestDottedKeys(const YAML::Node& overrides, const std::string& source_name,
-                    YAML::Node* nested, std::string* error);
+bool NestDottedKeys(const YAML::Node& overrides, const std::string& source_name, YAML::Node* nested,
+                    std::string* error);
 
 // Deep-merges `overrides` (nested maps) onto `base`: maps merge key by key, anything else
 // replaces the base's value.

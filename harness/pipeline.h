@@ -93,8 +93,8 @@ size_t FirstInitialisedFrame(const RunRecords& records);
 struct RunSummary {
   std::string name;
   TrajectoryMetrics metrics;
-  int lost_frames = 0;        // frames without a measured motion (vo::IsLostFrame)
-  int reinitialisations = 0;  // of those, frames the VO re-initialised on
+  int lost_frames = 0;             // frames without a measured motion (vo::IsLostFrame)
+  int reinitialisations = 0;       // of those, frames the VO re-initialised on
   int frames_not_initialised = 0;  // frames before the first one the VO initialised on: no
                                    // pose, not in the trajectories, metrics or lost_frames
   double vo_ms_median = 0.0;
@@ -106,9 +106,9 @@ struct RunSummary {
   double initial_orientation_error_deg = -1.0;  // vs ground truth; < 0 when not known
   bool has_ground_truth = false;  // at least 2 frames with ground truth: the metrics are set
   int ground_truth_frames = 0;    // frames with a ground-truth pose; the metrics use these only
-  VoMatchStats match_stats;  // the VO's matches against the ground truth (simulated runs and
-                             // datasets with depth); matches == 0 when not available
-  int frame_stride = 1;  // RunFramesOptions::frame_stride of the run
+  VoMatchStats match_stats;       // the VO's matches against the ground truth (simulated runs and
+                                  // datasets with depth); matches == 0 when not available
+  int frame_stride = 1;           // RunFramesOptions::frame_stride of the run
 };
 
 // The summary of a run: trajectory metrics over the frames with ground truth from the first

@@ -85,8 +85,10 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
   summary->gl_renderer = simulator->gl_renderer();
   const auto& track = simulator->body_track();
   summary->path_length_m = 0.0;
-  for (size_t i = 1; i < track.size(); ++i) summary->path_length_m += (track[i] - track[i - 1]).head<2>().norm();
-  summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (size_t i = 1; i < track.size(); ++i)
+    summary->path_length_m += (track[i] - track[i - 1]).head<2>().norm();
+  summary->wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary->frames_per_s = summary->wall_time_s > 0 ? n / summary->wall_time_s : 0.0;
   return true;
 }

@@ -22,17 +22,18 @@ DatasetFrame ToDatasetFrame(const sim::StereoFrame& frame);
 
 struct RenderSummary {
   int frames = 0;
-  double sim_time_s = 0.0;       // time of the last frame (s)
-  double path_length_m = 0.0;    // length of the robot base's track (m)
-  double wall_time_s = 0.0;      // rendering + writing wall time (s)
-  double frames_per_s = 0.0;     // stereo frames (with depth) rendered and written per second
+  double sim_time_s = 0.0;     // time of the last frame (s)
+  double path_length_m = 0.0;  // length of the robot base's track (m)
+  double wall_time_s = 0.0;    // rendering + writing wall time (s)
+  double frames_per_s = 0.0;   // stereo frames (with depth) rendered and written per second
   std::string gl_renderer;
 };
 
 struct RenderOptions {
-  DatasetFormat format = DatasetFormat::kKitti;  // kEuroc / kTum also write the mav0/ / TUM-style layout
-  bool overwrite = false;                        // replace an existing output folder
-  bool progress = true;                          // progress line on stderr
+  DatasetFormat format =
+      DatasetFormat::kKitti;  // kEuroc / kTum also write the mav0/ / TUM-style layout
+  bool overwrite = false;     // replace an existing output folder
+  bool progress = true;       // progress line on stderr
 };
 
 // Renders `scenario` into `out_dir` (atomically: nothing is left at out_dir on failure).

@@ -6,8 +6,9 @@
 namespace harness {
 
 bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameSource source,
-                 int expected_frames, const vo::OdometryOptions& vo_options, const RunOptions& options,
-                 const std::string& scenario_yaml, RunSummary* summary, std::string* error) {
+                 int expected_frames, const vo::OdometryOptions& vo_options,
+                 const RunOptions& options, const std::string& scenario_yaml, RunSummary* summary,
+                 std::string* error) {
   RunFramesOptions frames_options;
   frames_options.max_frames = options.max_frames;
   frames_options.frame_stride = options.frame_stride;
@@ -49,8 +50,8 @@ bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_op
          RunSequence(sequence, vo_options, options, summary, error);
 }
 
-bool RunKittiDataset(const std::string& dir, const vo::OdometryOptions& vo_options, const RunOptions& options,
-                     RunSummary* summary, std::string* error) {
+bool RunKittiDataset(const std::string& dir, const vo::OdometryOptions& vo_options,
+                     const RunOptions& options, RunSummary* summary, std::string* error) {
   EvalOptions kitti;  // the KITTI layout with its own poses.txt, if any
   EvalInfo info;
   StereoSequence sequence;

@@ -14,7 +14,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<StampedPose> Stamped(const std::vector<double>& t, const std::vector<Eigen::Isometry3d>& T) {
+std::vector<StampedPose> Stamped(const std::vector<double>& t,
+                                 const std::vector<Eigen::Isometry3d>& T) {
   std::vector<StampedPose> out;
   for (size_t i = 0; i < T.size(); ++i) out.push_back({t[i], T[i]});
   return out;
@@ -38,28 +39,42 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
     << (s.has_ground_truth ? " (the metrics below use these)" : " (no accuracy metrics)") << " |\n";
   if (s.has_ground_truth) {
     r << "| path length (ground truth) | " << Fmt(m.path_length_m, 3) << " m |\n";
-    r << "| end-pose error | " << Fmt(m.end_pose_error_m) << " m (" << Fmt(m.end_pose_error_pct, 2) << " % of the path) |\n";
+    r << "| end-pose error | " << Fmt(m.end_pose_error_m) << " m (" << Fmt(m.end_pose_error_pct, 2)
+      << " % of the path) |\n";
     r << "| end rotation error | " << Fmt(m.end_rotation_error_deg, 3) << " deg |\n";
     r << "| ATE RMSE (SE(3)-aligned) | " << Fmt(m.ate_rmse_m) << " m |\n";
     r << "| ATE RMSE (from the common start) | " << Fmt(m.ate_rmse_unaligned_m) << " m |\n";
-    r << "| RPE per frame (translation / rotation) | " << Fmt(m.rpe_trans_rmse_m * 1000, 2) << " mm / " << Fmt(m.rpe_rot_rmse_deg, 4) << " deg |\n";
+    r << "| RPE per frame (translation / rotation) | " << Fmt(m.rpe_trans_rmse_m * 1000, 2)
+      << " mm / " << Fmt(m.rpe_rot_rmse_deg, 4) << " deg |\n";
     if (s.match_stats.matches > 0)
-      r << "| VO matches correct (all / RANSAC inliers), vs ground truth | " << Fmt(100.0 * s.match_stats.precision(), 2) << " % / " << Fmt(100.0 * s.match_stats.inlier_precision(), 2) << " % of " << s.match_stats.matches << " |\n";
-    r << "| RPE per " << Fmt(m.rpe_distance_step_m, 1) << " m (translation / rotation) | " << Fmt(m.rpe_distance_trans_rmse_m * 1000, 1) << " mm / " << Fmt(m.rpe_distance_rot_rmse_deg, 3) << " deg |\n";
-    r << "| drift (KITTI-style, 1/8..8/8 of the path) | " << Fmt(m.drift_pct, 3) << " % / " << Fmt(m.drift_deg_per_m, 4) << " deg/m |\n";
+      r << "| VO matches correct (all / RANSAC inliers), vs ground truth | "
+        << Fmt(100.0 * s.match_stats.precision(), 2) << " % / "
+        << Fmt(100.0 * s.match_stats.inlier_precision(), 2) << " % of " << s.match_stats.matches
+        << " |\n";
+    r << "| RPE per " << Fmt(m.rpe_distance_step_m, 1) << " m (translation / rotation) | "
+      << Fmt(m.rpe_distance_trans_rmse_m * 1000, 1) << " mm / "
+      << Fmt(m.rpe_distance_rot_rmse_deg, 3) << " deg |\n";
+    r << "| drift (KITTI-style, 1/8..8/8 of the path) | " << Fmt(m.drift_pct, 3) << " % / "
+      << Fmt(m.drift_deg_per_m, 4) << " deg/m |\n";
     if (s.initial_orientation_error_deg >= 0)
-      r << "| initial orientation from planes (error vs GT) | " << (s.initial_orientation_ok ? "found" : "not found") << ", " << Fmt(s.initial_orientation_error_deg, 2) << " deg |\n";
+      r << "| initial orientation from planes (error vs GT) | "
+        << (s.initial_orientation_ok ? "found" : "not found") << ", "
+        << Fmt(s.initial_orientation_error_deg, 2) << " deg |\n";
   }
   r << "| lost frames (no measured motion) / re-initialisations | " << s.lost_frames << " / "
     << s.reinitialisations << " |\n";
   if (s.frames_not_initialised > 0) {
-    r << "| frames before the VO initialised (no pose, not evaluated) | " << s.frames_not_initialised
-      << " |\n";
+    r << "| frames before the VO initialised (no pose, not evaluated) | "
+      << s.frames_not_initialised << " |\n";
   }
-  r << "| VO time per frame, median / p95 | " << Fmt(s.vo_ms_median, 2) << " / " << Fmt(s.vo_ms_p95, 2) << " ms |\n";
-  for (const auto& [k, v] : s.stage_ms_median) r << "| stage median: " << k << " | " << Fmt(v, 2) << " ms |\n";
+  r << "| VO time per frame, median / p95 | " << Fmt(s.vo_ms_median, 2) << " / "
+    << Fmt(s.vo_ms_p95, 2) << " ms |\n";
+  for (const auto& [k, v] : s.stage_ms_median)
+    r << "| stage median: " << k << " | " << Fmt(v, 2) << " ms |\n";
   r << "\n![trajectory](trajectory.png)\n\n![errors](errors.png)\n\n![timing](timing.png)\n\n";
-  r << "Effective VO options (`vobench run --config` accepts this file as `vo_options.yaml`):\n\n```yaml\n" << options_yaml << "```\n";
+  r << "Effective VO options (`vobench run --config` accepts this file as "
+       "`vo_options.yaml`):\n\n```yaml\n"
+    << options_yaml << "```\n";
   return r.str();
 }
 
@@ -116,26 +131,32 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
     }
   }
   std::ostringstream csv;
-  csv << "frame,time_s,status,features,features_with_depth,matches,inliers,rms_reprojection_px,ba_ran,"
-         "disparity_ms,detect_ms,depth_ms,match_ms,motion_ms,ba_ms,total_ms,x_m,y_m,z_m,gt_distance_m,"
+  csv << "frame,time_s,status,features,features_with_depth,matches,inliers,rms_reprojection_px,ba_"
+         "ran,"
+         "disparity_ms,detect_ms,depth_ms,match_ms,motion_ms,ba_ms,total_ms,x_m,y_m,z_m,gt_"
+         "distance_m,"
          "translation_error_m,rotation_error_deg,motion_measured,reinitialised,prediction,"
-         "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_disparities,"
+         "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_"
+         "disparities,"
          "disparity_pixels\n";
   // One row per frame; frames before the first initialised one have no pose and no error.
   const double kNan = std::nan("");
-  auto row = [&](size_t frame, double time_s, const std::string& status, const vo::OdometryResult& r,
-                 const Eigen::Vector3d& p, double dist_m, double te, double re) {
+  auto row = [&](size_t frame, double time_s, const std::string& status,
+                 const vo::OdometryResult& r, const Eigen::Vector3d& p, double dist_m, double te,
+                 double re) {
     csv << frame << "," << FormatDouble(time_s) << "," << status << "," << r.num_features << ","
-        << r.num_features_with_depth << "," << r.num_matches << "," << r.num_inliers << "," << Fmt(r.rms_reprojection_px)
-        << "," << (r.ba_ran ? 1 : 0) << "," << Fmt(r.times.disparity_ms, 3) << "," << Fmt(r.times.detect_ms, 3) << ","
-        << Fmt(r.times.depth_ms, 3) << "," << Fmt(r.times.match_ms, 3) << "," << Fmt(r.times.motion_ms, 3) << ","
-        << Fmt(r.times.ba_ms, 3) << "," << Fmt(r.times.total_ms, 3) << "," << FormatDouble(p.x()) << ","
-        << FormatDouble(p.y()) << "," << FormatDouble(p.z()) << "," << Fmt(dist_m) << ","
-        << Fmt(te, 6) << "," << Fmt(re, 5) << "," << (r.motion_measured ? 1 : 0) << ","
-        << (r.reinitialised ? 1 : 0) << "," << vo::ToString(r.prediction) << "," << r.num_first_pass_inliers
-        << "," << Fmt(r.image_shift_px.x(), 2) << "," << Fmt(r.image_shift_px.y(), 2) << ","
-        << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << "," << r.num_disparities << ","
-        << r.disparity_pixels << "\n";
+        << r.num_features_with_depth << "," << r.num_matches << "," << r.num_inliers << ","
+        << Fmt(r.rms_reprojection_px) << "," << (r.ba_ran ? 1 : 0) << ","
+        << Fmt(r.times.disparity_ms, 3) << "," << Fmt(r.times.detect_ms, 3) << ","
+        << Fmt(r.times.depth_ms, 3) << "," << Fmt(r.times.match_ms, 3) << ","
+        << Fmt(r.times.motion_ms, 3) << "," << Fmt(r.times.ba_ms, 3) << ","
+        << Fmt(r.times.total_ms, 3) << "," << FormatDouble(p.x()) << "," << FormatDouble(p.y())
+        << "," << FormatDouble(p.z()) << "," << Fmt(dist_m) << "," << Fmt(te, 6) << ","
+        << Fmt(re, 5) << "," << (r.motion_measured ? 1 : 0) << "," << (r.reinitialised ? 1 : 0)
+        << "," << vo::ToString(r.prediction) << "," << r.num_first_pass_inliers << ","
+        << Fmt(r.image_shift_px.x(), 2) << "," << Fmt(r.image_shift_px.y(), 2) << ","
+        << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << ","
+        << r.num_disparities << "," << r.disparity_pixels << "\n";
   };
   for (size_t i = 0; i < first; ++i) {
     const vo::OdometryResult& r = records.frames[i].result;
@@ -152,9 +173,9 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
 }  // namespace
 
 std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary) {
-  return PerFrameCsv(records, summary,
-                     InitialisedTrajectories(records,
-                                             static_cast<size_t>(summary.frames_not_initialised)));
+  return PerFrameCsv(
+      records, summary,
+      InitialisedTrajectories(records, static_cast<size_t>(summary.frames_not_initialised)));
 }
 
 bool OpenRunFolder(const std::string& dir, OutputFolder* folder, std::string* error) {
@@ -175,10 +196,12 @@ void MakePlots(const std::string& folder, bool has_ground_truth, const std::stri
   if (!ok) std::fprintf(stderr, "warning: plots not made: %s\n", plot_error.c_str());
 }
 
-bool WriteRunFolder(const RunRecords& records, const RunSummary& s, const RunFolderContents& contents,
-                    const std::string& dir, OutputFolder* folder, std::string* error) {
+bool WriteRunFolder(const RunRecords& records, const RunSummary& s,
+                    const RunFolderContents& contents, const std::string& dir, OutputFolder* folder,
+                    std::string* error) {
   const fs::path p = folder->path();
-  const Trajectories t = InitialisedTrajectories(records, static_cast<size_t>(s.frames_not_initialised));
+  const Trajectories t =
+      InitialisedTrajectories(records, static_cast<size_t>(s.frames_not_initialised));
   if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(t.times, t.est), error) ||
       !WriteKittiPoses((p / "trajectory_kitti.txt").string(), t.est, error) ||
       !WriteTextFile((p / "per_frame.csv").string(), PerFrameCsv(records, s, t), error) ||
@@ -199,8 +222,8 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s, const RunFol
     const bool all_gt = t.gt_frames.size() == t.times.size();
     if (!WriteTum((p / "groundtruth_tum.txt").string(), Stamped(times_at_gt, gt_at_gt), error) ||
         (all_gt && !WriteKittiPoses((p / "groundtruth_kitti.txt").string(), t.gt, error)) ||
-        !WriteTum((p / "estimate_in_gt_world_tum.txt").string(), Stamped(t.times, AnchoredEstimate(t)),
-                  error))
+        !WriteTum((p / "estimate_in_gt_world_tum.txt").string(),
+                  Stamped(t.times, AnchoredEstimate(t)), error))
       return false;
   }
   if (contents.plots) MakePlots(p.string(), s.has_ground_truth, contents.outline_scene);

@@ -20,8 +20,8 @@
 #include <string>
 
 #include "harness/metric_registry.h"  // MetricsJson
-#include "harness/pipeline.h"
 #include "harness/output_folder.h"
+#include "harness/pipeline.h"
 #include "harness/trajectory_io.h"
 
 namespace harness {
@@ -41,8 +41,8 @@ bool OpenRunFolder(const std::string& dir, OutputFolder* folder, std::string* er
 // Writes every file of the run into `folder` (opened by OpenRunFolder), makes the plots and
 // publishes it as DIR. Nothing is published on an error or an interrupt.
 bool WriteRunFolder(const RunRecords& records, const RunSummary& summary,
-                    const RunFolderContents& contents, const std::string& dir,
-                    OutputFolder* folder, std::string* error);
+                    const RunFolderContents& contents, const std::string& dir, OutputFolder* folder,
+                    std::string* error);
 
 // The plots of a written run folder (trajectory.png and errors.png with ground truth,
 // timing.png); a missing python3-matplotlib gives a warning on stderr, not an error.

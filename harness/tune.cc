@@ -1,7 +1,5 @@
 #include "harness/tune.h"
 
-#include "harness/plots/plots.h"
-
 #include <sys/wait.h>
 #include <yaml-cpp/yaml.h>
 
@@ -21,6 +19,7 @@
 #include "harness/overrides.h"
 #include "harness/path_names.h"
 #include "harness/pipeline.h"
+#include "harness/plots/plots.h"
 #include "harness/progress.h"
 #include "harness/render.h"
 #include "harness/trajectory_io.h"
@@ -558,8 +557,7 @@ bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
 bool LoadTuneSpec(const std::string& path, TuneSpec* spec, std::string* error) {
   std::string text;
   if (!sim::ReadInputFile(path, "YAML tune file", &text, error)) return false;
-  if (!ParseTuneSpec(text, path, fs::path(path).parent_path().string(), spec, error))
-    return false;
+  if (!ParseTuneSpec(text, path, fs::path(path).parent_path().string(), spec, error)) return false;
   spec->source_path = path;
   return true;
 }

@@ -5,7 +5,6 @@
 #pragma once
 
 #include <cstdint>
-
 #include <opencv2/core.hpp>
 
 #include "sim/scenario.h"

@@ -6,11 +6,11 @@
 namespace sim {
 namespace {
 
-constexpr double kTurnDoneRad = 0.004;     // heading error that ends an in-place turn (rad)
-constexpr double kMinTurnRateRadps = 0.08; // slowest commanded turn: overcomes wheel friction
-constexpr double kTurnGain = 3.0;          // yaw-rate command per rad of heading error (1/s)
-constexpr double kAngularAccel = 1.5;      // yaw acceleration limit (rad/s²)
-constexpr double kCreepSpeed = 0.02;       // minimum speed while approaching a stop (m/s)
+constexpr double kTurnDoneRad = 0.004;      // heading error that ends an in-place turn (rad)
+constexpr double kMinTurnRateRadps = 0.08;  // slowest commanded turn: overcomes wheel friction
+constexpr double kTurnGain = 3.0;           // yaw-rate command per rad of heading error (1/s)
+constexpr double kAngularAccel = 1.5;       // yaw acceleration limit (rad/s²)
+constexpr double kCreepSpeed = 0.02;        // minimum speed while approaching a stop (m/s)
 
 double WrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
@@ -21,8 +21,8 @@ double Heading(const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
 
 }  // namespace
 
-void WheelSpeeds(const DriveCommand& cmd, double wheel_radius_m, double track_m,
-                 double* left_radps, double* right_radps) {
+void WheelSpeeds(const DriveCommand& cmd, double wheel_radius_m, double track_m, double* left_radps,
+                 double* right_radps) {
   *left_radps = (cmd.v_mps - cmd.w_radps * track_m / 2.0) / wheel_radius_m;
   *right_radps = (cmd.v_mps + cmd.w_radps * track_m / 2.0) / wheel_radius_m;
 }
@@ -44,7 +44,8 @@ DriveCommand PathFollower::Turn(double yaw_rad, double dt_s) {
   const double max_rate = options_.turn_rate_dps * M_PI / 180.0;
   // Rate that still lets us stop in time: w² = 2 α |err|.
   const double w_stop = std::sqrt(2.0 * kAngularAccel * std::abs(err));
-  const double w_mag = std::max(kMinTurnRateRadps, std::min({max_rate, kTurnGain * std::abs(err), w_stop}));
+  const double w_mag =
+      std::max(kMinTurnRateRadps, std::min({max_rate, kTurnGain * std::abs(err), w_stop}));
   const double w_target = std::copysign(w_mag, err);
   const double dw = kAngularAccel * dt_s;
   w_ = std::clamp(w_target, w_ - dw, w_ + dw);
@@ -97,7 +98,8 @@ DriveCommand PathFollower::Drive(const Eigen::Vector2d& position, double yaw_rad
   const double kappa = 2.0 * std::sin(alpha) / std::max(dist, 1e-6);
 
   // Speed: cruise, limited by the braking distance to the next stop.
-  double v_target = std::min(options_.speed_mps, std::sqrt(2.0 * options_.max_accel_mps2 * to_stop));
+  double v_target =
+      std::min(options_.speed_mps, std::sqrt(2.0 * options_.max_accel_mps2 * to_stop));
   v_target = std::max(v_target, std::min(kCreepSpeed, options_.speed_mps));
   const double v = RampSpeed(v_target, dt_s);
   return {v, v * kappa};

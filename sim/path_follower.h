@@ -2,9 +2,8 @@
 // waypoints, with either in-place turns at the corners or arcs that cut them.
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "sim/scenario.h"
 
@@ -12,13 +11,13 @@ namespace sim {
 
 // Body velocity command of a differential-drive base.
 struct DriveCommand {
-  double v_mps = 0.0;     // forward speed (m/s)
-  double w_radps = 0.0;   // yaw rate, counter-clockwise seen from above (rad/s)
+  double v_mps = 0.0;    // forward speed (m/s)
+  double w_radps = 0.0;  // yaw rate, counter-clockwise seen from above (rad/s)
 };
 
 // Wheel angular speeds (rad/s, positive = forward) for a body command.
-void WheelSpeeds(const DriveCommand& cmd, double wheel_radius_m, double track_m,
-                 double* left_radps, double* right_radps);
+void WheelSpeeds(const DriveCommand& cmd, double wheel_radius_m, double track_m, double* left_radps,
+                 double* right_radps);
 
 class PathFollower {
  public:
@@ -43,9 +42,9 @@ class PathFollower {
   std::vector<Eigen::Vector2d> path_;
   RobotOptions options_;
   Mode mode_ = Mode::kTurn;
-  size_t target_ = 1;   // heading to path_[target_]
-  double v_ = 0.0;      // current commanded forward speed (m/s), ramped
-  double w_ = 0.0;      // current commanded yaw rate when turning (rad/s), ramped
+  size_t target_ = 1;  // heading to path_[target_]
+  double v_ = 0.0;     // current commanded forward speed (m/s), ramped
+  double w_ = 0.0;     // current commanded yaw rate when turning (rad/s), ramped
 };
 
 }  // namespace sim

@@ -1,11 +1,10 @@
 #include "sim/renderer.h"
 
 #include <GL/osmesa.h>
+#include <spdlog/spdlog.h>
 
 #include <cstring>
 #include <vector>
-
-#include <spdlog/spdlog.h>
 
 namespace sim {
 
@@ -25,9 +24,11 @@ struct OffscreenRenderer::Impl {
 std::unique_ptr<OffscreenRenderer> OffscreenRenderer::Create(const mjModel* model, int width,
                                                              int height, std::string* error) {
   if (model->vis.global.offwidth < width || model->vis.global.offheight < height) {
-    if (error) *error = "offscreen buffer of the model (" + std::to_string(model->vis.global.offwidth) + "x" +
-                        std::to_string(model->vis.global.offheight) + ") is smaller than the requested " +
-                        std::to_string(width) + "x" + std::to_string(height);
+    if (error)
+      *error = "offscreen buffer of the model (" + std::to_string(model->vis.global.offwidth) +
+               "x" + std::to_string(model->vis.global.offheight) +
+               ") is smaller than the requested " + std::to_string(width) + "x" +
+               std::to_string(height);
     return nullptr;
   }
   std::unique_ptr<OffscreenRenderer> r(new OffscreenRenderer());
@@ -37,7 +38,8 @@ std::unique_ptr<OffscreenRenderer> OffscreenRenderer::Create(const mjModel* mode
   Impl& im = *r->impl_;
   im.context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
   if (!im.context) {
-    if (error) *error = "could not create an OSMesa context (is libOSMesa from libosmesa6 installed?)";
+    if (error)
+      *error = "could not create an OSMesa context (is libOSMesa from libosmesa6 installed?)";
     return nullptr;
   }
   im.window_buffer.assign(static_cast<size_t>(width) * height * 4, 0);
@@ -100,7 +102,8 @@ void OffscreenRenderer::Render(const mjModel* model, mjData* data, int cam_id, c
   if (rgb) {
     rgb->create(height_, width_, CV_8UC3);
     for (int r = 0; r < height_; ++r) {
-      std::memcpy(rgb->ptr<unsigned char>(r), &im.rgb_flipped[static_cast<size_t>(height_ - 1 - r) * width_ * 3],
+      std::memcpy(rgb->ptr<unsigned char>(r),
+                  &im.rgb_flipped[static_cast<size_t>(height_ - 1 - r) * width_ * 3],
                   static_cast<size_t>(width_) * 3);
     }
   }

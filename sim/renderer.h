@@ -1,11 +1,11 @@
 // Offscreen rendering of MuJoCo cameras through OSMesa (no display, no X server).
 #pragma once
 
-#include <memory>
-#include <string>
-
 #include <mujoco/mujoco.h>
+
+#include <memory>
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace sim {
 

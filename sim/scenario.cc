@@ -1,14 +1,14 @@
 #include "sim/scenario.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <utility>
 #include <vector>
-#include <sstream>
-
-#include <yaml-cpp/yaml.h>
 
 #include "sim/data_dir.h"
 #include "sim/yaml_input.h"
@@ -38,11 +38,11 @@ std::string PhysicsProblem(const Scenario& s, std::string* key) {
   const double steps = 1.0 / (s.rate_hz * s.physics_dt_s);  // physics steps per frame period
   const double whole = std::round(steps);
   if (steps < 1.0 - kStepsPerFrameTolerance) {
-    e << s.rate_hz << " Hz is above the physics rate 1/physics_dt_s = "
-      << Num(1.0 / s.physics_dt_s) << " Hz (a frame per physics step at most)";
+    e << s.rate_hz << " Hz is above the physics rate 1/physics_dt_s = " << Num(1.0 / s.physics_dt_s)
+      << " Hz (a frame per physics step at most)";
   } else if (std::abs(steps - whole) > kStepsPerFrameTolerance * whole) {
-    e << "the frame period 1/" << s.rate_hz << " s is " << Num(steps)
-      << " physics steps of " << s.physics_dt_s
+    e << "the frame period 1/" << s.rate_hz << " s is " << Num(steps) << " physics steps of "
+      << s.physics_dt_s
       << " s; expected a whole number (frames are taken on physics steps), e.g. rate_hz "
       << Num(1.0 / (std::floor(steps) * s.physics_dt_s)) << " or "
       << Num(1.0 / (std::ceil(steps) * s.physics_dt_s));
@@ -52,9 +52,10 @@ std::string PhysicsProblem(const Scenario& s, std::string* key) {
     *key = "noise.motion_blur_exposure_s";
     if (!(s.noise.motion_blur_exposure_s <= max_exposure_s + 1e-12))
       e << s.noise.motion_blur_exposure_s
-        << " s does not fit in the frame period: expected at most the period minus 2 physics steps, "
-        << Num(std::max(0.0, max_exposure_s)) << " s at rate_hz " << s.rate_hz << " and physics_dt_s "
-        << s.physics_dt_s;
+        << " s does not fit in the frame period: expected at most the period minus 2 physics "
+           "steps, "
+        << Num(std::max(0.0, max_exposure_s)) << " s at rate_hz " << s.rate_hz
+        << " and physics_dt_s " << s.physics_dt_s;
   }
   return e.str();
 }
@@ -63,35 +64,72 @@ std::string PhysicsProblem(const Scenario& s, std::string* key) {
 
 bool Scenario::IsValid(std::string* error) const {
   std::ostringstream e;
-  if (path.size() < 2) e << "path: expected at least 2 waypoints, got " << path.size();
-  else if (!(rate_hz > 0)) e << "rate_hz: expected > 0, got " << rate_hz;
-  else if (!(physics_dt_s > 0 && physics_dt_s <= 0.01)) e << "physics_dt_s: expected in (0, 0.01], got " << physics_dt_s;
-  else if (!(max_duration_s > 0)) e << "max_duration_s: expected > 0";
-  else if (!(settle_s >= 0)) e << "settle_s: expected >= 0";
-  else if (!(robot.speed_mps > 0 && robot.speed_mps <= 3)) e << "robot.speed_mps: expected in (0, 3], got " << robot.speed_mps;
-  else if (!(robot.max_accel_mps2 > 0)) e << "robot.max_accel_mps2: expected > 0";
-  else if (!(robot.turn_rate_dps > 0 && robot.turn_rate_dps <= 360)) e << "robot.turn_rate_dps: expected in (0, 360]";
-  else if (!(robot.lookahead_m > 0)) e << "robot.lookahead_m: expected > 0";
-  else if (robot.corner_mode != "in_place" && robot.corner_mode != "arc") e << "robot.corner_mode: expected 'in_place' or 'arc', got '" << robot.corner_mode << "'";
-  else if (!(robot.goal_tolerance_m > 0)) e << "robot.goal_tolerance_m: expected > 0";
-  else if (camera.width < 16 || camera.width > 4096 || camera.height < 16 || camera.height > 4096) e << "camera.width/height: expected 16..4096, got " << camera.width << "x" << camera.height;
-  else if (!(camera.fovy_deg > kMinFovDeg && camera.fovy_deg < kMaxFovDeg)) e << "camera.fovy_deg: expected in (1, 170), got " << camera.fovy_deg;
-  else if (const double fovx_deg = 2.0 * std::atan(std::tan(camera.fovy_deg * M_PI / 360.0) * camera.width / camera.height) * 180.0 / M_PI;
-           !(fovx_deg < kMaxFovDeg)) e << "camera.fovy_deg: " << camera.fovy_deg << " deg at " << camera.width << "x" << camera.height << " gives a horizontal field of view of " << fovx_deg << " deg; expected below " << kMaxFovDeg << " deg";
-  else if (!(camera.baseline_m >= kMinBaselineM && camera.baseline_m <= kMaxBaselineM)) e << "camera.baseline_m: expected " << kMinBaselineM << " .. " << kMaxBaselineM << " m (1 mm to 5 m), got " << camera.baseline_m;
-  else if (!(camera.height_m > 0)) e << "camera.height_m: expected > 0, got " << camera.height_m;
-  else if (!(camera.pitch_deg > -80 && camera.pitch_deg < 80)) e << "camera.pitch_deg: expected in (-80, 80)";
-  else if (!(noise.pixel_sigma >= 0)) e << "noise.pixel_sigma: expected >= 0";
-  else if (!(noise.gain_sigma >= 0 && noise.gain_sigma < 0.5)) e << "noise.gain_sigma: expected in [0, 0.5)";
-  else if (!(noise.bias_sigma >= 0)) e << "noise.bias_sigma: expected >= 0";
-  else if (!(noise.motion_blur_exposure_s >= 0 && noise.motion_blur_exposure_s < 1.0 / rate_hz)) e << "noise.motion_blur_exposure_s: expected in [0, 1/rate_hz)";
-  else if (noise.motion_blur_exposure_s > 0 && noise.motion_blur_samples < 2) e << "noise.motion_blur_samples: expected >= 2 when motion blur is on";
-  else if (noise.motion_blur_samples < 1 || noise.motion_blur_samples > kMaxMotionBlurSamples) e << "noise.motion_blur_samples: expected 1 .. " << kMaxMotionBlurSamples << ", got " << noise.motion_blur_samples;
-  else if (std::string key, physics = PhysicsProblem(*this, &key); !physics.empty()) e << key << ": " << physics;
+  if (path.size() < 2)
+    e << "path: expected at least 2 waypoints, got " << path.size();
+  else if (!(rate_hz > 0))
+    e << "rate_hz: expected > 0, got " << rate_hz;
+  else if (!(physics_dt_s > 0 && physics_dt_s <= 0.01))
+    e << "physics_dt_s: expected in (0, 0.01], got " << physics_dt_s;
+  else if (!(max_duration_s > 0))
+    e << "max_duration_s: expected > 0";
+  else if (!(settle_s >= 0))
+    e << "settle_s: expected >= 0";
+  else if (!(robot.speed_mps > 0 && robot.speed_mps <= 3))
+    e << "robot.speed_mps: expected in (0, 3], got " << robot.speed_mps;
+  else if (!(robot.max_accel_mps2 > 0))
+    e << "robot.max_accel_mps2: expected > 0";
+  else if (!(robot.turn_rate_dps > 0 && robot.turn_rate_dps <= 360))
+    e << "robot.turn_rate_dps: expected in (0, 360]";
+  else if (!(robot.lookahead_m > 0))
+    e << "robot.lookahead_m: expected > 0";
+  else if (robot.corner_mode != "in_place" && robot.corner_mode != "arc")
+    e << "robot.corner_mode: expected 'in_place' or 'arc', got '" << robot.corner_mode << "'";
+  else if (!(robot.goal_tolerance_m > 0))
+    e << "robot.goal_tolerance_m: expected > 0";
+  else if (camera.width < 16 || camera.width > 4096 || camera.height < 16 || camera.height > 4096)
+    e << "camera.width/height: expected 16..4096, got " << camera.width << "x" << camera.height;
+  else if (!(camera.fovy_deg > kMinFovDeg && camera.fovy_deg < kMaxFovDeg))
+    e << "camera.fovy_deg: expected in (1, 170), got " << camera.fovy_deg;
+  else if (const double fovx_deg =
+               2.0 *
+               std::atan(std::tan(camera.fovy_deg * M_PI / 360.0) * camera.width / camera.height) *
+               180.0 / M_PI;
+           !(fovx_deg < kMaxFovDeg))
+    e << "camera.fovy_deg: " << camera.fovy_deg << " deg at " << camera.width << "x"
+      << camera.height << " gives a horizontal field of view of " << fovx_deg
+      << " deg; expected below " << kMaxFovDeg << " deg";
+  else if (!(camera.baseline_m >= kMinBaselineM && camera.baseline_m <= kMaxBaselineM))
+    e << "camera.baseline_m: expected " << kMinBaselineM << " .. " << kMaxBaselineM
+      << " m (1 mm to 5 m), got " << camera.baseline_m;
+  else if (!(camera.height_m > 0))
+    e << "camera.height_m: expected > 0, got " << camera.height_m;
+  else if (!(camera.pitch_deg > -80 && camera.pitch_deg < 80))
+    e << "camera.pitch_deg: expected in (-80, 80)";
+  else if (!(noise.pixel_sigma >= 0))
+    e << "noise.pixel_sigma: expected >= 0";
+  else if (!(noise.gain_sigma >= 0 && noise.gain_sigma < 0.5))
+    e << "noise.gain_sigma: expected in [0, 0.5)";
+  else if (!(noise.bias_sigma >= 0))
+    e << "noise.bias_sigma: expected >= 0";
+  else if (!(noise.motion_blur_exposure_s >= 0 && noise.motion_blur_exposure_s < 1.0 / rate_hz))
+    e << "noise.motion_blur_exposure_s: expected in [0, 1/rate_hz)";
+  else if (noise.motion_blur_exposure_s > 0 && noise.motion_blur_samples < 2)
+    e << "noise.motion_blur_samples: expected >= 2 when motion blur is on";
+  else if (noise.motion_blur_samples < 1 || noise.motion_blur_samples > kMaxMotionBlurSamples)
+    e << "noise.motion_blur_samples: expected 1 .. " << kMaxMotionBlurSamples << ", got "
+      << noise.motion_blur_samples;
+  else if (std::string key, physics = PhysicsProblem(*this, &key); !physics.empty())
+    e << key << ": " << physics;
   else {
     for (size_t i = 0; i < path.size(); ++i) {
-      if (!path[i].allFinite()) { e << "path[" << i << "]: expected finite coordinates"; break; }
-      if (i > 0 && (path[i] - path[i - 1]).norm() < 1e-3) { e << "path[" << i << "]: repeats the previous waypoint"; break; }
+      if (!path[i].allFinite()) {
+        e << "path[" << i << "]: expected finite coordinates";
+        break;
+      }
+      if (i > 0 && (path[i] - path[i - 1]).norm() < 1e-3) {
+        e << "path[" << i << "]: repeats the previous waypoint";
+        break;
+      }
     }
   }
   if (e.tellp() == 0) return true;
@@ -111,8 +149,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   }
   constexpr int kIntMin = std::numeric_limits<int>::min();
   constexpr int kIntMax = std::numeric_limits<int>::max();
-  r.CheckKeys(root, "", {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s",
-                         "rate_hz", "robot", "scene", "seed", "settle_s", "textures"});
+  r.CheckKeys(root, "",
+              {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
+               "robot", "scene", "seed", "settle_s", "textures"});
   r.String(root, "", "name", &s.name);
   std::string scene;
   r.String(root, "", "scene", &scene);
@@ -135,55 +174,71 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   }
 
   if (const YAML::Node n = root["robot"]; n.IsDefined() && r.ok()) {
-    r.CheckKeys(n, "robot", {"corner_mode", "goal_tolerance_m", "lookahead_m", "max_accel_mps2",
-                             "speed_mps", "turn_rate_dps"});
+    r.CheckKeys(n, "robot",
+                {"corner_mode", "goal_tolerance_m", "lookahead_m", "max_accel_mps2", "speed_mps",
+                 "turn_rate_dps"});
     RobotOptions& o = s.robot;
     r.Double(n, "robot", "speed_mps", &o.speed_mps);
-    r.Check(o.speed_mps > 0 && o.speed_mps <= 3, n, "robot", "speed_mps", "expected in (0, 3] m/s, got " + Num(o.speed_mps));
+    r.Check(o.speed_mps > 0 && o.speed_mps <= 3, n, "robot", "speed_mps",
+            "expected in (0, 3] m/s, got " + Num(o.speed_mps));
     r.Double(n, "robot", "max_accel_mps2", &o.max_accel_mps2);
     r.Check(o.max_accel_mps2 > 0, n, "robot", "max_accel_mps2", "expected > 0");
     r.Double(n, "robot", "turn_rate_dps", &o.turn_rate_dps);
-    r.Check(o.turn_rate_dps > 0 && o.turn_rate_dps <= 360, n, "robot", "turn_rate_dps", "expected in (0, 360] deg/s");
+    r.Check(o.turn_rate_dps > 0 && o.turn_rate_dps <= 360, n, "robot", "turn_rate_dps",
+            "expected in (0, 360] deg/s");
     r.Double(n, "robot", "lookahead_m", &o.lookahead_m);
     r.Check(o.lookahead_m > 0, n, "robot", "lookahead_m", "expected > 0");
     r.String(n, "robot", "corner_mode", &o.corner_mode);
-    r.Check(o.corner_mode == "in_place" || o.corner_mode == "arc", n, "robot", "corner_mode", "expected 'in_place' or 'arc', got '" + o.corner_mode + "'");
+    r.Check(o.corner_mode == "in_place" || o.corner_mode == "arc", n, "robot", "corner_mode",
+            "expected 'in_place' or 'arc', got '" + o.corner_mode + "'");
     r.Double(n, "robot", "goal_tolerance_m", &o.goal_tolerance_m);
     r.Check(o.goal_tolerance_m > 0, n, "robot", "goal_tolerance_m", "expected > 0");
   }
   if (const YAML::Node n = root["camera"]; n.IsDefined() && r.ok()) {
-    r.CheckKeys(n, "camera", {"baseline_m", "forward_m", "fovy_deg", "height", "height_m", "pitch_deg", "width"});
+    r.CheckKeys(
+        n, "camera",
+        {"baseline_m", "forward_m", "fovy_deg", "height", "height_m", "pitch_deg", "width"});
     CameraOptions& o = s.camera;
     r.Int(n, "camera", "width", kIntMin, kIntMax, &o.width);
-    r.Check(o.width >= 16 && o.width <= 4096, n, "camera", "width", "expected 16..4096 pixels, got " + std::to_string(o.width));
+    r.Check(o.width >= 16 && o.width <= 4096, n, "camera", "width",
+            "expected 16..4096 pixels, got " + std::to_string(o.width));
     r.Int(n, "camera", "height", kIntMin, kIntMax, &o.height);
-    r.Check(o.height >= 16 && o.height <= 4096, n, "camera", "height", "expected 16..4096 pixels, got " + std::to_string(o.height));
+    r.Check(o.height >= 16 && o.height <= 4096, n, "camera", "height",
+            "expected 16..4096 pixels, got " + std::to_string(o.height));
     r.Double(n, "camera", "fovy_deg", &o.fovy_deg);
-    r.Check(o.fovy_deg > kMinFovDeg && o.fovy_deg < kMaxFovDeg, n, "camera", "fovy_deg", "expected in (1, 170) degrees, got " + Num(o.fovy_deg));
+    r.Check(o.fovy_deg > kMinFovDeg && o.fovy_deg < kMaxFovDeg, n, "camera", "fovy_deg",
+            "expected in (1, 170) degrees, got " + Num(o.fovy_deg));
     r.Double(n, "camera", "baseline_m", &o.baseline_m);
-    r.Check(o.baseline_m >= kMinBaselineM && o.baseline_m <= kMaxBaselineM, n, "camera", "baseline_m",
-            "expected a positive baseline of " + Num(kMinBaselineM) + " .. " + Num(kMaxBaselineM) + " m (1 mm to 5 m), got " + Num(o.baseline_m));
+    r.Check(o.baseline_m >= kMinBaselineM && o.baseline_m <= kMaxBaselineM, n, "camera",
+            "baseline_m",
+            "expected a positive baseline of " + Num(kMinBaselineM) + " .. " + Num(kMaxBaselineM) +
+                " m (1 mm to 5 m), got " + Num(o.baseline_m));
     r.Double(n, "camera", "height_m", &o.height_m);
     r.Check(o.height_m > 0, n, "camera", "height_m", "expected > 0 m, got " + Num(o.height_m));
     r.Double(n, "camera", "forward_m", &o.forward_m);
     r.Double(n, "camera", "pitch_deg", &o.pitch_deg);
-    r.Check(o.pitch_deg > -80 && o.pitch_deg < 80, n, "camera", "pitch_deg", "expected in (-80, 80) degrees");
+    r.Check(o.pitch_deg > -80 && o.pitch_deg < 80, n, "camera", "pitch_deg",
+            "expected in (-80, 80) degrees");
   }
   if (const YAML::Node n = root["noise"]; n.IsDefined() && r.ok()) {
-    r.CheckKeys(n, "noise", {"bias_sigma", "gain_sigma", "motion_blur_exposure_s", "motion_blur_samples", "pixel_sigma"});
+    r.CheckKeys(n, "noise",
+                {"bias_sigma", "gain_sigma", "motion_blur_exposure_s", "motion_blur_samples",
+                 "pixel_sigma"});
     NoiseOptions& o = s.noise;
     r.Double(n, "noise", "pixel_sigma", &o.pixel_sigma);
     r.Check(o.pixel_sigma >= 0, n, "noise", "pixel_sigma", "expected >= 0 grey levels");
     r.Double(n, "noise", "gain_sigma", &o.gain_sigma);
-    r.Check(o.gain_sigma >= 0 && o.gain_sigma < 0.5, n, "noise", "gain_sigma", "expected in [0, 0.5)");
+    r.Check(o.gain_sigma >= 0 && o.gain_sigma < 0.5, n, "noise", "gain_sigma",
+            "expected in [0, 0.5)");
     r.Double(n, "noise", "bias_sigma", &o.bias_sigma);
     r.Check(o.bias_sigma >= 0, n, "noise", "bias_sigma", "expected >= 0 grey levels");
     r.Double(n, "noise", "motion_blur_exposure_s", &o.motion_blur_exposure_s);
     r.Check(o.motion_blur_exposure_s >= 0, n, "noise", "motion_blur_exposure_s", "expected >= 0 s");
     r.Int(n, "noise", "motion_blur_samples", kIntMin, kIntMax, &o.motion_blur_samples);
-    r.Check(o.motion_blur_samples >= 1 && o.motion_blur_samples <= kMaxMotionBlurSamples, n, "noise",
-            "motion_blur_samples", "expected 1 .. " + std::to_string(kMaxMotionBlurSamples) +
-            " renders per frame, got " + std::to_string(o.motion_blur_samples));
+    r.Check(o.motion_blur_samples >= 1 && o.motion_blur_samples <= kMaxMotionBlurSamples, n,
+            "noise", "motion_blur_samples",
+            "expected 1 .. " + std::to_string(kMaxMotionBlurSamples) + " renders per frame, got " +
+                std::to_string(o.motion_blur_samples));
   }
   if (const YAML::Node n = root["textures"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(n, "textures", {"seed"});
@@ -195,8 +250,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     const std::string physics = PhysicsProblem(s, &key);
     if (!physics.empty()) {
       const YAML::Node noise = root["noise"];
-      const YAML::Node at = key == "rate_hz" ? root["rate_hz"]
-                            : noise.IsDefined() ? noise["motion_blur_exposure_s"] : YAML::Node();
+      const YAML::Node at = key == "rate_hz"    ? root["rate_hz"]
+                            : noise.IsDefined() ? noise["motion_blur_exposure_s"]
+                                                : YAML::Node();
       r.Fail(at.IsDefined() ? at : root, key, physics);
     }
   }
@@ -244,31 +300,29 @@ std::string ScenarioToYaml(const Scenario& s) {
   out << YAML::Key << "max_duration_s" << YAML::Value << s.max_duration_s;
   out << YAML::Key << "settle_s" << YAML::Value << s.settle_s;
   out << YAML::Key << "path" << YAML::Value << YAML::BeginSeq;
-  for (const auto& p : s.path) out << YAML::Flow << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;
+  for (const auto& p : s.path)
+    out << YAML::Flow << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;
   out << YAML::EndSeq;
-  out << YAML::Key << "robot" << YAML::Value << YAML::BeginMap
-      << YAML::Key << "speed_mps" << YAML::Value << s.robot.speed_mps
-      << YAML::Key << "max_accel_mps2" << YAML::Value << s.robot.max_accel_mps2
-      << YAML::Key << "turn_rate_dps" << YAML::Value << s.robot.turn_rate_dps
-      << YAML::Key << "lookahead_m" << YAML::Value << s.robot.lookahead_m
-      << YAML::Key << "corner_mode" << YAML::Value << s.robot.corner_mode
-      << YAML::Key << "goal_tolerance_m" << YAML::Value << s.robot.goal_tolerance_m << YAML::EndMap;
-  out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap
-      << YAML::Key << "width" << YAML::Value << s.camera.width
-      << YAML::Key << "height" << YAML::Value << s.camera.height
-      << YAML::Key << "fovy_deg" << YAML::Value << s.camera.fovy_deg
-      << YAML::Key << "baseline_m" << YAML::Value << s.camera.baseline_m
-      << YAML::Key << "height_m" << YAML::Value << s.camera.height_m
-      << YAML::Key << "forward_m" << YAML::Value << s.camera.forward_m
+  out << YAML::Key << "robot" << YAML::Value << YAML::BeginMap << YAML::Key << "speed_mps"
+      << YAML::Value << s.robot.speed_mps << YAML::Key << "max_accel_mps2" << YAML::Value
+      << s.robot.max_accel_mps2 << YAML::Key << "turn_rate_dps" << YAML::Value
+      << s.robot.turn_rate_dps << YAML::Key << "lookahead_m" << YAML::Value << s.robot.lookahead_m
+      << YAML::Key << "corner_mode" << YAML::Value << s.robot.corner_mode << YAML::Key
+      << "goal_tolerance_m" << YAML::Value << s.robot.goal_tolerance_m << YAML::EndMap;
+  out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap << YAML::Key << "width"
+      << YAML::Value << s.camera.width << YAML::Key << "height" << YAML::Value << s.camera.height
+      << YAML::Key << "fovy_deg" << YAML::Value << s.camera.fovy_deg << YAML::Key << "baseline_m"
+      << YAML::Value << s.camera.baseline_m << YAML::Key << "height_m" << YAML::Value
+      << s.camera.height_m << YAML::Key << "forward_m" << YAML::Value << s.camera.forward_m
       << YAML::Key << "pitch_deg" << YAML::Value << s.camera.pitch_deg << YAML::EndMap;
-  out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap
-      << YAML::Key << "pixel_sigma" << YAML::Value << s.noise.pixel_sigma
-      << YAML::Key << "gain_sigma" << YAML::Value << s.noise.gain_sigma
-      << YAML::Key << "bias_sigma" << YAML::Value << s.noise.bias_sigma
+  out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap << YAML::Key << "pixel_sigma"
+      << YAML::Value << s.noise.pixel_sigma << YAML::Key << "gain_sigma" << YAML::Value
+      << s.noise.gain_sigma << YAML::Key << "bias_sigma" << YAML::Value << s.noise.bias_sigma
       << YAML::Key << "motion_blur_exposure_s" << YAML::Value << s.noise.motion_blur_exposure_s
-      << YAML::Key << "motion_blur_samples" << YAML::Value << s.noise.motion_blur_samples << YAML::EndMap;
-  out << YAML::Key << "textures" << YAML::Value << YAML::BeginMap
-      << YAML::Key << "seed" << YAML::Value << s.textures.seed << YAML::EndMap;
+      << YAML::Key << "motion_blur_samples" << YAML::Value << s.noise.motion_blur_samples
+      << YAML::EndMap;
+  out << YAML::Key << "textures" << YAML::Value << YAML::BeginMap << YAML::Key << "seed"
+      << YAML::Value << s.textures.seed << YAML::EndMap;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

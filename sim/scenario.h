@@ -2,20 +2,19 @@
 // Loaded from YAML (see scenes/l_hallway.yaml for a documented example).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace sim {
 
 // Differential-drive robot and its path-tracking controller (pure pursuit).
 struct RobotOptions {
-  double speed_mps = 0.4;          // commanded cruise speed (m/s), > 0 (Pioneer 2DX ≈ 0.3–0.5)
-  double max_accel_mps2 = 0.5;     // linear acceleration/deceleration limit (m/s²), > 0
-  double turn_rate_dps = 30.0;     // max angular rate when turning in place (deg/s), > 0
-  double lookahead_m = 0.5;        // pure-pursuit look-ahead distance (m), > 0
+  double speed_mps = 0.4;       // commanded cruise speed (m/s), > 0 (Pioneer 2DX ≈ 0.3–0.5)
+  double max_accel_mps2 = 0.5;  // linear acceleration/deceleration limit (m/s²), > 0
+  double turn_rate_dps = 30.0;  // max angular rate when turning in place (deg/s), > 0
+  double lookahead_m = 0.5;     // pure-pursuit look-ahead distance (m), > 0
   std::string corner_mode = "in_place";  // "in_place": stop and rotate at corners; "arc": cut
                                          // corners on an arc (pure pursuit over the polyline)
   double goal_tolerance_m = 0.02;  // a waypoint counts as reached within this distance (m), > 0
@@ -35,25 +34,25 @@ constexpr int kMaxMotionBlurSamples = 1000;
 
 // Rectified stereo pair on the robot (the paper's Videre head by default).
 struct CameraOptions {
-  int width = 320;            // image width (pixels), 16..4096
-  int height = 240;           // image height (pixels), 16..4096
-  double fovy_deg = 55.0;     // vertical field of view (degrees), (1, 170)
-  double baseline_m = 0.09;   // stereo baseline (m), [kMinBaselineM, kMaxBaselineM] = 1 mm .. 5 m
-  double height_m = 1.0;      // optical centre height above the floor (m), > 0
-  double forward_m = 0.15;    // optical centre ahead of the wheel axle (m)
-  double pitch_deg = 0.0;     // downward tilt of the optical axis (degrees), (-80, 80)
+  int width = 320;           // image width (pixels), 16..4096
+  int height = 240;          // image height (pixels), 16..4096
+  double fovy_deg = 55.0;    // vertical field of view (degrees), (1, 170)
+  double baseline_m = 0.09;  // stereo baseline (m), [kMinBaselineM, kMaxBaselineM] = 1 mm .. 5 m
+  double height_m = 1.0;     // optical centre height above the floor (m), > 0
+  double forward_m = 0.15;   // optical centre ahead of the wheel axle (m)
+  double pitch_deg = 0.0;    // downward tilt of the optical axis (degrees), (-80, 80)
 };
 
 // Camera noise models; each is off at 0.
 struct NoiseOptions {
-  double pixel_sigma = 0.0;         // additive Gaussian pixel noise (grey levels, 0..255 scale)
-  double gain_sigma = 0.0;          // per-image multiplicative gain: gain ~ N(1, gain_sigma²)
-  double bias_sigma = 0.0;          // per-image exposure offset ~ N(0, bias_sigma²) (grey levels)
+  double pixel_sigma = 0.0;  // additive Gaussian pixel noise (grey levels, 0..255 scale)
+  double gain_sigma = 0.0;   // per-image multiplicative gain: gain ~ N(1, gain_sigma²)
+  double bias_sigma = 0.0;   // per-image exposure offset ~ N(0, bias_sigma²) (grey levels)
   double motion_blur_exposure_s = 0.0;  // exposure time for motion blur (s); 0 = no blur;
                                         // at most the frame period minus 2 physics steps (the
                                         // exposures of consecutive frames must not overlap)
-  int motion_blur_samples = 5;      // renders averaged over the exposure, 1..1000
-                                    // (kMaxMotionBlurSamples), >= 2 when blur is on
+  int motion_blur_samples = 5;          // renders averaged over the exposure, 1..1000
+                                        // (kMaxMotionBlurSamples), >= 2 when blur is on
 };
 
 // Procedural textures of the scene (sim/textures.h).

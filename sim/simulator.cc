@@ -1,12 +1,12 @@
 #include "sim/simulator.h"
 
+#include <mujoco/mujoco.h>
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <cstring>
 #include <mutex>
-
-#include <mujoco/mujoco.h>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
 
 #include "sim/noise.h"
 #include "sim/path_follower.h"
@@ -65,7 +65,8 @@ Eigen::Isometry3d BodyPose(const mjData* d, int body_id) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   const mjtNum* q = d->xquat + 4 * body_id;
   T.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
-  T.translation() = Eigen::Vector3d(d->xpos[3 * body_id], d->xpos[3 * body_id + 1], d->xpos[3 * body_id + 2]);
+  T.translation() =
+      Eigen::Vector3d(d->xpos[3 * body_id], d->xpos[3 * body_id + 1], d->xpos[3 * body_id + 2]);
   return T;
 }
 
@@ -88,7 +89,8 @@ bool FillTextures(mjModel* m, uint64_t seed, const std::string& scene, std::stri
       if (mat >= 0 && m->mat_texid[mat] == t && m->geom_type[g] == mjGEOM_PLANE) geom = g;
     }
     if (geom < 0) {
-      *error = scene + ": texture '" + name + "' is not used by any plane geom (generated textures are sized from their plane)";
+      *error = scene + ": texture '" + name +
+               "' is not used by any plane geom (generated textures are sized from their plane)";
       return false;
     }
     const double width_m = 2.0 * m->geom_size[3 * geom];
@@ -96,7 +98,8 @@ bool FillTextures(mjModel* m, uint64_t seed, const std::string& scene, std::stri
     const int w = m->tex_width[t], h = m->tex_height[t];
     TextureOptions options;
     options.px_per_m = w / width_m;
-    cv::Mat img = GenerateTexture(kind, width_m, height_m, DeriveSeed(seed, HashName(name)), options);
+    cv::Mat img =
+        GenerateTexture(kind, width_m, height_m, DeriveSeed(seed, HashName(name)), options);
     if (img.empty() || img.type() != CV_8UC3) {
       *error = scene + ": texture generator failed for '" + name + "'";
       return false;
@@ -104,7 +107,8 @@ bool FillTextures(mjModel* m, uint64_t seed, const std::string& scene, std::stri
     if (img.cols != w || img.rows != h) cv::resize(img, img, cv::Size(w, h), 0, 0, cv::INTER_AREA);
     cv::cvtColor(img, img, cv::COLOR_BGR2RGB);
     unsigned char* dst = m->tex_rgb + m->tex_adr[t];
-    for (int r = 0; r < h; ++r) std::memcpy(dst + static_cast<size_t>(r) * w * 3, img.ptr(r), static_cast<size_t>(w) * 3);
+    for (int r = 0; r < h; ++r)
+      std::memcpy(dst + static_cast<size_t>(r) * w * 3, img.ptr(r), static_cast<size_t>(w) * 3);
   }
   return true;
 }
@@ -128,9 +132,9 @@ struct Simulator::Impl {
   std::unique_ptr<OffscreenRenderer> renderer;
   std::unique_ptr<PathFollower> follower;
   int body = -1, root_joint = -1, act_left = -1, act_right = -1, cam0 = -1, cam1 = -1;
-  long start_step = 0;      // physics step of frame time 0 (after settling)
-  int next_frame = 0;       // index of the frame being assembled
-  bool finished = false;    // path done and robot at rest: no further frames start
+  long start_step = 0;    // physics step of frame time 0 (after settling)
+  int next_frame = 0;     // index of the frame being assembled
+  bool finished = false;  // path done and robot at rest: no further frames start
   int warnings_at_start = 0;
 
   ~Impl() {
@@ -169,13 +173,18 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   im.act_right = mj_name2id(m, mjOBJ_ACTUATOR, kRightActuator);
   im.cam0 = mj_name2id(m, mjOBJ_CAMERA, kCam0);
   im.cam1 = mj_name2id(m, mjOBJ_CAMERA, kCam1);
-  if (im.body < 0 || im.root_joint < 0 || im.act_left < 0 || im.act_right < 0 || im.cam0 < 0 || im.cam1 < 0) {
-    *error = scene + ": the scene must contain the robot (body 'robot' with free joint 'robot_root', "
+  if (im.body < 0 || im.root_joint < 0 || im.act_left < 0 || im.act_right < 0 || im.cam0 < 0 ||
+      im.cam1 < 0) {
+    *error = scene +
+             ": the scene must contain the robot (body 'robot' with free joint 'robot_root', "
              "actuators 'drive_left'/'drive_right', cameras 'cam0'/'cam1'); include robot_p2dx.xml";
     return nullptr;
   }
-  if (m->jnt_type[im.root_joint] != mjJNT_FREE || m->cam_bodyid[im.cam0] != im.body || m->cam_bodyid[im.cam1] != im.body) {
-    *error = scene + ": joint 'robot_root' must be a free joint and cameras 'cam0'/'cam1' must sit on body 'robot'";
+  if (m->jnt_type[im.root_joint] != mjJNT_FREE || m->cam_bodyid[im.cam0] != im.body ||
+      m->cam_bodyid[im.cam1] != im.body) {
+    *error = scene +
+             ": joint 'robot_root' must be a free joint and cameras 'cam0'/'cam1' must sit on body "
+             "'robot'";
     return nullptr;
   }
   m->opt.timestep = scenario.physics_dt_s;
@@ -198,7 +207,8 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   R_body_mjcam0.col(0) = Eigen::Vector3d(0, -1, 0);
   R_body_mjcam0.col(1) = Eigen::Vector3d(0, 0, 1);
   R_body_mjcam0.col(2) = Eigen::Vector3d(-1, 0, 0);
-  const Eigen::Matrix3d R_body_mjcam = R_body_mjcam0 * Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Matrix3d R_body_mjcam =
+      R_body_mjcam0 * Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitX()).toRotationMatrix();
   const Eigen::Quaterniond q_body_mjcam(R_body_mjcam);
   const double z_cam = co.height_m - scenario.robot.wheel_radius_m;
   const Eigen::Vector3d right_dir = R_body_mjcam.col(0);  // camera x (right) in the body frame
@@ -219,7 +229,8 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   StereoCalibration& cal = sim->calibration_;
   cal.width = co.width;
   cal.height = co.height;
-  IntrinsicsFromFovy(co.fovy_deg, co.width, co.height, &cal.fx_px, &cal.fy_px, &cal.cx_px, &cal.cy_px);
+  IntrinsicsFromFovy(co.fovy_deg, co.width, co.height, &cal.fx_px, &cal.fy_px, &cal.cx_px,
+                     &cal.cy_px);
   cal.baseline_m = co.baseline_m;
   cal.T_body_cam0.linear() = R_body_mjcam * Eigen::Vector3d(1, -1, -1).asDiagonal();
   cal.T_body_cam0.translation() = p_cam0;
@@ -257,7 +268,8 @@ int Simulator::EstimatedFrames() const {
   double t = 0.0;
   const auto& p = scenario_.path;
   for (size_t i = 1; i < p.size(); ++i) {
-    t += (p[i] - p[i - 1]).norm() / scenario_.robot.speed_mps + scenario_.robot.speed_mps / scenario_.robot.max_accel_mps2;
+    t += (p[i] - p[i - 1]).norm() / scenario_.robot.speed_mps +
+         scenario_.robot.speed_mps / scenario_.robot.max_accel_mps2;
     if (i + 1 < p.size() && scenario_.robot.corner_mode == "in_place") {
       const Eigen::Vector2d a = p[i] - p[i - 1], b = p[i + 1] - p[i];
       const double turn = std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)));
@@ -284,7 +296,9 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
   const int samples = blur ? sc.noise.motion_blur_samples : 1;
   std::vector<long> sample_steps(samples);
   for (int i = 0; i < samples; ++i) {
-    const double off = blur ? sc.noise.motion_blur_exposure_s * (static_cast<double>(i) / (samples - 1) - 0.5) : 0.0;
+    const double off =
+        blur ? sc.noise.motion_blur_exposure_s * (static_cast<double>(i) / (samples - 1) - 0.5)
+             : 0.0;
     sample_steps[i] = std::max(0l, im.start_step + std::lround((t_frame + off) / dt));
   }
   const long gt_step = im.start_step + std::lround(t_frame / dt);
@@ -305,14 +319,18 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
     const long step = std::lround(d->time / dt);
     if (step > im.start_step + std::lround(sc.max_duration_s / dt)) {
       *error = sc.source_path + ": the robot did not finish its path within max_duration_s = " +
-               std::to_string(sc.max_duration_s) + " s (stuck against a wall, or the path leaves the scene?)";
+               std::to_string(sc.max_duration_s) +
+               " s (stuck against a wall, or the path leaves the scene?)";
       return false;
     }
     if (g_warning_count > im.warnings_at_start) {
-      *error = sc.scene_path + ": MuJoCo warning during simulation (see log); the physics are not trustworthy";
+      *error = sc.scene_path +
+               ": MuJoCo warning during simulation (see log); the physics are not trustworthy";
       return false;
     }
-    if (step >= im.start_step) body_track_.emplace_back(d->xpos[3 * im.body], d->xpos[3 * im.body + 1], d->xpos[3 * im.body + 2]);
+    if (step >= im.start_step)
+      body_track_.emplace_back(d->xpos[3 * im.body], d->xpos[3 * im.body + 1],
+                               d->xpos[3 * im.body + 2]);
 
     // Render the samples that fall on this step.
     for (int i = 0; i < samples; ++i) {
@@ -336,7 +354,8 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
     // End of the path: once the controller is done and the robot stands still, no new frame
     // starts (a frame already under way is completed above).
     const Eigen::Vector2d pos(d->qpos[qadr], d->qpos[qadr + 1]);
-    const double speed = Eigen::Vector3d(d->qvel[vadr], d->qvel[vadr + 1], d->qvel[vadr + 2]).norm();
+    const double speed =
+        Eigen::Vector3d(d->qvel[vadr], d->qvel[vadr + 1], d->qvel[vadr + 2]).norm();
     if (step >= im.start_step && im.follower->done() && speed < kStoppedSpeedMps && rendered == 0) {
       im.finished = true;
       return false;
@@ -356,7 +375,8 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
   // Average the exposure samples, then the per-image noise (seeded by frame and camera).
   for (int c = 0; c < 2; ++c) {
     acc[c] *= 1.0 / samples;
-    cv::Mat out = ApplyCameraNoise(acc[c], sc.noise, DeriveSeed(sc.seed, static_cast<uint64_t>(k), c));
+    cv::Mat out =
+        ApplyCameraNoise(acc[c], sc.noise, DeriveSeed(sc.seed, static_cast<uint64_t>(k), c));
     (c == 0 ? frame->left : frame->right) = out;
   }
   frame->index = k;

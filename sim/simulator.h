@@ -3,12 +3,11 @@
 // frame rate, with ground-truth pose and depth.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
-#include <opencv2/core.hpp>
 
 #include "sim/scenario.h"
 
@@ -17,23 +16,23 @@ namespace sim {
 // Rectified stereo calibration the simulator renders with. Pixel centres at integer
 // coordinates (OpenCV); cam1 = cam0 shifted by +baseline_m along cam0's x axis.
 struct StereoCalibration {
-  int width = 0;             // image width (pixels)
-  int height = 0;            // image height (pixels)
-  double fx_px = 0.0;        // focal lengths (pixels)
+  int width = 0;       // image width (pixels)
+  int height = 0;      // image height (pixels)
+  double fx_px = 0.0;  // focal lengths (pixels)
   double fy_px = 0.0;
-  double cx_px = 0.0;        // principal point (pixels)
+  double cx_px = 0.0;  // principal point (pixels)
   double cy_px = 0.0;
-  double baseline_m = 0.0;   // stereo baseline (m)
+  double baseline_m = 0.0;                                        // stereo baseline (m)
   Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();  // cam0 on the robot base
 };
 
 // One stereo frame and its ground truth.
 struct StereoFrame {
-  int index = 0;             // frame number from 0
-  double time_s = 0.0;       // frame time from the first frame (s); mid-exposure with blur
-  cv::Mat left;              // CV_8UC1 grey, cam0
-  cv::Mat right;             // CV_8UC1 grey, cam1
-  cv::Mat depth_m;           // CV_32FC1 z-depth of the left view (m), noise-free
+  int index = 0;        // frame number from 0
+  double time_s = 0.0;  // frame time from the first frame (s); mid-exposure with blur
+  cv::Mat left;         // CV_8UC1 grey, cam0
+  cv::Mat right;        // CV_8UC1 grey, cam1
+  cv::Mat depth_m;      // CV_32FC1 z-depth of the left view (m), noise-free
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();  // computer-vision axes
   Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();  // robot base (x forward, z up)
 };

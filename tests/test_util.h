@@ -1,12 +1,12 @@
 // Shared test helpers: pose matchers and named tolerances.
 #pragma once
 
+#include <gmock/gmock.h>
+
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include <Eigen/Geometry>
-#include <gmock/gmock.h>
 
 namespace vobench_test {
 
@@ -15,7 +15,8 @@ namespace vobench_test {
 inline double RotationAngleRad(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
   const Eigen::Matrix3d R = R_a.transpose() * R_b;
   const double c = (R.trace() - 1.0) / 2.0;
-  const double s = 0.5 * Eigen::Vector3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1)).norm();
+  const double s =
+      0.5 * Eigen::Vector3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1)).norm();
   return std::atan2(s, c);
 }
 

@@ -6,9 +6,8 @@
 // intrinsics and orientation: T_cam0_cam1 = [I | (baseline_m, 0, 0)].
 #pragma once
 
-#include <string>
-
 #include <Eigen/Core>
+#include <string>
 
 namespace vo {
 

@@ -1,7 +1,5 @@
 #include "vo/disparity.h"
 
-#include "vo/sad_block_matcher.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -9,6 +7,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+
+#include "vo/sad_block_matcher.h"
 
 namespace vo {
 namespace {
@@ -204,7 +204,7 @@ bool DepthSamplingOptions::IsValid(std::string* error) const {
 // DisparityEstimator
 
 struct DisparityEstimator::Impl {
-  cv::Ptr<cv::StereoMatcher> matcher;  // both views (the right one on the mirrored pair)
+  cv::Ptr<cv::StereoMatcher> matcher;    // both views (the right one on the mirrored pair)
   std::unique_ptr<SadBlockMatcher> sad;  // kBlockMatchingOneVolume: both views at once
   // Scratch buffers, reused between calls.
   cv::Mat padded_a, padded_b, flipped_a, flipped_b, raw_fixed;
@@ -273,8 +273,9 @@ bool CheckPair(const DisparityOptions& o, const cv::Mat& left, const cv::Mat& ri
     return false;
   }
   if (num_disparities != 0 && (num_disparities < 16 || num_disparities % 16 != 0)) {
-    result->message = "num_disparities must be 0 (the options') or a positive multiple of 16, got " +
-                      std::to_string(num_disparities);
+    result->message =
+        "num_disparities must be 0 (the options') or a positive multiple of 16, got " +
+        std::to_string(num_disparities);
     return false;
   }
   // Inputs: rectified 8-bit grey pair of one size.
@@ -361,8 +362,7 @@ DisparityResult DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& 
       cv::compare(s.texture, min_texture_sum, s.low_texture, cv::CMP_LT);
       discard = &s.low_texture;
     }
-    s.sad->Compute(left, right, &s.left_fixed, lr_check ? &s.right_fixed : nullptr, discard,
-                   nd);
+    s.sad->Compute(left, right, &s.left_fixed, lr_check ? &s.right_fixed : nullptr, discard, nd);
   } else {
     // Correlation along the epipolar lines, sub-pixel (1/16 px), left view.
     match(*s.matcher, left, right, &s.left_fixed);

@@ -94,11 +94,9 @@ bool SvdMatcherOptions::IsValid(std::string* error) const {
   } else if (jacobi_max_size < 2) {
     msg << "SvdMatcherOptions::jacobi_max_size must be >= 2, got " << jacobi_max_size;
   } else if (!(coherence_sigmas >= 0.0) || !std::isfinite(coherence_sigmas)) {
-    msg << "SvdMatcherOptions::coherence_sigmas must be finite and >= 0, got "
-        << coherence_sigmas;
+    msg << "SvdMatcherOptions::coherence_sigmas must be finite and >= 0, got " << coherence_sigmas;
   } else if (!(coherence_min_px >= 0.0) || !std::isfinite(coherence_min_px)) {
-    msg << "SvdMatcherOptions::coherence_min_px must be finite and >= 0, got "
-        << coherence_min_px;
+    msg << "SvdMatcherOptions::coherence_min_px must be finite and >= 0, got " << coherence_min_px;
   } else if (!(coherence_radius_px > 0.0) || !std::isfinite(coherence_radius_px)) {
     msg << "SvdMatcherOptions::coherence_radius_px must be finite and > 0, got "
         << coherence_radius_px;

@@ -222,14 +222,14 @@ struct SvdMatcherOptions {
   // (a near neighbour that looks alike), also when the prediction itself is off (the
   // neighbours share its error). Measured on l_hallway (match-eval, texture seeds 7 and 3,
   // strides 1-8): precision 0.989-0.994 -> 0.990-0.998 at the same recall.
-  double coherence_sigmas = 0.6;     // the tolerance in units of the gate's σ (0.6 · 10 px · 0.5
-                                     // = 3 px around the motion prior); 0 = no coherence test,
-                                     // >= 0
-  double coherence_min_px = 2.0;     // the tolerance never falls below this (pixels), >= 0
+  double coherence_sigmas = 0.6;  // the tolerance in units of the gate's σ (0.6 · 10 px · 0.5
+                                  // = 3 px around the motion prior); 0 = no coherence test,
+                                  // >= 0
+  double coherence_min_px = 2.0;  // the tolerance never falls below this (pixels), >= 0
   double coherence_radius_px = 60.0;  // neighbours: matches whose previous features lie within
                                       // this of the match's (pixels), > 0
-  int coherence_neighbours = 6;      // at most this many, the nearest; a match with fewer than
-                                     // two neighbours is kept, >= 2
+  int coherence_neighbours = 6;       // at most this many, the nearest; a match with fewer than
+                                      // two neighbours is kept, >= 2
 
   bool IsValid(std::string* error) const;
 };

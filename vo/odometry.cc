@@ -720,9 +720,9 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
         << (few_features  ? "too few features for RANSAC, no few-point motion"
             : ransac.ok() ? "too few inliers"
                           : ToString(ransac.status))
-        << " ("
-        << ransac.num_inliers << " inliers of " << correspondences.size() << " correspondences, "
-        << matches.size() << " matches; need " << options_.min_inliers << ")";
+        << " (" << ransac.num_inliers << " inliers of " << correspondences.size()
+        << " correspondences, " << matches.size() << " matches; need " << options_.min_inliers
+        << ")";
     if (!ransac.message.empty()) why << ": " << ransac.message;
     result.times.motion_ms += MsSince(motion_start);
     // After a loss, a frame that has plenty of features but cannot be matched to the last good
@@ -792,10 +792,10 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   // Weight of this motion in the prior: 1 from reliable_min_inliers inliers up, less below
   // (a weak motion moves the prior only part of the way), 0 when the BA was rejected.
   const double weight =
-      ba_rejected               ? 0.0
-      : result.few_point_motion ? tracking.few_point_prior_update
-                                : std::min(1.0, static_cast<double>(ransac.num_inliers) /
-                                                    tracking.reliable_min_inliers);
+      ba_rejected ? 0.0
+      : result.few_point_motion
+          ? tracking.few_point_prior_update
+          : std::min(1.0, static_cast<double>(ransac.num_inliers) / tracking.reliable_min_inliers);
   if (IsFinite(per_frame) && (weight > 0.0 || !has_velocity_)) {
     velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
     has_velocity_ = true;
@@ -852,8 +852,8 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   const bool orientation_frame =
       !reference_.valid && !initialised_ && options_.estimate_initial_orientation;
   const bool dense = options_.disparity_mode == DisparityMode::kDense || orientation_frame;
-  result.num_disparities = scene_num_disparities_ > 0 ? scene_num_disparities_
-                                                      : options_.disparity.num_disparities;
+  result.num_disparities =
+      scene_num_disparities_ > 0 ? scene_num_disparities_ : options_.disparity.num_disparities;
   Clock::time_point t = Clock::now();
   const DisparityResult disparity =
       dense ? disparity_->Compute(left, right, result.num_disparities)

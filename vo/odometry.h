@@ -105,7 +105,6 @@
 #include <vector>
 
 #include "vo/bundle_adjustment.h"
-#include "vo/sliding_window.h"
 #include "vo/camera.h"
 #include "vo/disparity.h"
 #include "vo/features.h"
@@ -114,6 +113,7 @@
 #include "vo/plane_orientation.h"
 #include "vo/prior_motion.h"
 #include "vo/ransac.h"
+#include "vo/sliding_window.h"
 #include "vo/tracks.h"
 #include "vo/types.h"
 
@@ -189,32 +189,33 @@ struct RobustTrackingOptions {
                                            // adjustment was rejected not at all; >= 3. 30 =
                                            // confident_min_inliers: a motion the matcher trusts is
                                            // one the prior may repeat
-  bool few_point_motion = false;  // OFF by default (measured, l_hallway texture seeds 1-10:
-                                 // stride 1 lost frames 113 -> 38, median end-pose error
-                                 // 0.347 -> 0.152 m, but strides 2 and 3 worse on seeds 2, 5,
-                                 // 10: median 0.256 -> 0.331 m at stride 2). On: when RANSAC
-                                 // finds no consensus (too few features or
-                                 // matches: a plain wall in front of the camera), the motion is
-                                 // estimated from the few matches and the motion prior
-                                 // (prior_motion.h: 1-point rotation hypotheses, then a
-                                 // Gauss-Newton fit regularised by the prior) instead of losing
-                                 // the frame; needs a prior (not on the first tracked frame)
+  bool few_point_motion = false;   // OFF by default (measured, l_hallway texture seeds 1-10:
+                                   // stride 1 lost frames 113 -> 38, median end-pose error
+                                   // 0.347 -> 0.152 m, but strides 2 and 3 worse on seeds 2, 5,
+                                   // 10: median 0.256 -> 0.331 m at stride 2). On: when RANSAC
+                                   // finds no consensus (too few features or
+                                   // matches: a plain wall in front of the camera), the motion is
+                                   // estimated from the few matches and the motion prior
+                                   // (prior_motion.h: 1-point rotation hypotheses, then a
+                                   // Gauss-Newton fit regularised by the prior) instead of losing
+                                   // the frame; needs a prior (not on the first tracked frame)
   int few_point_min_features = 3;  // a frame with fewer than min_features features with depth,
                                    // but at least this many, is still matched against the
                                    // reference (few_point_motion), >= 1
   PriorMotionOptions few_point;    // that solver (fewer inliers than its min_inliers and
                                    // min_inlier_fraction: lost)
-  double few_point_max_shift_disagreement_px = 3.0;  // a few-point motion is rejected when
-                                   // the image shift it predicts (the image centre at the
-                                   // reference's median depth) is farther from the
-                                   // coarse-to-fine shift measured for the frame than the
-                                   // prior's prediction is, by more than this (pixels), >= 0:
-                                   // two wrong matches that agree must not turn the camera by
-                                   // degrees that the image does not show, while the global
-                                   // shift's own error (parallax and zoom of forward motion)
-                                   // is what the prior shows too. No check without a shift.
-                                   // A few-point frame is never bundle-adjusted: a BA over a
-                                   // few points has no prior and is weaker than the solver
+  double few_point_max_shift_disagreement_px =
+      3.0;                              // a few-point motion is rejected when
+                                        // the image shift it predicts (the image centre at the
+                                        // reference's median depth) is farther from the
+                                        // coarse-to-fine shift measured for the frame than the
+                                        // prior's prediction is, by more than this (pixels), >= 0:
+                                        // two wrong matches that agree must not turn the camera by
+                                        // degrees that the image does not show, while the global
+                                        // shift's own error (parallax and zoom of forward motion)
+                                        // is what the prior shows too. No check without a shift.
+                                        // A few-point frame is never bundle-adjusted: a BA over a
+                                        // few points has no prior and is weaker than the solver
   double few_point_prior_update = 1.0;  // weight of a few-point motion in the constant-velocity
                                         // prior, in [0, 1] (the solver's estimate already
                                         // contains the prior)
@@ -255,9 +256,9 @@ struct OdometryOptions {
                                            // disparity_range_margin_px, rounded up to 16 and
                                            // at most the camera-derived range; the full range
                                            // on the first frame and after a lost frame
-  double disparity_range_margin = 0.25;     // relative margin of that range, >= 0
-  double disparity_range_margin_px = 8.0;   // absolute margin (pixels), >= 0
-  bool derive_num_disparities = true;     // search range from the camera: the smallest multiple
+  double disparity_range_margin = 0.25;    // relative margin of that range, >= 0
+  double disparity_range_margin_px = 8.0;  // absolute margin (pixels), >= 0
+  bool derive_num_disparities = true;      // search range from the camera: the smallest multiple
                                        // of 16 >= fx · baseline / disparity_min_depth_m, clamped
                                        // to [16, max_num_disparities] (and < image width)
   double disparity_min_depth_m = 0.7;  // nearest depth the derived search range covers (metres),
@@ -397,10 +398,10 @@ struct OdometryResult {
   Eigen::Vector2d image_shift_px = Eigen::Vector2d::Zero();  // that shift (pixels), when ok
   int num_first_pass_inliers = 0;  // inliers of the first (prior-centred) pass, before the
                                    // coarse-to-fine and guided passes
-  int num_disparities = 0;           // the disparity search range of this frame (pixels)
-  int disparity_pixels = 0;          // pixels whose disparity was evaluated (the whole image
-                                     // with disparity_mode dense; left + right-view pixels
-                                     // with at_features)
+  int num_disparities = 0;         // the disparity search range of this frame (pixels)
+  int disparity_pixels = 0;        // pixels whose disparity was evaluated (the whole image
+                                   // with disparity_mode dense; left + right-view pixels
+                                   // with at_features)
   StageTimes times;
   bool initial_orientation_ok = false;  // first frame only: the hallway orientation was found
                                         // and defines the world frame
@@ -566,9 +567,9 @@ class StereoOdometry {
   std::unique_ptr<FrameMatcher> matcher_;
   SlidingWindow window_;  // tracks, window poses and the bundle adjustment (sliding_window.h)
 
-  int64_t frame_index_ = 0;   // index of the next call
-  bool initialised_ = false;  // a reference was set at least once since Reset
-  int consecutive_lost_ = 0;  // lost frames since the last good one
+  int64_t frame_index_ = 0;         // index of the next call
+  bool initialised_ = false;        // a reference was set at least once since Reset
+  int consecutive_lost_ = 0;        // lost frames since the last good one
   bool previous_measured_ = false;  // the previous call's motion was measured (the prior is
                                     // a measured motion, not a bridge: few_point_motion)
   Reference reference_;

@@ -86,7 +86,8 @@ inline void UpdateColumn(int16_t* colsum, uint8_t a_add, const uint8_t* r_add, u
   }
 #else
   for (int k = 0; k < n; ++k) {
-    colsum[k] = static_cast<int16_t>(colsum[k] + AbsDiff(a_add, r_add[k]) - AbsDiff(a_sub, r_sub[k]));
+    colsum[k] =
+        static_cast<int16_t>(colsum[k] + AbsDiff(a_add, r_add[k]) - AbsDiff(a_sub, r_sub[k]));
   }
 #endif
 }
@@ -208,8 +209,7 @@ inline void RightAmbiguity(const int16_t* c, const int16_t* thresh, const int16_
                            int16_t* amb, int n) {
 #ifdef __SSE2__
   __m128i kidx = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m128i eight = _mm_set1_epi16(8), one = _mm_set1_epi16(1),
-                minus_one = _mm_set1_epi16(-1);
+  const __m128i eight = _mm_set1_epi16(8), one = _mm_set1_epi16(1), minus_one = _mm_set1_epi16(-1);
   for (int k = 0; k < n; k += 8, kidx = _mm_add_epi16(kidx, eight)) {
     const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + k));
     const __m128i t = _mm_loadu_si128(reinterpret_cast<const __m128i*>(thresh + k));
@@ -217,8 +217,8 @@ inline void RightAmbiguity(const int16_t* c, const int16_t* thresh, const int16_
         _mm_sub_epi16(kidx, _mm_loadu_si128(reinterpret_cast<const __m128i*>(rbest + k)));
     const __m128i far = _mm_or_si128(_mm_cmpgt_epi16(dk, one), _mm_cmpgt_epi16(minus_one, dk));
     __m128i* pa = reinterpret_cast<__m128i*>(amb + k);
-    _mm_storeu_si128(pa, _mm_or_si128(_mm_loadu_si128(pa),
-                                      _mm_andnot_si128(_mm_cmpgt_epi16(v, t), far)));
+    _mm_storeu_si128(
+        pa, _mm_or_si128(_mm_loadu_si128(pa), _mm_andnot_si128(_mm_cmpgt_epi16(v, t), far)));
   }
 #else
   for (int k = 0; k < n; ++k) {
@@ -279,7 +279,7 @@ void ProcessRows(const RowContext& c) {
         const int X = pad_left - half + j;
         const int b = base(j);
         K::UpdateColumn(&c.column_sums[static_cast<size_t>(j) * nd], l_add[X], r_add + b, l_sub[X],
-                     r_sub + b, nd);
+                        r_sub + b, nd);
       }
     }
     // Window costs along the row: a sliding sum of the column sums.
@@ -290,9 +290,10 @@ void ProcessRows(const RowContext& c) {
       for (int k = 0; k < nd; ++k) cost0[k] = static_cast<int16_t>(cost0[k] + cs[k]);
     }
     for (int x = 1; x < w; ++x) {
-      K::SlideRight(&c.costs[static_cast<size_t>(x) * nd], &c.costs[static_cast<size_t>(x - 1) * nd],
-                 &c.column_sums[static_cast<size_t>(x + win - 1) * nd],
-                 &c.column_sums[static_cast<size_t>(x - 1) * nd], nd);
+      K::SlideRight(&c.costs[static_cast<size_t>(x) * nd],
+                    &c.costs[static_cast<size_t>(x - 1) * nd],
+                    &c.column_sums[static_cast<size_t>(x + win - 1) * nd],
+                    &c.column_sums[static_cast<size_t>(x - 1) * nd], nd);
     }
 
     // Left view: best disparity per pixel, uniqueness, sub-pixel.
@@ -303,7 +304,8 @@ void ProcessRows(const RowContext& c) {
       int best = 0;
       int16_t best_cost = 0;
       K::ArgMin(cx, nd, &best, &best_cost);
-      if (uniq256 > 0 && !(skip && skip[x]) && K::Ambiguous(cx, nd, best, Threshold(best_cost, uniq256))) {
+      if (uniq256 > 0 && !(skip && skip[x]) &&
+          K::Ambiguous(cx, nd, best, Threshold(best_cost, uniq256))) {
         lout[x] = kSadInvalidFixed;
         continue;
       }
@@ -322,20 +324,21 @@ void ProcessRows(const RowContext& c) {
     for (int start = 0; start < K::kLanes; ++start) {
       for (int x = start; x < w; x += K::kLanes) {
         const int q0 = w - 1 - x + dmin;
-        K::RightMinUpdate(&c.costs[static_cast<size_t>(x) * nd], &c.right_min[q0], &c.right_best[q0],
-                       nd);
+        K::RightMinUpdate(&c.costs[static_cast<size_t>(x) * nd], &c.right_min[q0],
+                          &c.right_best[q0], nd);
       }
     }
     std::fill(c.right_ambiguous, c.right_ambiguous + nq, 0);
     if (uniq256 > 0) {
       for (int q = 0; q < nq; ++q) {
-        c.right_thresh[q] = static_cast<int16_t>(std::min<int>(Threshold(c.right_min[q], uniq256), INT16_MAX));
+        c.right_thresh[q] =
+            static_cast<int16_t>(std::min<int>(Threshold(c.right_min[q], uniq256), INT16_MAX));
       }
       for (int start = 0; start < K::kLanes; ++start) {
         for (int x = start; x < w; x += K::kLanes) {
           const int q0 = w - 1 - x + dmin;
           K::RightAmbiguity(&c.costs[static_cast<size_t>(x) * nd], &c.right_thresh[q0],
-                         &c.right_best[q0], &c.right_ambiguous[q0], nd);
+                            &c.right_best[q0], &c.right_ambiguous[q0], nd);
         }
       }
     }
@@ -482,13 +485,13 @@ __attribute__((flatten)) void ProcessRowsBaseline(const RowContext& c) {
   ProcessRows<KernelsBaseline>(c);
 }
 __attribute__((flatten)) int16_t LeftAtBaseline(const SadBlockMatcher::Geometry& g,
-                                                const cv::Mat& lpf, const cv::Mat& rrev,
-                                                int16_t* c, int x, int y) {
+                                                const cv::Mat& lpf, const cv::Mat& rrev, int16_t* c,
+                                                int x, int y) {
   return LeftAtImpl<KernelsBaseline>(g, lpf, rrev, c, x, y);
 }
 __attribute__((flatten)) int16_t RightAtBaseline(const SadBlockMatcher::Geometry& g,
-                                                 const cv::Mat& lpf, const cv::Mat& rpf,
-                                                 int16_t* d, uint8_t* seg, int xr, int y) {
+                                                 const cv::Mat& lpf, const cv::Mat& rpf, int16_t* d,
+                                                 uint8_t* seg, int xr, int y) {
   return RightAtImpl<KernelsBaseline>(g, lpf, rpf, d, seg, xr, y);
 }
 
@@ -517,9 +520,9 @@ struct KernelsAvx2 {
       const __m128i da = _mm_or_si128(_mm_subs_epu8(va, ra), _mm_subs_epu8(ra, va));
       const __m128i ds = _mm_or_si128(_mm_subs_epu8(vs, rs), _mm_subs_epu8(rs, vs));
       __m256i* p = reinterpret_cast<__m256i*>(colsum + k);
-      const __m256i sum = _mm256_sub_epi16(
-          _mm256_add_epi16(_mm256_loadu_si256(p), _mm256_cvtepu8_epi16(da)),
-          _mm256_cvtepu8_epi16(ds));
+      const __m256i sum =
+          _mm256_sub_epi16(_mm256_add_epi16(_mm256_loadu_si256(p), _mm256_cvtepu8_epi16(da)),
+                           _mm256_cvtepu8_epi16(ds));
       _mm256_storeu_si256(p, sum);
     }
   }
@@ -624,8 +627,8 @@ struct KernelsAvx2 {
       _mm256_storeu_si256(pb, _mm256_blendv_epi8(_mm256_loadu_si256(pb), kidx, better));
     }
   }
-  VO_AVX2 static void RightAmbiguity(const int16_t* c, const int16_t* thresh,
-                                     const int16_t* rbest, int16_t* amb, int n) {
+  VO_AVX2 static void RightAmbiguity(const int16_t* c, const int16_t* thresh, const int16_t* rbest,
+                                     int16_t* amb, int n) {
     __m256i kidx = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     const __m256i sixteen = _mm256_set1_epi16(16), one = _mm256_set1_epi16(1),
                   minus_one = _mm256_set1_epi16(-1);
@@ -709,8 +712,8 @@ void SadBlockMatcher::Prepare(const cv::Mat& left, const cv::Mat& right, int num
 }
 
 void SadBlockMatcher::ReleaseDenseScratch() {
-  for (std::vector<int16_t>* v : {&column_sums_, &costs_, &right_min_, &right_best_,
-                                  &right_thresh_, &right_ambiguous_}) {
+  for (std::vector<int16_t>* v :
+       {&column_sums_, &costs_, &right_min_, &right_best_, &right_thresh_, &right_ambiguous_}) {
     std::vector<int16_t>().swap(*v);
   }
 }
@@ -727,12 +730,11 @@ int16_t SadBlockMatcher::LeftAt(int x, int y) {
 int16_t SadBlockMatcher::RightAt(int xr, int y) {
 #if VO_SAD_HAVE_AVX2
   if (geometry_.avx2) {
-    return RightAtAvx2(geometry_, left_pf_, right_pf_, pixel_costs_.data(), segment_.data(), xr,
-                       y);
+    return RightAtAvx2(geometry_, left_pf_, right_pf_, pixel_costs_.data(), segment_.data(), xr, y);
   }
 #endif
-  return RightAtBaseline(geometry_, left_pf_, right_pf_, pixel_costs_.data(), segment_.data(),
-                         xr, y);
+  return RightAtBaseline(geometry_, left_pf_, right_pf_, pixel_costs_.data(), segment_.data(), xr,
+                         y);
 }
 
 void SadBlockMatcher::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* left_fixed,

@@ -61,8 +61,8 @@ class SadBlockMatcher {
   // throws away anyway (e.g. its texture filter); their uniqueness test is skipped, so their
   // output may hold a non-unique estimate. num_disparities: this pair's search range (a
   // multiple of 16, >= 16; 0 = the options').
-  void Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* left_fixed,
-               cv::Mat* right_fixed, const cv::Mat* discard = nullptr, int num_disparities = 0);
+  void Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* left_fixed, cv::Mat* right_fixed,
+               const cv::Mat* discard = nullptr, int num_disparities = 0);
 
   // Sparse evaluation: Prepare() prefilters and pads the pair once (same inputs as Compute,
   // and num_disparities: the search range of this pair, a multiple of 16 >= 16, 0 = the
@@ -83,8 +83,7 @@ class SadBlockMatcher {
 
   // Geometry of the prepared pair (Prepare / Compute).
   struct Geometry {
-    int w = 0, h = 0, nd = 0, dmin = 0, half = 0, win = 0, pad_left = 0, padded_w = 0,
-        uniq256 = 0;
+    int w = 0, h = 0, nd = 0, dmin = 0, half = 0, win = 0, pad_left = 0, padded_w = 0, uniq256 = 0;
     bool avx2 = false;  // the AVX2 kernels are used (also sets the right view's tie order)
   };
 

@@ -44,7 +44,6 @@ BundleAdjustmentProblem SelectBaPoints(BundleAdjustmentProblem problem, int max_
   return selected;
 }
 
-
 SlidingWindow::SlidingWindow(const SlidingWindowOptions& options)
     : options_(options), tracks_(TrackManagerOptions{options.window_frames}) {}
 

@@ -40,8 +40,8 @@ struct WindowRefinement {
   bool ran = false;        // the BA result was used (the stored poses are refined)
   bool rejected = false;   // the divergence guard rejected it (`message` says by how much)
   std::string message;
-  int num_frames = 0;      // poses in the problem (when ran)
-  int num_points = 0;      // points optimised (when ran)
+  int num_frames = 0;                // poses in the problem (when ran)
+  int num_points = 0;                // points optimised (when ran)
   double rms_reprojection_px = 0.0;  // inlier rms after the BA (when ran)
 };
 

@@ -9,11 +9,11 @@
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <utility>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <utility>
 
 #include "vo/disparity.h"
 #include "vo/features.h"
@@ -222,7 +222,8 @@ void SizeArgs(benchmark::internal::Benchmark* b) {
 
 // The pipeline's detector (bucketed Harris, 300 features).
 void BM_PipelineHarris(benchmark::State& state) {
-  const StereoPair& p = PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const StereoPair& p =
+      PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   vo::DetectorOptions options;
   options.max_features = 300;
   options.bucket_cols = 8;
@@ -241,7 +242,8 @@ BENCHMARK(BM_PipelineHarris)->Apply(SizeArgs);
 
 // The dense map (disparity_mode dense).
 void BM_PipelineDisparityDense(benchmark::State& state) {
-  const StereoPair& p = PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const StereoPair& p =
+      PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   vo::DisparityEstimator estimator(PipelineDisparity(static_cast<int>(state.range(2))));
   for (auto _ : state) {
     const vo::DisparityResult r = estimator.Compute(p.left, p.right);
@@ -279,7 +281,8 @@ BENCHMARK(BM_PipelineDisparityAtFeatures)->Apply(SizeArgs);
 
 // Its fixed part alone (prefiltered, padded views; the caches).
 void BM_PipelineDisparityPrepare(benchmark::State& state) {
-  const StereoPair& p = PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const StereoPair& p =
+      PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   vo::DisparityEstimator estimator(PipelineDisparity(static_cast<int>(state.range(2))));
   for (auto _ : state) {
     const vo::DisparityResult r = estimator.PrepareAtPixels(p.left, p.right);

@@ -15,9 +15,9 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
-#include <string>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 #include <vector>
 
 #include "vo/odometry.h"
@@ -29,16 +29,17 @@ constexpr int kForwardFrames = 20;
 constexpr int kTurnFrames = 20;
 
 // The camera rigs of results/speed/ (as the simulator renders them): 0 = the hallway head
-// (320x240, fx 230 px, 0.09 m; the L-hallway rig), 1 = the same at 640x480, 2 = EuRoC-like (752x480, fx 458 px,
-// 0.11 m), 3 = KITTI-like (1241x376, fx 718 px, 0.54 m).
+// (320x240, fx 230 px, 0.09 m; the L-hallway rig), 1 = the same at 640x480, 2 = EuRoC-like
+// (752x480, fx 458 px, 0.11 m), 3 = KITTI-like (1241x376, fx 718 px, 0.54 m).
 vo::StereoCamera RigCamera(int rig) {
   struct Rig {
     int width, height;
     double fx, baseline;
   };
-  static const Rig rigs[] = {
-      {320, 240, 230.0, 0.09}, {640, 480, 460.0, 0.09}, {752, 480, 458.0, 0.11},
-      {1241, 376, 718.0, 0.54}};
+  static const Rig rigs[] = {{320, 240, 230.0, 0.09},
+                             {640, 480, 460.0, 0.09},
+                             {752, 480, 458.0, 0.11},
+                             {1241, 376, 718.0, 0.54}};
   const Rig& r = rigs[rig];
   vo::StereoCamera cam;
   cam.width = r.width;
@@ -49,7 +50,6 @@ vo::StereoCamera RigCamera(int rig) {
   cam.baseline_m = r.baseline;
   return cam;
 }
-
 
 // A corridor box in the hallway frame (x along, y left, z up), one random texture per face
 // (1 cm texels, blurred noise at two scales), ray-cast with 2 × 2 supersampling.

@@ -14,8 +14,8 @@ namespace vobench_fuzz {
 inline const std::string& InputPath(const char* target) {
   static const std::string path = [target] {
     const char* dir = std::getenv("TMPDIR");
-    return std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/vobench_" + target +
-           "_" + std::to_string(::getpid()) + ".txt";
+    return std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/vobench_" + target + "_" +
+           std::to_string(::getpid()) + ".txt";
   }();
   return path;
 }

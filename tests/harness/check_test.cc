@@ -12,14 +12,13 @@
 #include <fstream>
 #include <sstream>
 
-#include "tests/sim/sim_test_util.h"
-
 #include "tests/harness/cli_test_util.h"
+#include "tests/sim/sim_test_util.h"
 
 namespace {
 
-using vobench_test::RunVobench;
 using vobench_test::ReadAll;
+using vobench_test::RunVobench;
 
 namespace fs = std::filesystem;
 using vobench_test::TempDir;
@@ -229,7 +228,8 @@ TEST(CheckCommandTest, PassesOnItsOwnBaselineAndCatchesADegradedConfiguration) {
   // gets worse than its tolerance.
   const auto degraded = RunVobench(
       "check --set use_bundle_adjustment=false --set matcher.type=ncc_mutual"
-      " --set matcher.prediction=none" + common);
+      " --set matcher.prediction=none" +
+      common);
   EXPECT_EQ(degraded.exit_code, 1) << degraded.output;
   EXPECT_NE(degraded.output.find("FAILED"), std::string::npos) << degraded.output;
   const std::string moved = degraded.output.substr(degraded.output.find("what moved:"));
@@ -237,7 +237,8 @@ TEST(CheckCommandTest, PassesOnItsOwnBaselineAndCatchesADegradedConfiguration) {
     bool end_pose_worse = false;
     std::istringstream lines(moved);
     for (std::string line; std::getline(lines, line);)
-      end_pose_worse |= line.find(run) != std::string::npos && line.find("WORSE") != std::string::npos;
+      end_pose_worse |=
+          line.find(run) != std::string::npos && line.find("WORSE") != std::string::npos;
     EXPECT_TRUE(end_pose_worse) << run << "\n" << degraded.output;
   }
   EXPECT_NE(ReadAll(dir / "out/check.md").find("WORSE"), std::string::npos);

@@ -25,8 +25,8 @@ struct CommandResult {
 // Runs `vobench ARGS` (the build's binary, VOBENCH_BINARY) through the shell, in the folder
 // `dir` when one is given.
 inline CommandResult RunVobench(const std::string& args, const std::string& dir = "") {
-  const std::string cmd = (dir.empty() ? std::string() : "cd '" + dir + "' && ") +
-                          VOBENCH_BINARY + " " + args + " 2>&1";
+  const std::string cmd = (dir.empty() ? std::string() : "cd '" + dir + "' && ") + VOBENCH_BINARY +
+                          " " + args + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   std::string out;
   char buf[4096];

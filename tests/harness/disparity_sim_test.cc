@@ -1,8 +1,8 @@
 // The disparity stage against the simulator's ground-truth depth on the L-hallway
 // (bad-pixel rate > 1 px and density over pixels with ground truth).
-#include <cstdio>
-
 #include <gtest/gtest.h>
+
+#include <cstdio>
 
 #include "harness/render.h"
 #include "sim/simulator.h"
@@ -49,7 +49,8 @@ TEST(DisparitySimTest, HallwayDisparityAgreesWithGroundTruthDepth) {
   ASSERT_GT(with_gt, 0);
   const double bad_rate = static_cast<double>(bad) / valid;
   const double density = static_cast<double>(valid) / with_gt;
-  std::printf("[ hallway disparity vs GT depth ] bad (>1 px) %.2f %%, density %.2f %%\n", 100 * bad_rate, 100 * density);
+  std::printf("[ hallway disparity vs GT depth ] bad (>1 px) %.2f %%, density %.2f %%\n",
+              100 * bad_rate, 100 * density);
   EXPECT_LT(bad_rate, kMaxBadRate);
   EXPECT_GT(density, kMinDensity);
 }
@@ -83,7 +84,8 @@ TEST(DisparitySimTest, DisparityAtPixelsEqualsTheDenseMapOnTheHallway) {
     for (int y = 0; y < f.left.rows; ++y) {
       for (int x = 0; x < f.left.cols; ++x) {
         const float expected = d.disparity_px.at<float>(y, x);
-        ASSERT_EQ(sparse.DisparityAt(x, y), expected) << "frame " << frames << " (" << x << ", " << y << ")";
+        ASSERT_EQ(sparse.DisparityAt(x, y), expected)
+            << "frame " << frames << " (" << x << ", " << y << ")";
         valid += expected >= 0.0f;
         ++pixels;
       }

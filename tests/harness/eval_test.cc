@@ -6,8 +6,6 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-
-#include <opencv2/imgproc.hpp>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,6 +15,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -24,16 +23,15 @@
 #include "harness/render.h"
 #include "harness/trajectory_io.h"
 #include "sim/simulator.h"
-#include "tests/sim/sim_test_util.h"
-
 #include "tests/harness/cli_test_util.h"
+#include "tests/sim/sim_test_util.h"
 
 namespace harness {
 namespace {
 
-using vobench_test::RunVobench;
 using vobench_test::CommandResult;
 using vobench_test::ReadAll;
+using vobench_test::RunVobench;
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;

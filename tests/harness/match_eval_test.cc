@@ -73,10 +73,10 @@ TEST(MatchEvalTest, VoMatchStatsCountCorrectWrongAndLeftOut) {
   };
   const std::vector<vo::Feature> ref = {feature(100, 50), feature(150, 80), feature(120, 160),
                                         feature(200, 200)};
-  const std::vector<vo::Feature> cur = {feature(88.5, 50),    // correct (exact)
-                                        feature(139.5, 81),   // correct (1.1 px off)
-                                        feature(111.5, 160),  // wrong (3 px off)
-                                        feature(188.5, 200)}; // ambiguous reference depth
+  const std::vector<vo::Feature> cur = {feature(88.5, 50),     // correct (exact)
+                                        feature(139.5, 81),    // correct (1.1 px off)
+                                        feature(111.5, 160),   // wrong (3 px off)
+                                        feature(188.5, 200)};  // ambiguous reference depth
   std::vector<vo::Match> matches;
   for (int i = 0; i < 4; ++i) {
     vo::Match m;

@@ -3,11 +3,11 @@
 // everywhere, and nothing else names metrics on its own.
 #include "harness/metric_registry.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <map>
 #include <set>
-
-#include <gtest/gtest.h>
 
 #include "harness/check.h"
 #include "harness/suite.h"
@@ -28,8 +28,8 @@ harness::RunSummary FullSummary() {
   s.metrics.ate_rmse_m = 0.125;
   s.match_stats.matches = 100;
   s.lost_frames = 3;
-  for (const char* stage : {"ba", "depth", "detect", "disparity", "guided", "match", "motion",
-                            "predict"})
+  for (const char* stage :
+       {"ba", "depth", "detect", "disparity", "guided", "match", "motion", "predict"})
     s.stage_ms_median[stage] = 1.5;
   return s;
 }
@@ -100,7 +100,8 @@ TEST(MetricRegistryTest, SummaryCsvColumnsAreTheRegistrysWithTimingLast) {
     EXPECT_EQ(timed, m.csv && m.group == MetricGroup::kTiming) << m.key;
   }
   ASSERT_GE(cols.size(), timing.size());
-  EXPECT_TRUE(std::equal(timing.begin(), timing.end(), cols.end() - static_cast<long>(timing.size())));
+  EXPECT_TRUE(
+      std::equal(timing.begin(), timing.end(), cols.end() - static_cast<long>(timing.size())));
   EXPECT_EQ(timing.back(), "wall_s");
 }
 
@@ -113,9 +114,9 @@ TEST(MetricRegistryTest, TuneAndCheckTakeTheirMetricsFromTheRegistry) {
   EXPECT_FALSE(harness::ObjectiveValue(FullSummary(), "vo_ms_median", &v));  // timing
   EXPECT_FALSE(harness::ObjectiveValue(FullSummary(), "no_such_metric", &v));
   const std::vector<std::string> checked = harness::CheckedMetrics();
-  EXPECT_EQ(checked, (std::vector<std::string>{"end_pose_error_m", "end_rotation_error_deg",
-                                                "ate_rmse_m", "rpe_trans_rmse_m", "drift_pct",
-                                                "lost_frames"}));
+  EXPECT_EQ(checked,
+            (std::vector<std::string>{"end_pose_error_m", "end_rotation_error_deg", "ate_rmse_m",
+                                      "rpe_trans_rmse_m", "drift_pct", "lost_frames"}));
   const harness::Baseline rule = harness::DefaultBaselineRule();
   for (const std::string& k : checked)
     EXPECT_DOUBLE_EQ(rule.absolute_tolerance.at(k), harness::FindMetric(k)->check_tolerance) << k;

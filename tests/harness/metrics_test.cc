@@ -1,9 +1,9 @@
 // Trajectory metrics on hand-computed cases.
 #include "harness/metrics.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace {
 

@@ -24,15 +24,14 @@
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
 
-
 namespace {
 
 namespace fs = std::filesystem;
 using harness::FolderMarker;
 using harness::OutputFolder;
 using ::testing::HasSubstr;
-using vobench_test::ReadAll;
 using vobench_test::EntriesStartingWith;
+using vobench_test::ReadAll;
 using vobench_test::RunVobench;
 using vobench_test::TempDir;
 using vobench_test::WriteText;

@@ -10,8 +10,8 @@ namespace {
 TEST(OverridesTest, DottedKeysBecomeNestedMaps) {
   YAML::Node nested;
   std::string error;
-  ASSERT_TRUE(harness::NestDottedKeys(YAML::Load("{a.b.c: 1, a.d: 2, e: {f.g: 3}}"), "t",
-                                      &nested, &error))
+  ASSERT_TRUE(
+      harness::NestDottedKeys(YAML::Load("{a.b.c: 1, a.d: 2, e: {f.g: 3}}"), "t", &nested, &error))
       << error;
   EXPECT_EQ(nested["a"]["b"]["c"].as<int>(), 1);
   EXPECT_EQ(nested["a"]["d"].as<int>(), 2);
@@ -58,8 +58,8 @@ TEST(OverridesTest, ScenarioOverridesAreCheckedStrictly) {
   EXPECT_FALSE(harness::ApplyScenarioOverrides(base, YAML::Load("{noise.pixel_sigmaa: 1}"),
                                                "suite.yaml", &s, &error));
   EXPECT_NE(error.find("pixel_sigmaa"), std::string::npos) << error;
-  EXPECT_FALSE(harness::ApplyScenarioOverrides(base, YAML::Load("{rate_hz: -1}"), "suite.yaml",
-                                               &s, &error));
+  EXPECT_FALSE(
+      harness::ApplyScenarioOverrides(base, YAML::Load("{rate_hz: -1}"), "suite.yaml", &s, &error));
   EXPECT_NE(error.find("rate_hz"), std::string::npos) << error;
 }
 
@@ -67,14 +67,14 @@ TEST(OverridesTest, VoOverridesApplyOnTopOfTheGivenOptions) {
   vo::OdometryOptions options;
   options.ba_window_frames = 7;
   std::string error;
-  ASSERT_TRUE(harness::ApplyVoOverrides(YAML::Load("{matcher.type: ncc_mutual}"), "t", &options,
-                                        &error))
+  ASSERT_TRUE(
+      harness::ApplyVoOverrides(YAML::Load("{matcher.type: ncc_mutual}"), "t", &options, &error))
       << error;
   EXPECT_EQ(options.ba_window_frames, 7);
   EXPECT_EQ(options.matcher.type, vo::MatcherType::kNccMutual);
   vo::OdometryOptions bad = options;
-  EXPECT_FALSE(harness::ApplyVoOverrides(YAML::Load("{matcher.type: nonsense}"), "tune.yaml",
-                                         &bad, &error));
+  EXPECT_FALSE(
+      harness::ApplyVoOverrides(YAML::Load("{matcher.type: nonsense}"), "tune.yaml", &bad, &error));
   EXPECT_NE(error.find("tune.yaml"), std::string::npos) << error;
 }
 

@@ -3,9 +3,9 @@
 // and the per-frame log of the run folder.
 #include "harness/pipeline.h"
 
-#include <sstream>
-
 #include <gtest/gtest.h>
+
+#include <sstream>
 
 #include "harness/run_folder.h"
 #include "tests/vo/vo_test_util.h"
@@ -41,8 +41,8 @@ TEST(PipelineTest, RunFramesTakesEveryKthFrameUpToMaxFrames) {
   options.max_frames = 8;  // source frames 0..7: the VO sees 0, 3, 6
   RunRecords records;
   std::string error;
-  ASSERT_TRUE(harness::RunFrames("black", BlackFrames(20, &given), odometry, options, &records,
-                                 &error))
+  ASSERT_TRUE(
+      harness::RunFrames("black", BlackFrames(20, &given), odometry, options, &records, &error))
       << error;
   ASSERT_EQ(records.frames.size(), 3u);
   EXPECT_EQ(given, 8);
@@ -68,7 +68,8 @@ TEST(PipelineTest, RunFramesRefusesAStrideBelowOne) {
   options.frame_stride = 0;
   RunRecords records;
   std::string error;
-  EXPECT_FALSE(harness::RunFrames("x", BlackFrames(3, &given), odometry, options, &records, &error));
+  EXPECT_FALSE(
+      harness::RunFrames("x", BlackFrames(3, &given), odometry, options, &records, &error));
   EXPECT_EQ(error, "frame stride must be >= 1, got 0");
 }
 
@@ -122,10 +123,10 @@ TEST(PipelineTest, SummarizeCountsAndMediansOfACraftedRunAreExact) {
   EXPECT_DOUBLE_EQ(s.metrics.path_length_m, 5.0);
   EXPECT_NEAR(s.metrics.end_pose_error_m, 0.0, 1e-12);
   EXPECT_NEAR(s.metrics.ate_rmse_m, 0.0, 1e-12);
-  EXPECT_DOUBLE_EQ(s.vo_ms_median, 50.0);         // 30, 40, 50, 60, 70
+  EXPECT_DOUBLE_EQ(s.vo_ms_median, 50.0);  // 30, 40, 50, 60, 70
   EXPECT_DOUBLE_EQ(s.stage_ms_median.at("detect"), 5.0);
   EXPECT_DOUBLE_EQ(s.features_median, 104.0);  // 102..107, first included; nearest rank
-  EXPECT_DOUBLE_EQ(s.inliers_median, 55.0);       // 53..57
+  EXPECT_DOUBLE_EQ(s.inliers_median, 55.0);    // 53..57
 }
 
 TEST(PipelineTest, SummarizeUsesOnlyTheFramesWithGroundTruth) {

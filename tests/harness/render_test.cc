@@ -2,22 +2,21 @@
 // run after run, and bad input ends with a message, a non-zero exit and no output folder.
 #include "harness/render.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
-#include <gtest/gtest.h>
-
 #include "harness/dataset.h"
-#include "tests/sim/sim_test_util.h"
-
 #include "tests/harness/cli_test_util.h"
+#include "tests/sim/sim_test_util.h"
 
 namespace {
 
-using vobench_test::RunVobench;
 using vobench_test::ReadAll;
+using vobench_test::RunVobench;
 
 namespace fs = std::filesystem;
 using vobench_test::TempDir;
@@ -30,16 +29,19 @@ std::string ShortScenario(const TempDir& dir, const std::string& extra = "") {
   const std::string path = dir / "short.yaml";
   WriteText(path, "name: short\nscene: " + std::string(VOBENCH_SOURCE_DIR) +
                       "/scenes/hallway_l.xml\npath:\n  - [0, 0]\n  - [0.8, 0]\n"
-                      "noise:\n  pixel_sigma: 1.5\n  gain_sigma: 0.02\n" + extra);
+                      "noise:\n  pixel_sigma: 1.5\n  gain_sigma: 0.02\n" +
+                      extra);
   return path;
 }
 
 TEST(RenderTest, DatasetOnDiskEqualsTheSimulationAndIsDeterministic) {
   TempDir dir("render");
   const std::string scenario_path = ShortScenario(dir);
-  const auto a = RunVobench("render " + scenario_path + " --out " + (dir / "a") + " -q --format euroc");
+  const auto a =
+      RunVobench("render " + scenario_path + " --out " + (dir / "a") + " -q --format euroc");
   ASSERT_EQ(a.exit_code, 0) << a.output;
-  const auto b = RunVobench("render " + scenario_path + " --out " + (dir / "b") + " -q --format euroc");
+  const auto b =
+      RunVobench("render " + scenario_path + " --out " + (dir / "b") + " -q --format euroc");
   ASSERT_EQ(b.exit_code, 0) << b.output;
 
   // Byte-identical trees, but for the marker (its command line, time and pid differ).
@@ -49,10 +51,12 @@ TEST(RenderTest, DatasetOnDiskEqualsTheSimulationAndIsDeterministic) {
       files.push_back(fs::relative(e.path(), dir / "a").string());
   EXPECT_TRUE(fs::exists(fs::path(dir / "a") / ".vobench.json"));
   ASSERT_GT(files.size(), 20u);
-  for (const auto& f : files) EXPECT_EQ(ReadAll(fs::path(dir / "b") / f), ReadAll(fs::path(dir / "a") / f)) << f;
-  for (const char* f : {"calib.txt", "times.txt", "poses.txt", "groundtruth_tum.txt", "image_0/000000.png",
-                        "image_1/000000.png", "depth/000000.png", "mav0/cam0/data.csv", "mav0/cam0/sensor.yaml",
-                        "mav0/cam1/sensor.yaml", "mav0/state_groundtruth_estimate0/data.csv"})
+  for (const auto& f : files)
+    EXPECT_EQ(ReadAll(fs::path(dir / "b") / f), ReadAll(fs::path(dir / "a") / f)) << f;
+  for (const char* f :
+       {"calib.txt", "times.txt", "poses.txt", "groundtruth_tum.txt", "image_0/000000.png",
+        "image_1/000000.png", "depth/000000.png", "mav0/cam0/data.csv", "mav0/cam0/sensor.yaml",
+        "mav0/cam1/sensor.yaml", "mav0/state_groundtruth_estimate0/data.csv"})
     EXPECT_TRUE(fs::exists(fs::path(dir / "a") / f)) << f;
 
   // Read back and compare with a fresh simulation of the same scenario.
@@ -82,8 +86,10 @@ TEST(RenderTest, DatasetOnDiskEqualsTheSimulationAndIsDeterministic) {
     EXPECT_NEAR(d.time_s, f.time_s, 1e-9);
     if (n == 0) T_world_first = f.T_world_cam0;
     const Eigen::Isometry3d expected = T_world_first.inverse() * f.T_world_cam0;
-    EXPECT_LT((reader.poses()[n].matrix() - expected.matrix()).cwiseAbs().maxCoeff(), kPoseTol) << n;
-    EXPECT_LT((d.T_world_cam0.matrix() - f.T_world_cam0.matrix()).cwiseAbs().maxCoeff(), kPoseTol) << n;
+    EXPECT_LT((reader.poses()[n].matrix() - expected.matrix()).cwiseAbs().maxCoeff(), kPoseTol)
+        << n;
+    EXPECT_LT((d.T_world_cam0.matrix() - f.T_world_cam0.matrix()).cwiseAbs().maxCoeff(), kPoseTol)
+        << n;
     // Depth to the millimetre (16-bit PNG in mm).
     const float z_gt = f.depth_m.at<float>(120, 160);
     EXPECT_NEAR(d.depth_m.at<float>(120, 160), z_gt, 0.0005 + 1e-6) << n;
@@ -118,14 +124,25 @@ TEST_F(RenderBadInputTest, MissingScenario) {
   EXPECT_NE(r.output.find("none.yaml"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
-TEST_F(RenderBadInputTest, MalformedYaml) { ExpectRefused(kScene + "path: [[0, 0], [1, 0]\n", "malformed YAML"); }
-TEST_F(RenderBadInputTest, UnknownKey) { ExpectRefused(kScene + "path: [[0, 0], [1, 0]]\nspeed: 3\n", "'speed'"); }
-TEST_F(RenderBadInputTest, WrongType) { ExpectRefused(kScene + "path: [[0, 0], [1, 0]]\nrate_hz: [1]\n", "'rate_hz'"); }
-TEST_F(RenderBadInputTest, NegativeBaseline) {
-  ExpectRefused(kScene + "path: [[0, 0], [1, 0]]\ncamera:\n  baseline_m: -1\n", "'camera.baseline_m'");
+TEST_F(RenderBadInputTest, MalformedYaml) {
+  ExpectRefused(kScene + "path: [[0, 0], [1, 0]\n", "malformed YAML");
 }
-TEST_F(RenderBadInputTest, NaN) { ExpectRefused(kScene + "path: [[0, 0], [1, 0]]\nrate_hz: .nan\n", "'rate_hz'"); }
-TEST_F(RenderBadInputTest, ShortPath) { ExpectRefused(kScene + "path: [[0, 0]]\n", "at least 2 waypoints"); }
+TEST_F(RenderBadInputTest, UnknownKey) {
+  ExpectRefused(kScene + "path: [[0, 0], [1, 0]]\nspeed: 3\n", "'speed'");
+}
+TEST_F(RenderBadInputTest, WrongType) {
+  ExpectRefused(kScene + "path: [[0, 0], [1, 0]]\nrate_hz: [1]\n", "'rate_hz'");
+}
+TEST_F(RenderBadInputTest, NegativeBaseline) {
+  ExpectRefused(kScene + "path: [[0, 0], [1, 0]]\ncamera:\n  baseline_m: -1\n",
+                "'camera.baseline_m'");
+}
+TEST_F(RenderBadInputTest, NaN) {
+  ExpectRefused(kScene + "path: [[0, 0], [1, 0]]\nrate_hz: .nan\n", "'rate_hz'");
+}
+TEST_F(RenderBadInputTest, ShortPath) {
+  ExpectRefused(kScene + "path: [[0, 0]]\n", "at least 2 waypoints");
+}
 TEST_F(RenderBadInputTest, MalformedMjcf) {
   WriteText(dir_ / "broken.xml", "<mujoco><worldbody><body></worldbody></mujoco>");
   ExpectRefused("scene: broken.xml\npath: [[0, 0], [1, 0]]\n", "broken.xml");
@@ -137,7 +154,8 @@ TEST_F(RenderBadInputTest, PathLeavesTheHallway) {
 TEST_F(RenderBadInputTest, ExistingOutputIsRefused) {
   fs::create_directories(dir_ / "exists");
   WriteText(dir_ / "exists/keep.txt", "x");
-  const auto r = RunVobench("render " + ShortScenario(dir_) + " --out " + (dir_ / "exists") + " -q");
+  const auto r =
+      RunVobench("render " + ShortScenario(dir_) + " --out " + (dir_ / "exists") + " -q");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_TRUE(fs::exists(dir_ / "exists/keep.txt"));
 }

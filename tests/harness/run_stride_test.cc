@@ -97,7 +97,7 @@ TEST(RunBadStartTest, BlackFirstFramesAreNotInitialisedAndCostNothing) {
   std::vector<harness::DatasetFrame> dark;
   for (int i = 0; i < 3; ++i) {
     harness::DatasetFrame d = frames.front();
-    d.left = cv::Mat(d.left.size(), CV_8UC1, cv::Scalar(0));  // new buffers (assigning
+    d.left = cv::Mat(d.left.size(), CV_8UC1, cv::Scalar(0));    // new buffers (assigning
     d.right = cv::Mat(d.right.size(), CV_8UC1, cv::Scalar(0));  // Mat::zeros would write into
                                                                 // the shared clean frame)
     d.time_s = frames.front().time_s - 0.1 * (3 - i);
@@ -131,7 +131,8 @@ TEST(RunBadStartTest, BlackFirstFramesAreNotInitialisedAndCostNothing) {
   // Within the clean run's own error (and far from the 1.9 m / 120° of the wrong world).
   const double tol_m = std::max(0.01, clean.metrics.end_pose_error_m);
   EXPECT_NEAR(bad.metrics.end_pose_error_m, clean.metrics.end_pose_error_m, tol_m);
-  EXPECT_NEAR(bad.metrics.ate_rmse_m, clean.metrics.ate_rmse_m, std::max(0.01, clean.metrics.ate_rmse_m));
+  EXPECT_NEAR(bad.metrics.ate_rmse_m, clean.metrics.ate_rmse_m,
+              std::max(0.01, clean.metrics.ate_rmse_m));
   EXPECT_LT(bad.metrics.end_rotation_error_deg, clean.metrics.end_rotation_error_deg + 0.5);
   // No pose for the black frames: the trajectories start at the first initialised frame.
   std::vector<harness::StampedPose> traj;

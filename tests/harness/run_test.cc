@@ -2,10 +2,10 @@
 // L-hallway, run-folder contents, determinism, VO config files.
 #include "harness/run.h"
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "harness/render.h"
@@ -53,12 +53,13 @@ TEST(RunTest, PapersConfigurationOnTheLHallwayMeetsThePapersFigure) {
   EXPECT_GT(s.match_stats.precision(), 0.95);
   EXPECT_GT(s.match_stats.inlier_precision(), 0.99);
   // The run folder has what the issue names.
-  for (const char* f : {"trajectory_tum.txt", "trajectory_kitti.txt", "groundtruth_tum.txt", "per_frame.csv",
-                        "vo_options.yaml", "scenario.yaml", "metrics.json", "report.md"})
+  for (const char* f :
+       {"trajectory_tum.txt", "trajectory_kitti.txt", "groundtruth_tum.txt", "per_frame.csv",
+        "vo_options.yaml", "scenario.yaml", "metrics.json", "report.md"})
     EXPECT_TRUE(fs::exists(fs::path(options.out_dir) / f)) << f;
   const nlohmann::json j = ReadJson(options.out_dir + "/metrics.json");
-  for (const char* k : {"frames", "path_length_m", "end_pose_error_m", "end_pose_error_pct", "ate_rmse_m",
-                        "lost_frames", "vo_ms_median", "vo_ms_p95", "match_precision",
+  for (const char* k : {"frames", "path_length_m", "end_pose_error_m", "end_pose_error_pct",
+                        "ate_rmse_m", "lost_frames", "vo_ms_median", "vo_ms_p95", "match_precision",
                         "inlier_match_precision", "rpe_distance_trans_rmse_m"})
     EXPECT_TRUE(j.contains(k)) << k;
   EXPECT_EQ(j["frames"].get<int>(), s.metrics.frames);
@@ -79,7 +80,8 @@ TEST(RunTest, SameScenarioGivesIdenticalAccuracyMetricsAndTrajectory) {
     options.progress = false;
     options.plots = false;
     harness::RunSummary s;
-    ASSERT_TRUE(harness::RunScenario(scenario, vo::OdometryOptions(), options, &s, &error)) << error;
+    ASSERT_TRUE(harness::RunScenario(scenario, vo::OdometryOptions(), options, &s, &error))
+        << error;
     std::ifstream in(options.out_dir + "/trajectory_tum.txt");
     traj[k].assign(std::istreambuf_iterator<char>(in), {});
     metrics[k] = ReadJson(options.out_dir + "/metrics.json");
@@ -110,9 +112,11 @@ TEST(RunTest, RefusesToReplaceAFolderThatIsNotARun) {
 TEST(VoConfigTest, RoundTripAndErrors) {
   vo::OdometryOptions o;
   std::string error;
-  ASSERT_TRUE(harness::ParseVoConfig("matcher:\n  type: ncc_mutual\n  svd:\n    sigma_px: 14\n"
-                                     "use_bundle_adjustment: false\nba_window_frames: 7\n",
-                                     "cfg.yaml", &o, &error)) << error;
+  ASSERT_TRUE(
+      harness::ParseVoConfig("matcher:\n  type: ncc_mutual\n  svd:\n    sigma_px: 14\n"
+                             "use_bundle_adjustment: false\nba_window_frames: 7\n",
+                             "cfg.yaml", &o, &error))
+      << error;
   EXPECT_EQ(o.matcher.type, vo::MatcherType::kNccMutual);
   EXPECT_DOUBLE_EQ(o.matcher.svd.sigma_px, 14);
   EXPECT_FALSE(o.use_bundle_adjustment);
@@ -130,10 +134,12 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   const std::string effective = harness::VoConfigToYaml(o);
   for (const char* top : {"\nba:", "\ndisparity:", "\nmatcher:", "\ndetector:", "\nransac:"}) {
     const size_t first = effective.find(top);
-    EXPECT_EQ(effective.find(top, first + 1), std::string::npos) << top << " twice in\n" << effective;
+    EXPECT_EQ(effective.find(top, first + 1), std::string::npos) << top << " twice in\n"
+                                                                 << effective;
   }
   vo::OdometryOptions again;
-  ASSERT_TRUE(harness::ParseVoConfig(harness::VoConfigToYaml(o), "effective.yaml", &again, &error)) << error;
+  ASSERT_TRUE(harness::ParseVoConfig(harness::VoConfigToYaml(o), "effective.yaml", &again, &error))
+      << error;
   EXPECT_EQ(harness::VoConfigToYaml(again), harness::VoConfigToYaml(o));
   EXPECT_EQ(again.ba.max_num_iterations, 7);
   EXPECT_EQ(again.ba.loss_scale_px, 2.5);
@@ -147,7 +153,8 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   EXPECT_NE(error.find("matcher.typo"), std::string::npos) << error;
   EXPECT_FALSE(harness::ParseVoConfig("ba_window_frames: 11\n", "cfg.yaml", &bad, &error));
   EXPECT_NE(error.find("ba_window_frames"), std::string::npos) << error;
-  EXPECT_FALSE(harness::ParseVoConfig("ransac:\n  inlier_threshold_px: .nan\n", "cfg.yaml", &bad, &error));
+  EXPECT_FALSE(
+      harness::ParseVoConfig("ransac:\n  inlier_threshold_px: .nan\n", "cfg.yaml", &bad, &error));
   EXPECT_FALSE(harness::ParseVoConfig("matcher:\n  type: magic\n", "cfg.yaml", &bad, &error));
   EXPECT_FALSE(harness::ParseVoConfig("use_bundle_adjustment: maybe\n", "cfg.yaml", &bad, &error));
   EXPECT_FALSE(harness::ParseVoConfig("a: [1\n", "cfg.yaml", &bad, &error));

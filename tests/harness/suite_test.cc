@@ -13,14 +13,13 @@
 #include <set>
 #include <sstream>
 
-#include "tests/sim/sim_test_util.h"
-
 #include "tests/harness/cli_test_util.h"
+#include "tests/sim/sim_test_util.h"
 
 namespace {
 
-using vobench_test::RunVobench;
 using vobench_test::ReadAll;
+using vobench_test::RunVobench;
 
 namespace fs = std::filesystem;
 using vobench_test::TempDir;

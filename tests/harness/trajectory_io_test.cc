@@ -240,7 +240,8 @@ TEST_F(TrajectoryIoTest, TimeStampsThatGoBackwardsOrRepeatAreRefusedWithFileAndL
                                     "2.0 0 0 0 0 0 0 1\n"
                                     "1.5 0 0 0 0 0 0 1\n");
   EXPECT_FALSE(ReadTum(tum, &poses, &error));
-  EXPECT_THAT(error, HasSubstr(tum + ":3: time stamp 1.5 is before the previous one, 2.0 (line 2)"));
+  EXPECT_THAT(error,
+              HasSubstr(tum + ":3: time stamp 1.5 is before the previous one, 2.0 (line 2)"));
 }
 
 TEST_F(TrajectoryIoTest, WriteRejectsNonFiniteAndUnwritablePaths) {

@@ -14,7 +14,6 @@
 
 #include "harness/dataset.h"
 #include "harness/trajectory_io.h"
-
 #include "tests/harness/cli_test_util.h"
 
 namespace harness {

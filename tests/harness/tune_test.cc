@@ -17,15 +17,14 @@
 #include "harness/render.h"
 #include "harness/run.h"
 #include "harness/vo_config.h"
-#include "tests/sim/sim_test_util.h"
-
 #include "tests/harness/cli_test_util.h"
+#include "tests/sim/sim_test_util.h"
 
 namespace {
 
-using vobench_test::RunVobench;
 using vobench_test::CommandResult;
 using vobench_test::ReadAll;
+using vobench_test::RunVobench;
 
 namespace fs = std::filesystem;
 using harness::Evaluation;

@@ -7,13 +7,14 @@
 // the test fails until the field is registered in harness/vo_config.cc (or listed as internal
 // here, with the reason) and the recorded size and count are updated. (A small field that
 // fits in a struct's tail padding leaves its size unchanged: the size is a guard, not a proof.)
+#include "harness/vo_config.h"
+
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
 #include <map>
 #include <string>
 
-#include "harness/vo_config.h"
 #include "vo/odometry.h"
 
 namespace {

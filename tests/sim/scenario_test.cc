@@ -1,12 +1,12 @@
 // Scenario files: the shipped ones load; every malformed input is refused with a message that
 // names the file, the key (and line) and what was expected.
 #include "sim/scenario.h"
-#include "sim/simulator.h"
-
-#include <cmath>
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "sim/simulator.h"
 #include "sim_test_util.h"
 
 namespace {
@@ -116,7 +116,8 @@ TEST_F(ScenarioFileTest, SectionThatIsNotAMappingIsRefused) {
     for (const char* value : {"\n  speed_mps:lookahead 0.4", " [1, 2]", " 3"}) {
       SCOPED_TRACE(std::string(section) + ":" + value);
       std::string e;
-      const std::string yaml = std::string("scene: scene.xml\npath: [[0, 0], [2, 0]]\n") + section + ":" + value + "\n";
+      const std::string yaml =
+          std::string("scene: scene.xml\npath: [[0, 0], [2, 0]]\n") + section + ":" + value + "\n";
       EXPECT_NO_THROW(e = Load(yaml));
       EXPECT_NE(e.find(std::string("'") + section + "'"), std::string::npos) << e;
       EXPECT_NE(e.find("expected a mapping"), std::string::npos) << e;
@@ -159,7 +160,8 @@ TEST_F(ScenarioFileTest, DuplicateKeysAreRefusedWithBothLines) {
   EXPECT_NE(Load(Replace("rate_hz: 10", "rate_hz: 10\nrate_hz: 20"))
                 .find("s.yaml:5: key 'rate_hz': duplicate (first at line 4)"),
             std::string::npos);
-  const std::string e = Load(Replace("  baseline_m: 0.12", "  baseline_m: 0.12\n  baseline_m: 0.5"));
+  const std::string e =
+      Load(Replace("  baseline_m: 0.12", "  baseline_m: 0.12\n  baseline_m: 0.5"));
   EXPECT_NE(e.find("s.yaml:10: key 'camera.baseline_m': duplicate (first at line 9)"),
             std::string::npos)
       << e;
@@ -191,8 +193,7 @@ TEST_F(ScenarioFileTest, MotionBlurMustFitTheFramePeriodWithBoundedSamples) {
   EXPECT_EQ(Load(Replace("  pixel_sigma: 1.0", "  motion_blur_exposure_s: 0.096")), "");
   const std::string samples = Load(Replace(
       "  pixel_sigma: 1.0", "  motion_blur_exposure_s: 0.03\n  motion_blur_samples: 100000000"));
-  EXPECT_NE(samples.find("key 'noise.motion_blur_samples': expected 1 .. 1000"),
-            std::string::npos)
+  EXPECT_NE(samples.find("key 'noise.motion_blur_samples': expected 1 .. 1000"), std::string::npos)
       << samples;
 }
 
@@ -239,8 +240,10 @@ TEST_F(ScenarioFileTest, PathThroughAWallIsRefusedNamingTheWaypoint) {
 
 TEST_F(ScenarioFileTest, OutOfRangeValues) {
   EXPECT_NE(Load(Replace("rate_hz: 10", "rate_hz: 0")), "");
-  EXPECT_NE(Load(Replace("  baseline_m: 0.12", "  width: 8")).find("'camera.width'"), std::string::npos);
-  EXPECT_NE(Load(Replace("name: t", "name: t\nrobot:\n  corner_mode: drift")).find("corner_mode"), std::string::npos);
+  EXPECT_NE(Load(Replace("  baseline_m: 0.12", "  width: 8")).find("'camera.width'"),
+            std::string::npos);
+  EXPECT_NE(Load(Replace("name: t", "name: t\nrobot:\n  corner_mode: drift")).find("corner_mode"),
+            std::string::npos);
 }
 
 }  // namespace

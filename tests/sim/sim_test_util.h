@@ -1,11 +1,11 @@
 // Helpers for simulator tests: temporary scene folders with inline MJCF.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "sim/scenario.h"
 
@@ -43,16 +43,19 @@ inline std::string WriteScene(const TempDir& dir, const std::string& worldbody_x
                              dir / "robot_p2dx.xml",
                              std::filesystem::copy_options::overwrite_existing);
   const std::string scene = dir / "scene.xml";
-  WriteText(scene, "<mujoco model='test'>\n"
-                   "  <option timestep='0.002' integrator='implicit'/>\n"
-                   "  <statistic extent='1'/>\n"
-                   "  <visual><headlight active='0' ambient='0 0 0' diffuse='0 0 0' specular='0 0 0'/>"
-                   "<map znear='0.02' zfar='40'/></visual>\n"
-                   "  <asset>" + assets_xml + "</asset>\n"
-                   "  <include file='robot_p2dx.xml'/>\n"
-                   "  <worldbody>\n"
-                   "    <geom name='physics_floor' type='plane' size='0 0 1' group='3'/>\n" +
-                       worldbody_xml + "  </worldbody>\n</mujoco>\n");
+  WriteText(scene,
+            "<mujoco model='test'>\n"
+            "  <option timestep='0.002' integrator='implicit'/>\n"
+            "  <statistic extent='1'/>\n"
+            "  <visual><headlight active='0' ambient='0 0 0' diffuse='0 0 0' specular='0 0 0'/>"
+            "<map znear='0.02' zfar='40'/></visual>\n"
+            "  <asset>" +
+                assets_xml +
+                "</asset>\n"
+                "  <include file='robot_p2dx.xml'/>\n"
+                "  <worldbody>\n"
+                "    <geom name='physics_floor' type='plane' size='0 0 1' group='3'/>\n" +
+                worldbody_xml + "  </worldbody>\n</mujoco>\n");
   return scene;
 }
 

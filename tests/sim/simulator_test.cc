@@ -2,9 +2,9 @@
 // robot drives the paper's L through the physics; renders are deterministic.
 #include "sim/simulator.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
 #include "sim_test_util.h"
@@ -16,21 +16,22 @@ using vobench_test::MakeScenario;
 using vobench_test::TempDir;
 using vobench_test::WriteScene;
 
-constexpr double kProjectionTolPx = 0.3;     // the bound for marker reprojection
-constexpr double kMarkerDepthTolM = 0.01;    // depth of the marker's front surface vs GT
+constexpr double kProjectionTolPx = 0.3;   // the bound for marker reprojection
+constexpr double kMarkerDepthTolM = 0.01;  // depth of the marker's front surface vs GT
 constexpr double kMarkerRadiusM = 0.03;
 
 // Small self-lit white spheres at known world points in an otherwise black, empty scene.
-const std::vector<Eigen::Vector3d> kMarkers = {
-    {2.0, 0.0, 1.0},  {2.5, 0.6, 1.3},  {1.6, -0.5, 0.7}, {3.0, -0.9, 1.5},
-    {2.2, 0.45, 0.6}, {1.8, 0.3, 1.25}, {2.8, 0.0, 0.45}, {2.4, -0.7, 1.1}};
+const std::vector<Eigen::Vector3d> kMarkers = {{2.0, 0.0, 1.0},  {2.5, 0.6, 1.3},  {1.6, -0.5, 0.7},
+                                               {3.0, -0.9, 1.5}, {2.2, 0.45, 0.6}, {1.8, 0.3, 1.25},
+                                               {2.8, 0.0, 0.45}, {2.4, -0.7, 1.1}};
 
 std::string MarkerXml() {
   std::string xml;
   for (const auto& p : kMarkers) {
     char buf[256];
     std::snprintf(buf, sizeof(buf),
-                  "    <geom type='sphere' size='%g' pos='%g %g %g' material='marker' contype='0' conaffinity='0'/>\n",
+                  "    <geom type='sphere' size='%g' pos='%g %g %g' material='marker' contype='0' "
+                  "conaffinity='0'/>\n",
                   kMarkerRadiusM, p.x(), p.y(), p.z());
     xml += buf;
   }
@@ -64,7 +65,8 @@ struct ProjectionCase {
 };
 
 void PrintTo(const ProjectionCase& c, std::ostream* os) {
-  *os << c.width << "x" << c.height << " fovy " << c.fovy_deg << " pitch " << c.pitch_deg << " baseline " << c.baseline_m;
+  *os << c.width << "x" << c.height << " fovy " << c.fovy_deg << " pitch " << c.pitch_deg
+      << " baseline " << c.baseline_m;
 }
 
 class ProjectionTest : public ::testing::TestWithParam<ProjectionCase> {};
@@ -72,8 +74,8 @@ class ProjectionTest : public ::testing::TestWithParam<ProjectionCase> {};
 TEST_P(ProjectionTest, MarkersLandWhereCalibrationAndPoseProjectThem) {
   const ProjectionCase pc = GetParam();
   TempDir dir("proj");
-  const std::string scene = WriteScene(dir, MarkerXml(),
-                                       "<material name='marker' rgba='1 1 1 1' emission='1'/>");
+  const std::string scene =
+      WriteScene(dir, MarkerXml(), "<material name='marker' rgba='1 1 1 1' emission='1'/>");
   sim::Scenario s = MakeScenario(scene);
   s.camera.width = pc.width;
   s.camera.height = pc.height;
@@ -100,7 +102,8 @@ TEST_P(ProjectionTest, MarkersLandWhereCalibrationAndPoseProjectThem) {
     for (const auto& p_world : kMarkers) {
       const Eigen::Vector3d p = T_cam_world * p_world;
       ASSERT_GT(p.z(), 0.5);
-      const Eigen::Vector2d uv(cal.fx_px * p.x() / p.z() + cal.cx_px, cal.fy_px * p.y() / p.z() + cal.cy_px);
+      const Eigen::Vector2d uv(cal.fx_px * p.x() / p.z() + cal.cx_px,
+                               cal.fy_px * p.y() / p.z() + cal.cy_px);
       if (uv.x() < 8 || uv.y() < 8 || uv.x() > pc.width - 9 || uv.y() > pc.height - 9) continue;
       double best = 1e9;
       for (const auto& b : blobs) best = std::min(best, (b - uv).norm());
@@ -215,7 +218,8 @@ TEST(SimulatorTest, SceneErrorsNameTheFile) {
   EXPECT_NE(error.find(broken), std::string::npos) << error;
   // Valid MJCF without the robot.
   const std::string empty = dir / "empty.xml";
-  vobench_test::WriteText(empty, "<mujoco><worldbody><geom type='plane' size='1 1 1'/></worldbody></mujoco>");
+  vobench_test::WriteText(
+      empty, "<mujoco><worldbody><geom type='plane' size='1 1 1'/></worldbody></mujoco>");
   s = MakeScenario(empty);
   EXPECT_EQ(sim::Simulator::Create(s, &error), nullptr);
   EXPECT_NE(error.find(empty), std::string::npos) << error;
@@ -227,9 +231,10 @@ TEST(SimulatorTest, SceneErrorsNameTheFile) {
 TEST(SimulatorTest, PathThroughAWallIsRefusedBeforeSimulating) {
   TempDir dir("wall");
   // A 2 m wide, 2.5 m high wall across the x axis at x = 0.5 (normal along -x).
-  const std::string scene = WriteScene(
-      dir, "    <geom name='blocker' type='plane' size='1 1.25 0.1' pos='0.5 0 1.25' "
-           "xyaxes='0 1 0 0 0 1' contype='0' conaffinity='0'/>\n");
+  const std::string scene =
+      WriteScene(dir,
+                 "    <geom name='blocker' type='plane' size='1 1.25 0.1' pos='0.5 0 1.25' "
+                 "xyaxes='0 1 0 0 0 1' contype='0' conaffinity='0'/>\n");
   std::string error;
   EXPECT_EQ(sim::Simulator::Create(MakeScenario(scene, 1.0), &error), nullptr);
   EXPECT_NE(error.find("key 'path[1]'"), std::string::npos) << error;

@@ -234,8 +234,10 @@ TEST(DisparityAtPixelsTest, EqualsTheDenseMapOnMiddlebury) {
     const std::string dir = vobench_test::SharedDataDir() + "/middlebury/" + name;
     if (!IsDirectory(dir)) continue;
     const bool tsukuba = std::string(name) == "tsukuba";
-    const cv::Mat left = cv::imread(dir + (tsukuba ? "/im3.png" : "/im2.png"), cv::IMREAD_GRAYSCALE);
-    const cv::Mat right = cv::imread(dir + (tsukuba ? "/im4.png" : "/im6.png"), cv::IMREAD_GRAYSCALE);
+    const cv::Mat left =
+        cv::imread(dir + (tsukuba ? "/im3.png" : "/im2.png"), cv::IMREAD_GRAYSCALE);
+    const cv::Mat right =
+        cv::imread(dir + (tsukuba ? "/im4.png" : "/im6.png"), cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(left.empty() || right.empty()) << "unreadable images in " << dir;
     DisparityOptions o = OneVolumeNoSpeckle();
     o.num_disparities = 32;

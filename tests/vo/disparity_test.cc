@@ -378,8 +378,8 @@ TEST(DisparityTest, EstimatorIsReusableAndDeterministic) {
 // from the same cost volume gives the same left-right check as StereoBM on the mirrored pair.
 TEST(DisparityTest, OneVolumeMatcherAgreesWithStereoBm) {
   // Fractions of the pixels valid in both results (measured: see the printout).
-  constexpr double kMinSameLeftView = 0.99;    // identical 1/16 px values, checks off
-  constexpr double kMinSameValidity = 0.98;    // same valid/invalid decision, all filters on
+  constexpr double kMinSameLeftView = 0.99;  // identical 1/16 px values, checks off
+  constexpr double kMinSameValidity = 0.98;  // same valid/invalid decision, all filters on
   const SyntheticPair p = PlanarPair(6.3, 0.02, 0.015, 11);
   for (bool lr_check : {false, true}) {
     DisparityOptions bm;
@@ -405,10 +405,11 @@ TEST(DisparityTest, OneVolumeMatcherAgreesWithStereoBm) {
       }
     }
     const double total = static_cast<double>(kWidth) * kHeight;
-    std::printf("[ one volume vs StereoBM, lr check %d ] valid %d / %d, same value %.4f, "
-                "same validity %.4f\n",
-                lr_check, b.num_valid, a.num_valid, static_cast<double>(same) / both,
-                same_validity / total);
+    std::printf(
+        "[ one volume vs StereoBM, lr check %d ] valid %d / %d, same value %.4f, "
+        "same validity %.4f\n",
+        lr_check, b.num_valid, a.num_valid, static_cast<double>(same) / both,
+        same_validity / total);
     ASSERT_GT(both, 0.5 * total);
     if (!lr_check) {
       EXPECT_GT(static_cast<double>(same) / both, kMinSameLeftView);
@@ -425,7 +426,8 @@ TEST(DisparityOptionsTest, OneVolumeRejectsWindowsThatOverflowItsCosts) {
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_NE(error.find("block_size"), std::string::npos) << error;
   EXPECT_FALSE(ComputeDisparity(cv::Mat(64, 64, CV_8UC1, cv::Scalar(0)),
-                                cv::Mat(64, 64, CV_8UC1, cv::Scalar(0)), o).ok);
+                                cv::Mat(64, 64, CV_8UC1, cv::Scalar(0)), o)
+                   .ok);
 }
 
 // ------------------------------------------------------------------------------------------

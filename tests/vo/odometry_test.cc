@@ -1003,8 +1003,7 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
   rejects([](OdometryOptions* o) { o->disparity.algorithm = DisparityAlgorithm::kBlockMatching; },
           "disparity_mode at_features needs disparity.algorithm block_matching_one_volume");
   rejects([](OdometryOptions* o) { o->disparity_range_margin = -0.1; }, "disparity_range_margin");
-  rejects([](OdometryOptions* o) { o->disparity_range_margin_px = NAN; },
-          "disparity_range_margin");
+  rejects([](OdometryOptions* o) { o->disparity_range_margin_px = NAN; }, "disparity_range_margin");
   rejects(
       [](OdometryOptions* o) {
         o->derive_num_disparities = false;

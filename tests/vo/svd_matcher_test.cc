@@ -2,7 +2,6 @@
 // exactness of the component decomposition, sparse vs dense agreement, the size guard.
 #include "vo/svd_matcher.h"
 
-#include "tests/synthetic_images.h"
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,6 +13,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "tests/synthetic_images.h"
 
 namespace vo {
 namespace {
@@ -360,17 +361,17 @@ CoherenceScene MakeCoherenceScene(const Eigen::Vector2d& motion) {
 TEST(CoherenceTest, DropsTheMatchesThatMoveUnlikeTheirNeighbours) {
   const CoherenceScene s = MakeCoherenceScene(Eigen::Vector2d(7.0, -3.0));
   int rejected = -1;
-  const std::vector<Match> kept =
-      RejectIncoherentMatches(s.prev, s.curr, MatchPrediction(), s.matches, 60.0, 6, 3.0, &rejected);
+  const std::vector<Match> kept = RejectIncoherentMatches(s.prev, s.curr, MatchPrediction(),
+                                                          s.matches, 60.0, 6, 3.0, &rejected);
   EXPECT_EQ(rejected, 2);
   ASSERT_EQ(kept.size(), 34u);
   for (const Match& m : kept) EXPECT_EQ(m.prev, m.curr);  // only the true pairs, in order
   for (size_t k = 1; k < kept.size(); ++k) EXPECT_LT(kept[k - 1].prev, kept[k].prev);
   // A tolerance above the decoys' 6 px keeps everything.
-  EXPECT_EQ(RejectIncoherentMatches(s.prev, s.curr, MatchPrediction(), s.matches, 60.0, 6, 6.5,
-                                    &rejected)
-                .size(),
-            36u);
+  EXPECT_EQ(
+      RejectIncoherentMatches(s.prev, s.curr, MatchPrediction(), s.matches, 60.0, 6, 6.5, &rejected)
+          .size(),
+      36u);
   EXPECT_EQ(rejected, 0);
 }
 
@@ -382,8 +383,8 @@ TEST(CoherenceTest, MeasuresDisplacementsFromThePredictionAndKeepsLoneMatches) {
   MatchPrediction off;
   for (const Feature& f : s.prev) off.uv_px.push_back(f.uv_px + motion + Eigen::Vector2d(-20, 0));
   int rejected = -1;
-  std::vector<Match> kept = RejectIncoherentMatches(s.prev, s.curr, off, s.matches, 60.0, 6, 3.0,
-                                                    &rejected);
+  std::vector<Match> kept =
+      RejectIncoherentMatches(s.prev, s.curr, off, s.matches, 60.0, 6, 3.0, &rejected);
   EXPECT_EQ(rejected, 2);
   for (const Match& m : kept) EXPECT_EQ(m.prev, m.curr);
   // Neighbours farther than the radius do not count: with 20 px, every feature (30 px apart)
