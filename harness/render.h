@@ -4,21 +4,12 @@
 #include <string>
 
 #include "harness/dataset.h"
+#include "harness/sim_adapter.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 #include "vo/camera.h"
 
 namespace harness {
-
-// Resolves a scenario argument: an existing file, or the name of a scenario shipped in
-// scenes/ ("l_hallway"). Loads and validates it.
-bool ResolveScenario(const std::string& arg, sim::Scenario* scenario, std::string* error);
-
-// The simulator's calibration as the VO's camera model.
-vo::StereoCamera ToStereoCamera(const sim::StereoCalibration& calibration);
-
-// A simulated frame as a dataset frame (with ground truth and depth).
-DatasetFrame ToDatasetFrame(const sim::StereoFrame& frame);
 
 struct RenderSummary {
   int frames = 0;
