@@ -283,25 +283,24 @@ std::vector<Match> RejectIncoherentMatches(const std::vector<Feature>& prev,
                                            const std::vector<Match>& matches, double radius_px,
                                            int neighbours, double max_px, int* num_rejected) {
   const size_t n = matches.size();
-  std::vector<Eigen::Vector2d> from(n), displacement(n);
+  auto from = [&](size_t m) -> const Eigen::Vector2d& { return prev[matches[m].prev].uv_px; };
+  std::vector<Eigen::Vector2d> displacement(n);
   for (size_t m = 0; m < n; ++m) {
-    const Eigen::Vector2d& uv_prev = prev[matches[m].prev].uv_px;
-    from[m] = uv_prev;
-    displacement[m] = curr[matches[m].curr].uv_px - prediction.Centre(matches[m].prev, uv_prev);
+    displacement[m] = curr[matches[m].curr].uv_px - prediction.Centre(matches[m].prev, from(m));
   }
   // The k nearest other matches within the radius, by (squared distance, index): a sweep over
   // the matches sorted by x that stops once |dx| exceeds the k-th distance found so far.
   std::vector<int> by_x(n);
   std::iota(by_x.begin(), by_x.end(), 0);
   std::sort(by_x.begin(), by_x.end(), [&](int a, int b) {
-    return from[a].x() < from[b].x() || (from[a].x() == from[b].x() && a < b);
+    return from(a).x() < from(b).x() || (from(a).x() == from(b).x() && a < b);
   });
   std::vector<double> sx(n), sy(n);  // positions in that order
   std::vector<size_t> rank(n);
   for (size_t r = 0; r < n; ++r) {
     rank[by_x[r]] = r;
-    sx[r] = from[by_x[r]].x();
-    sy[r] = from[by_x[r]].y();
+    sx[r] = from(by_x[r]).x();
+    sy[r] = from(by_x[r]).y();
   }
   std::vector<Match> kept;
   kept.reserve(n);
