@@ -329,6 +329,7 @@ void StereoOdometry::Reset() {
   has_velocity_ = false;
   scene_num_disparities_ = 0;
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
+  world_up_known_ = false;
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
   last_matches_.clear();
@@ -414,7 +415,7 @@ Eigen::Isometry3d CorrectPriorWithImageShift(const StereoCamera& camera,
 }
 
 Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, OdometryResult* result) {
-  const Eigen::Isometry3d predicted = PredictedPose(prior);
+  const Eigen::Isometry3d predicted = T_world_prev_ * BridgeMotion(prior);
   const RobustTrackingOptions& o = options_.tracking;
   if (options_.matcher.prediction == PredictionMode::kNone || !o.rotation_from_shift ||
       previous_left_.empty() || current_left_.empty() ||
@@ -431,7 +432,7 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
   // The prior's own frame-to-frame motion (not T_world_prev⁻¹ · predicted, which would feed
   // rounding in the composed poses back into the prior, frame after frame), corrected at the
   // median depth of this frame's features (last_features_; none: far away).
-  const Eigen::Isometry3d T_prev_curr_prior = PriorMotion(prior);
+  const Eigen::Isometry3d T_prev_curr_prior = BridgeMotion(prior);
   double depth_m = -1.0;
   if (!last_features_.empty()) {
     std::vector<double> z;
@@ -439,8 +440,13 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
     std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
     depth_m = z[z.size() / 2];
   }
-  const Eigen::Isometry3d T_prev_curr =
+  Eigen::Isometry3d T_prev_curr =
       CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m);
+  // A ground vehicle turns about up only: the shift's vertical part (zoom, parallax) is no tilt.
+  if (prior == nullptr && options_.tracking.ground_vehicle && world_up_known_) {
+    T_prev_curr =
+        PlanarPart(T_prev_curr, T_world_prev_.linear().transpose() * Eigen::Vector3d::UnitZ());
+  }
   if (!IsFinite(T_prev_curr)) return predicted;
   // The shift the prior itself predicts: the correction's rotation seen at the image centre.
   const double residual_px =
@@ -459,6 +465,12 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
 Eigen::Isometry3d StereoOdometry::PriorMotion(const MotionPrior* prior) const {
   if (prior != nullptr && IsFinite(prior->T_prev_curr)) return prior->T_prev_curr;
   return has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity();
+}
+
+Eigen::Isometry3d StereoOdometry::BridgeMotion(const MotionPrior* prior) const {
+  const Eigen::Isometry3d T = PriorMotion(prior);
+  if (prior != nullptr || !options_.tracking.ground_vehicle || !world_up_known_) return T;
+  return PlanarPart(T, T_world_prev_.linear().transpose() * Eigen::Vector3d::UnitZ());
 }
 
 Eigen::Isometry3d StereoOdometry::PredictedPose(const MotionPrior* prior) const {
@@ -483,6 +495,7 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
                   (orientation_result_.status == PlaneOrientationResult::Status::kNoWall &&
                    !options_.orientation_requires_wall);
   R_hall_cam0_initial_ = ok ? orientation_result_.R_hall_cam0 : Eigen::Matrix3d::Identity();
+  world_up_known_ = ok;
   return ok;
 }
 
@@ -552,6 +565,23 @@ StereoOdometry::MotionAttempt StereoOdometry::EstimateMotion(
   return a;
 }
 
+PriorMotionResult StereoOdometry::FewPointMotion(
+    const std::vector<StereoCorrespondence>& correspondences,
+    const Eigen::Isometry3d& T_ref_curr_prior, Eigen::Isometry3d* few_prior) const {
+  // A ground vehicle's motion is planar: the prior without roll, pitch and lift, and the
+  // correction about the world's up (known when the first frame's orientation found the
+  // floor), as the reference's pose puts it.
+  const Eigen::Isometry3d* T_world_ref = window_.Pose(reference_.frame_index);
+  const bool planar = options_.tracking.ground_vehicle && world_up_known_ && T_world_ref != nullptr;
+  const Eigen::Vector3d up_ref =
+      planar ? Eigen::Vector3d(T_world_ref->linear().transpose() * Eigen::Vector3d::UnitZ())
+             : Eigen::Vector3d::UnitZ();
+  *few_prior = planar ? PlanarPart(T_ref_curr_prior, up_ref) : T_ref_curr_prior;
+  const Eigen::Vector3d up_curr = few_prior->linear().transpose() * up_ref;
+  return EstimateMotionWithPrior(camera_, correspondences, *few_prior, options_.tracking.few_point,
+                                 planar ? &up_curr : nullptr);
+}
+
 StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
     const MatchFrame& frame, const Eigen::Isometry3d* T_ref_curr_prior, OdometryResult* result,
     std::string* matcher_error) {
@@ -619,7 +649,23 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
                 &attempt)) {
         return best;
       }
-      if (attempt.inliers() > best.inliers()) best = std::move(attempt);
+      if (attempt.inliers() > best.inliers()) {
+        best = std::move(attempt);
+      } else if (best.inliers() == 0 && attempt.inliers() == 0 && o.few_point_motion &&
+                 T_ref_curr_prior != nullptr) {
+        // Neither pass has a RANSAC consensus (too few features: the few-point solver will
+        // decide). The prior's pass must not win by default: a prior that lags a turn centres
+        // its gates where the features are not and picks up neighbours that agree with it.
+        // The pass whose matches support more of the few-point motion is kept.
+        Eigen::Isometry3d unused;
+        const PriorMotionResult few_best =
+            FewPointMotion(best.correspondences, *T_ref_curr_prior, &unused);
+        const PriorMotionResult few_shift =
+            FewPointMotion(attempt.correspondences, *T_ref_curr_prior, &unused);
+        if (few_shift.ok && (!few_best.ok || few_shift.num_inliers > few_best.num_inliers)) {
+          best = std::move(attempt);
+        }
+      }
     }
   }
 
@@ -664,8 +710,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
       previous_measured_ && consecutive_lost_ == 0 &&
       options_.matcher.prediction != PredictionMode::kNone && !correspondences.empty() &&
       (few_features || static_cast<int>(correspondences.size()) < options_.min_inliers)) {
-    const PriorMotionResult few =
-        EstimateMotionWithPrior(camera_, correspondences, *T_ref_curr_prior, tracking.few_point);
+    Eigen::Isometry3d few_prior;
+    const PriorMotionResult few = FewPointMotion(correspondences, *T_ref_curr_prior, &few_prior);
     bool agrees = few.ok;
     if (few.ok && result.image_shift_ok) {
       // The image shift the motions predict at the image centre (reference's median depth)
@@ -682,8 +728,7 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
       const double few_px =
           (PredictedCentreShift(camera_, few.T_prev_curr, depth_m) - result.image_shift_px).norm();
       const double prior_px =
-          (PredictedCentreShift(camera_, *T_ref_curr_prior, depth_m) - result.image_shift_px)
-              .norm();
+          (PredictedCentreShift(camera_, few_prior, depth_m) - result.image_shift_px).norm();
       agrees = few_px <= prior_px + tracking.few_point_max_shift_disagreement_px;
     }
     if (agrees) {

@@ -13,7 +13,25 @@ constexpr double kNumericStep = 1e-6;     // central-difference step of the Jaco
 constexpr double kConvergedStep = 1e-10;  // stop when |δ|² falls below this
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
+// The correction's parameters y and their map to x = (ω, v) = B · y: the identity (6
+// parameters), or the planar basis (a rotation about up, two translations across it).
+using Basis = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+// Columns of B for a ground vehicle whose up direction in the current camera frame is `up`
+// (unit): (up, 0), (0, e1), (0, e2) with e1, e2 spanning the plane perpendicular to up.
+Basis PlanarBasis(const Eigen::Vector3d& up) {
+  const Eigen::Vector3d u = up.normalized();
+  // e1: the camera's forward axis made perpendicular to up (the x axis when they are parallel).
+  Eigen::Vector3d e1 = Eigen::Vector3d::UnitZ() - u.z() * u;
+  if (e1.norm() < 1e-6) e1 = Eigen::Vector3d::UnitX() - u.x() * u;
+  e1.normalize();
+  const Eigen::Vector3d e2 = u.cross(e1);
+  Basis B = Basis::Zero(6, 3);
+  B.block<3, 1>(0, 0) = u;
+  B.block<3, 1>(3, 1) = e1;
+  B.block<3, 1>(3, 2) = e2;
+  return B;
+}
 
 // T_prior · [Exp(ω) | v] for x = (ω, v).
 Eigen::Isometry3d Corrected(const Eigen::Isometry3d& T_prior, const Vector6d& x) {
@@ -45,7 +63,8 @@ int Classify(const StereoCamera& camera, const std::vector<StereoCorrespondence>
   return n;
 }
 
-// Whitened residuals at x: per inlier (u_left, v_left, u_right) / σ_px, then ω / σ_rot, v / σ_t.
+// Whitened residuals at x: per inlier (u_left, v_left, u_right) / σ_px, then ω / σ_rot, v / σ_t
+// (the basis is orthonormal within ω and within v, so these are the parameters' own priors).
 Eigen::VectorXd Residuals(const StereoCamera& camera, const std::vector<StereoCorrespondence>& corr,
                           const std::vector<int>& inliers, const Eigen::Isometry3d& T_prior,
                           const Vector6d& x, const PriorMotionOptions& o) {
@@ -70,40 +89,41 @@ Eigen::VectorXd Residuals(const StereoCamera& camera, const std::vector<StereoCo
   return r;
 }
 
-// Gauss-Newton on x from x0 over the given inliers (a step that raises the cost is halved, at
-// most a few times, then the iteration stops).
+// Gauss-Newton on y (x = B · y) from y0 over the given inliers (a step that raises the cost is
+// halved, at most a few times, then the iteration stops). Returns x.
 Vector6d Refine(const StereoCamera& camera, const std::vector<StereoCorrespondence>& corr,
-                const std::vector<bool>& mask, const Eigen::Isometry3d& T_prior, const Vector6d& x0,
-                const PriorMotionOptions& o) {
+                const std::vector<bool>& mask, const Eigen::Isometry3d& T_prior, const Basis& B,
+                const Eigen::VectorXd& y0, const PriorMotionOptions& o) {
   std::vector<int> inliers;
   for (size_t i = 0; i < mask.size(); ++i) {
     if (mask[i]) inliers.push_back(static_cast<int>(i));
   }
-  Vector6d x = x0;
-  Eigen::VectorXd r = Residuals(camera, corr, inliers, T_prior, x, o);
+  const int k = static_cast<int>(B.cols());
+  Eigen::VectorXd y = y0;
+  Eigen::VectorXd r = Residuals(camera, corr, inliers, T_prior, B * y, o);
   double cost = r.squaredNorm();
-  Eigen::MatrixXd J(r.size(), 6);
+  Eigen::MatrixXd J(r.size(), k);
   for (int it = 0; it < o.max_iterations; ++it) {
-    for (int j = 0; j < 6; ++j) {
-      Vector6d xp = x, xm = x;
-      xp(j) += kNumericStep;
-      xm(j) -= kNumericStep;
-      J.col(j) = (Residuals(camera, corr, inliers, T_prior, xp, o) -
-                  Residuals(camera, corr, inliers, T_prior, xm, o)) /
+    for (int j = 0; j < k; ++j) {
+      Eigen::VectorXd yp = y, ym = y;
+      yp(j) += kNumericStep;
+      ym(j) -= kNumericStep;
+      J.col(j) = (Residuals(camera, corr, inliers, T_prior, B * yp, o) -
+                  Residuals(camera, corr, inliers, T_prior, B * ym, o)) /
                  (2.0 * kNumericStep);
     }
-    const Matrix6d H = J.transpose() * J;
-    const Vector6d g = J.transpose() * r;
-    const Vector6d delta = -H.ldlt().solve(g);
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::VectorXd g = J.transpose() * r;
+    const Eigen::VectorXd delta = -H.ldlt().solve(g);
     if (!delta.allFinite()) break;
     double step = 1.0;
     bool improved = false;
     for (int halving = 0; halving < 4; ++halving, step *= 0.5) {
-      const Vector6d x_new = x + step * delta;
-      const Eigen::VectorXd r_new = Residuals(camera, corr, inliers, T_prior, x_new, o);
+      const Eigen::VectorXd y_new = y + step * delta;
+      const Eigen::VectorXd r_new = Residuals(camera, corr, inliers, T_prior, B * y_new, o);
       const double cost_new = r_new.squaredNorm();
       if (cost_new <= cost) {
-        x = x_new;
+        y = y_new;
         r = r_new;
         cost = cost_new;
         improved = true;
@@ -112,8 +132,11 @@ Vector6d Refine(const StereoCamera& camera, const std::vector<StereoCorresponden
     }
     if (!improved || (step * delta).squaredNorm() < kConvergedStep) break;
   }
-  return x;
+  return B * y;
 }
+
+// The parameters y of x in the basis B (B's columns are orthonormal: y = Bᵀ x).
+Eigen::VectorXd Coordinates(const Basis& B, const Vector6d& x) { return B.transpose() * x; }
 
 }  // namespace
 
@@ -144,7 +167,8 @@ bool PriorMotionOptions::IsValid(std::string* error) const {
 PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
                                           const std::vector<StereoCorrespondence>& corr,
                                           const Eigen::Isometry3d& T_prior,
-                                          const PriorMotionOptions& o) {
+                                          const PriorMotionOptions& o,
+                                          const Eigen::Vector3d* up_curr) {
   PriorMotionResult result;
   result.T_prev_curr = T_prior;
   result.inlier_mask.assign(corr.size(), false);
@@ -157,6 +181,11 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
     result.message = "invalid input: non-finite prior";
     return result;
   }
+  if (up_curr != nullptr && (!up_curr->allFinite() || !(up_curr->norm() > 0.0))) {
+    result.message = "invalid input: up direction must be finite and non-zero";
+    return result;
+  }
+  const Basis B = up_curr != nullptr ? PlanarBasis(*up_curr) : Basis(Basis::Identity(6, 6));
   for (const StereoCorrespondence& c : corr) {
     if (!c.p_prev_cam0.allFinite() || !c.uv_curr_px.allFinite() ||
         !std::isfinite(c.disparity_curr_px)) {
@@ -178,9 +207,18 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
                             (corr[i].uv_curr_px.y() - camera.cy_px) / camera.fy_px, 1.0);
     const Eigen::Vector3d a = R_prior.transpose() * (corr[i].p_prev_cam0 - T_prior.translation());
     if (!(a.norm() > 0.0) || a.normalized().dot(b.normalized()) <= 0.0) continue;
-    const Eigen::AngleAxisd Q(Eigen::Quaterniond::FromTwoVectors(b, a));
     Vector6d x = Vector6d::Zero();
-    x.head<3>() = Q.angle() * Q.axis();
+    if (up_curr != nullptr) {
+      // Planar: the rotation about up that turns b's horizontal direction onto a's.
+      const Eigen::Vector3d u = B.block<3, 1>(0, 0);
+      const Eigen::Vector3d bh = b - b.dot(u) * u;
+      const Eigen::Vector3d ah = a - a.dot(u) * u;
+      if (!(bh.norm() > 0.0) || !(ah.norm() > 0.0)) continue;
+      x.head<3>() = std::atan2(bh.cross(ah).dot(u), bh.dot(ah)) * u;
+    } else {
+      const Eigen::AngleAxisd Q(Eigen::Quaterniond::FromTwoVectors(b, a));
+      x.head<3>() = Q.angle() * Q.axis();
+    }
     if (!x.allFinite()) continue;
     std::vector<bool> mask;
     double sq = 0.0;
@@ -198,12 +236,12 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
   }
 
   // Refine on the inliers, re-classify, refine again.
-  Vector6d x = Refine(camera, corr, best_mask, T_prior, best_x, o);
+  Vector6d x = Refine(camera, corr, best_mask, T_prior, B, Coordinates(B, best_x), o);
   std::vector<bool> mask;
   double sq = 0.0;
   int n = Classify(camera, corr, Corrected(T_prior, x), o, &mask, &sq);
   if (n >= best_n && mask != best_mask) {
-    x = Refine(camera, corr, mask, T_prior, x, o);
+    x = Refine(camera, corr, mask, T_prior, B, Coordinates(B, x), o);
     n = Classify(camera, corr, Corrected(T_prior, x), o, &mask, &sq);
   }
   if (n < best_n) {  // the refinement lost support: keep the hypothesis
@@ -230,6 +268,20 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
   }
   result.ok = true;
   return result;
+}
+
+Eigen::Isometry3d PlanarPart(const Eigen::Isometry3d& T_a_b, const Eigen::Vector3d& up_a) {
+  if (!T_a_b.matrix().allFinite() || !up_a.allFinite() || !(up_a.norm() > 0.0)) return T_a_b;
+  const Eigen::Vector3d u = up_a.normalized();
+  // Swing-twist: the twist is the quaternion's vector part projected onto the axis.
+  const Eigen::Quaterniond q(T_a_b.linear());
+  Eigen::Quaterniond twist(q.w(), 0.0, 0.0, 0.0);
+  twist.vec() = q.vec().dot(u) * u;
+  Eigen::Isometry3d P = Eigen::Isometry3d::Identity();
+  if (twist.norm() > 1e-12) P.linear() = twist.normalized().toRotationMatrix();
+  const Eigen::Vector3d t = T_a_b.translation();
+  P.translation() = t - t.dot(u) * u;
+  return P;
 }
 
 }  // namespace vo

@@ -12,7 +12,10 @@ import sys
 CONFIGS = [("default", "svd_ncc_gabor, prediction: motion_prior (the library default)"),
            ("paper", "svd_ncc_gabor, prediction: none (the paper as published)"),
            ("lucas_kanade", "lucas_kanade, prediction: motion_prior"),
-           ("ncc_mutual", "ncc_mutual, prediction: motion_prior")]
+           ("ncc_mutual", "ncc_mutual, prediction: motion_prior"),
+           ("few_point", "svd_ncc_gabor, tracking.few_point_motion: true"),
+           ("few_point_ground", "svd_ncc_gabor, tracking.few_point_motion: true, "
+            "ground_vehicle: true")]
 KEYS = ["end_pose_error_m", "end_pose_error_pct", "ate_rmse_m", "lost_frames",
         "reinitialisations", "vo_ms_median"]
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Robustness sweep of issue #9, the figures in results/robustness/summary.md: l_hallway with
 # texture seeds 1-10 (only textures.seed changed) x frame strides 1, 2, 3, 5 (and 8 on seed 7)
-# x four VO configurations, plus camera.pitch_deg 10, a 640x480 camera (same field of view) and
+# x six VO configurations, plus camera.pitch_deg 10, a 640x480 camera (same field of view) and
 # the low-texture plain_corridor scene at strides 1, 2, 3, 5.
 # Each hallway is rendered once (vobench render, KITTI layout) and every run reads the same
 # frames (vobench run --dataset --stride), which gives the same trajectories as simulating each
@@ -37,8 +37,13 @@ printf 'matcher:\n  type: svd_ncc_gabor\n' > "$WORK/default.yaml"
 printf 'matcher:\n  type: svd_ncc_gabor\n  prediction: none\nreinit_after_lost_frames: 1\n' > "$WORK/paper.yaml"
 printf 'matcher:\n  type: lucas_kanade\n' > "$WORK/lucas_kanade.yaml"
 printf 'matcher:\n  type: ncc_mutual\n' > "$WORK/ncc_mutual.yaml"
+# The plain-wall options (off by default; README, "Robust tracking"): few-point motion, alone and
+# with the ground-vehicle (planar) constraint.
+printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n' > "$WORK/few_point.yaml"
+printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n' \
+  > "$WORK/few_point_ground.yaml"
 runs=()
-for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual}; do
+for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual few_point few_point_ground}; do
   for s in 1 2 3 4 5 6 7 8 9 10; do for k in 1 2 3 5; do runs+=("seed$s $k $c"); done; done
   runs+=("seed7 8 $c" "pitch10 1 $c" "vga 1 $c")
   for k in 1 2 3 5; do runs+=("corridor $k $c"); done
