@@ -686,6 +686,31 @@ TEST(OdometryLostTest, SeveralBlackFramesAreBridged) {
               IsNearPose(TrueMotionFromFirst(11), 1.0 * kDeg, 0.03));
 }
 
+// Ground vehicle: the constant-velocity bridge of black frames is planar about the world's up
+// (found on the first frame's floor): no roll, no pitch, no lift, exactly; the yaw and the
+// forward motion are the prior's. The end pose stays as close to the truth as without it.
+TEST(OdometryLostTest, GroundVehicleBridgesBlackFramesInThePlane) {
+  OdometryOptions options;
+  options.tracking.ground_vehicle = true;
+  const std::vector<OdometryResult> results = RunCorridor(options, {4, 5, 6});
+  ASSERT_TRUE(results[0].initial_orientation_ok);
+  for (int i : {4, 5, 6}) {
+    ASSERT_EQ(results[i].status, TrackingStatus::kLost);
+    const Eigen::Vector3d up_prev =
+        results[i - 1].T_world_cam0.linear().transpose() * Eigen::Vector3d::UnitZ();
+    const Eigen::Isometry3d& step = results[i].T_prev_curr;
+    const Eigen::AngleAxisd aa(step.linear());
+    EXPECT_LT(aa.angle() * aa.axis().cross(up_prev).norm(), 1e-9) << "frame " << i;
+    EXPECT_NEAR(step.translation().dot(up_prev), 0.0, 1e-9) << "frame " << i;
+    EXPECT_NEAR(results[i].T_world_cam0.translation().z(),
+                results[i - 1].T_world_cam0.translation().z(), 1e-9)
+        << "frame " << i;
+  }
+  EXPECT_EQ(results[7].status, TrackingStatus::kRecovered) << results[7].message;
+  EXPECT_THAT(EstimatedMotionFromFirst(results, 11),
+              IsNearPose(TrueMotionFromFirst(11), 1.0 * kDeg, 0.03));
+}
+
 // ---- (3b) Predicted matching, coarse-to-fine search, counting --------------------------------
 
 // A turn in place with a stop: 1 cm per frame forward, no rotation for frames 1-2, then 7° per
