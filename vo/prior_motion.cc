@@ -17,14 +17,19 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 // parameters), or the planar basis (a rotation about up, two translations across it).
 using Basis = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
+// The horizontal forward axis of a camera whose up direction is u (unit): its z axis made
+// perpendicular to u (its x axis when they are parallel).
+Eigen::Vector3d HorizontalForward(const Eigen::Vector3d& u) {
+  Eigen::Vector3d e1 = Eigen::Vector3d::UnitZ() - u.z() * u;
+  if (e1.norm() < 1e-6) e1 = Eigen::Vector3d::UnitX() - u.x() * u;
+  return e1.normalized();
+}
+
 // Columns of B for a ground vehicle whose up direction in the current camera frame is `up`
 // (unit): (up, 0), (0, e1), (0, e2) with e1, e2 spanning the plane perpendicular to up.
 Basis PlanarBasis(const Eigen::Vector3d& up) {
   const Eigen::Vector3d u = up.normalized();
-  // e1: the camera's forward axis made perpendicular to up (the x axis when they are parallel).
-  Eigen::Vector3d e1 = Eigen::Vector3d::UnitZ() - u.z() * u;
-  if (e1.norm() < 1e-6) e1 = Eigen::Vector3d::UnitX() - u.x() * u;
-  e1.normalize();
+  const Eigen::Vector3d e1 = HorizontalForward(u);
   const Eigen::Vector3d e2 = u.cross(e1);
   Basis B = Basis::Zero(6, 3);
   B.block<3, 1>(0, 0) = u;
@@ -33,15 +38,31 @@ Basis PlanarBasis(const Eigen::Vector3d& up) {
   return B;
 }
 
-// T_prior · [Exp(ω) | v] for x = (ω, v).
-Eigen::Isometry3d Corrected(const Eigen::Isometry3d& T_prior, const Vector6d& x) {
-  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
-  const Eigen::Vector3d w = x.head<3>();
-  const double angle = w.norm();
-  if (angle > 0.0) D.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-  D.translation() = x.tail<3>();
-  return T_prior * D;
-}
+// The motions searched, x = B · y. Without a vehicle: the prior corrected,
+// T_prior · [Exp(ω) | v] (6-DoF, or planar with the planar basis). With one: the vehicle's
+// motion of yaw yaw0 + u·ω and forward distance forward0 + e1·v (VehicleMotion), where
+// (yaw0, forward0) are the prior's.
+struct Model {
+  Eigen::Isometry3d T_prior = Eigen::Isometry3d::Identity();
+  Basis B;
+  bool vehicle = false;
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  Eigen::Vector3d forward = Eigen::Vector3d::Zero();
+  double axle_m = 0.0, yaw0 = 0.0, forward0 = 0.0;
+
+  Eigen::Isometry3d At(const Vector6d& x) const {
+    if (vehicle) {
+      return VehicleMotion(up, axle_m, yaw0 + x.head<3>().dot(up),
+                           forward0 + x.tail<3>().dot(forward));
+    }
+    Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+    const Eigen::Vector3d w = x.head<3>();
+    const double angle = w.norm();
+    if (angle > 0.0) D.linear() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+    D.translation() = x.tail<3>();
+    return T_prior * D;
+  }
+};
 
 // Inliers of T_prev_curr (both image errors <= threshold) and their squared-error sum.
 int Classify(const StereoCamera& camera, const std::vector<StereoCorrespondence>& corr,
@@ -66,10 +87,10 @@ int Classify(const StereoCamera& camera, const std::vector<StereoCorrespondence>
 // Whitened residuals at x: per inlier (u_left, v_left, u_right) / σ_px, then ω / σ_rot, v / σ_t
 // (the basis is orthonormal within ω and within v, so these are the parameters' own priors).
 Eigen::VectorXd Residuals(const StereoCamera& camera, const std::vector<StereoCorrespondence>& corr,
-                          const std::vector<int>& inliers, const Eigen::Isometry3d& T_prior,
-                          const Vector6d& x, const PriorMotionOptions& o) {
+                          const std::vector<int>& inliers, const Model& model, const Vector6d& x,
+                          const PriorMotionOptions& o) {
   Eigen::VectorXd r(3 * inliers.size() + 6);
-  const Eigen::Isometry3d T_curr_prev = Corrected(T_prior, x).inverse();
+  const Eigen::Isometry3d T_curr_prev = model.At(x).inverse();
   const double inv_px = 1.0 / o.measurement_sigma_px;
   for (size_t k = 0; k < inliers.size(); ++k) {
     Eigen::Vector2d el, er;
@@ -92,15 +113,16 @@ Eigen::VectorXd Residuals(const StereoCamera& camera, const std::vector<StereoCo
 // Gauss-Newton on y (x = B · y) from y0 over the given inliers (a step that raises the cost is
 // halved, at most a few times, then the iteration stops). Returns x.
 Vector6d Refine(const StereoCamera& camera, const std::vector<StereoCorrespondence>& corr,
-                const std::vector<bool>& mask, const Eigen::Isometry3d& T_prior, const Basis& B,
-                const Eigen::VectorXd& y0, const PriorMotionOptions& o) {
+                const std::vector<bool>& mask, const Model& model, const Eigen::VectorXd& y0,
+                const PriorMotionOptions& o) {
+  const Basis& B = model.B;
   std::vector<int> inliers;
   for (size_t i = 0; i < mask.size(); ++i) {
     if (mask[i]) inliers.push_back(static_cast<int>(i));
   }
   const int k = static_cast<int>(B.cols());
   Eigen::VectorXd y = y0;
-  Eigen::VectorXd r = Residuals(camera, corr, inliers, T_prior, B * y, o);
+  Eigen::VectorXd r = Residuals(camera, corr, inliers, model, B * y, o);
   double cost = r.squaredNorm();
   Eigen::MatrixXd J(r.size(), k);
   for (int it = 0; it < o.max_iterations; ++it) {
@@ -108,8 +130,8 @@ Vector6d Refine(const StereoCamera& camera, const std::vector<StereoCorresponden
       Eigen::VectorXd yp = y, ym = y;
       yp(j) += kNumericStep;
       ym(j) -= kNumericStep;
-      J.col(j) = (Residuals(camera, corr, inliers, T_prior, B * yp, o) -
-                  Residuals(camera, corr, inliers, T_prior, B * ym, o)) /
+      J.col(j) = (Residuals(camera, corr, inliers, model, B * yp, o) -
+                  Residuals(camera, corr, inliers, model, B * ym, o)) /
                  (2.0 * kNumericStep);
     }
     const Eigen::MatrixXd H = J.transpose() * J;
@@ -120,7 +142,7 @@ Vector6d Refine(const StereoCamera& camera, const std::vector<StereoCorresponden
     bool improved = false;
     for (int halving = 0; halving < 4; ++halving, step *= 0.5) {
       const Eigen::VectorXd y_new = y + step * delta;
-      const Eigen::VectorXd r_new = Residuals(camera, corr, inliers, T_prior, B * y_new, o);
+      const Eigen::VectorXd r_new = Residuals(camera, corr, inliers, model, B * y_new, o);
       const double cost_new = r_new.squaredNorm();
       if (cost_new <= cost) {
         y = y_new;
@@ -158,6 +180,8 @@ bool PriorMotionOptions::IsValid(std::string* error) const {
     msg << "max_iterations must be >= 1, got " << max_iterations;
   } else if (!(min_depth_m > 0.0) || !std::isfinite(min_depth_m)) {
     msg << "min_depth_m must be finite and > 0, got " << min_depth_m;
+  } else if (!std::isfinite(axle_behind_camera_m)) {
+    msg << "axle_behind_camera_m must be finite, got " << axle_behind_camera_m;
   }
   if (msg.tellp() == 0) return true;
   if (error) *error = msg.str();
@@ -185,7 +209,21 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
     result.message = "invalid input: up direction must be finite and non-zero";
     return result;
   }
-  const Basis B = up_curr != nullptr ? PlanarBasis(*up_curr) : Basis(Basis::Identity(6, 6));
+  Model model;
+  model.T_prior = T_prior;
+  model.B = up_curr != nullptr ? PlanarBasis(*up_curr) : Basis(Basis::Identity(6, 6));
+  if (up_curr != nullptr && o.no_sideways_slip) {
+    // A wheeled vehicle: yaw and forward distance only, from the prior's.
+    model.vehicle = true;
+    model.up = up_curr->normalized();
+    model.forward = HorizontalForward(model.up);
+    model.axle_m = o.axle_behind_camera_m;
+    const Eigen::Vector2d yaw_forward = VehicleMotionParameters(T_prior, model.up, model.axle_m);
+    model.yaw0 = yaw_forward(0);
+    model.forward0 = yaw_forward(1);
+    model.B = Basis(model.B.leftCols(2));
+  }
+  const Basis& B = model.B;
   for (const StereoCorrespondence& c : corr) {
     if (!c.p_prev_cam0.allFinite() || !c.uv_curr_px.allFinite() ||
         !std::isfinite(c.disparity_curr_px)) {
@@ -198,7 +236,7 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
   Vector6d best_x = Vector6d::Zero();
   std::vector<bool> best_mask;
   double best_sq = 0.0;
-  int best_n = Classify(camera, corr, T_prior, o, &best_mask, &best_sq);
+  int best_n = Classify(camera, corr, model.At(Vector6d::Zero()), o, &best_mask, &best_sq);
   const Eigen::Matrix3d R_prior = T_prior.linear();
   for (size_t i = 0; i < corr.size(); ++i) {
     // The observed bearing b in the current camera; the point's direction a' seen from the
@@ -208,7 +246,30 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
     const Eigen::Vector3d a = R_prior.transpose() * (corr[i].p_prev_cam0 - T_prior.translation());
     if (!(a.norm() > 0.0) || a.normalized().dot(b.normalized()) <= 0.0) continue;
     Vector6d x = Vector6d::Zero();
-    if (up_curr != nullptr) {
+    if (model.vehicle) {
+      // The vehicle's yaw that puts the point on its bearing: the yaw moves the camera about
+      // the axle too, so the rotation about up that turns b's horizontal direction onto the
+      // point's (seen from the moved camera) is repeated until it settles.
+      const Eigen::Vector3d& u = model.up;
+      const Eigen::Vector3d bh = b - b.dot(u) * u;
+      double yaw = 0.0;
+      bool settled = bh.norm() > 0.0;
+      for (int it = 0; settled && it < 5; ++it) {
+        x.head<3>() = yaw * u;
+        const Eigen::Isometry3d T = model.At(x);
+        const Eigen::Vector3d p = T.linear().transpose() * (corr[i].p_prev_cam0 - T.translation());
+        const Eigen::Vector3d ph = p - p.dot(u) * u;
+        if (!(ph.norm() > 0.0) || p.dot(b) <= 0.0) {
+          settled = false;
+          break;
+        }
+        const double step = std::atan2(bh.cross(ph).dot(u), bh.dot(ph));
+        yaw += step;
+        if (std::abs(step) < 1e-12) break;
+      }
+      if (!settled) continue;
+      x.head<3>() = yaw * u;
+    } else if (up_curr != nullptr) {
       // Planar: the rotation about up that turns b's horizontal direction onto a's.
       const Eigen::Vector3d u = B.block<3, 1>(0, 0);
       const Eigen::Vector3d bh = b - b.dot(u) * u;
@@ -222,7 +283,7 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
     if (!x.allFinite()) continue;
     std::vector<bool> mask;
     double sq = 0.0;
-    const int n = Classify(camera, corr, Corrected(T_prior, x), o, &mask, &sq);
+    const int n = Classify(camera, corr, model.At(x), o, &mask, &sq);
     if (n > best_n || (n == best_n && sq < best_sq)) {
       best_n = n;
       best_sq = sq;
@@ -236,13 +297,13 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
   }
 
   // Refine on the inliers, re-classify, refine again.
-  Vector6d x = Refine(camera, corr, best_mask, T_prior, B, Coordinates(B, best_x), o);
+  Vector6d x = Refine(camera, corr, best_mask, model, Coordinates(B, best_x), o);
   std::vector<bool> mask;
   double sq = 0.0;
-  int n = Classify(camera, corr, Corrected(T_prior, x), o, &mask, &sq);
+  int n = Classify(camera, corr, model.At(x), o, &mask, &sq);
   if (n >= best_n && mask != best_mask) {
-    x = Refine(camera, corr, mask, T_prior, B, Coordinates(B, x), o);
-    n = Classify(camera, corr, Corrected(T_prior, x), o, &mask, &sq);
+    x = Refine(camera, corr, mask, model, Coordinates(B, x), o);
+    n = Classify(camera, corr, model.At(x), o, &mask, &sq);
   }
   if (n < best_n) {  // the refinement lost support: keep the hypothesis
     x = best_x;
@@ -250,7 +311,7 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
     n = best_n;
     sq = best_sq;
   }
-  const Eigen::Isometry3d T = Corrected(T_prior, x);
+  const Eigen::Isometry3d T = model.At(x);
   if (!T.matrix().allFinite()) {
     result.message = "refinement diverged";
     return result;
@@ -282,6 +343,32 @@ Eigen::Isometry3d PlanarPart(const Eigen::Isometry3d& T_a_b, const Eigen::Vector
   const Eigen::Vector3d t = T_a_b.translation();
   P.translation() = t - t.dot(u) * u;
   return P;
+}
+
+Eigen::Isometry3d VehicleMotion(const Eigen::Vector3d& up, double axle_behind_camera_m,
+                                double yaw_rad, double forward_m) {
+  const Eigen::Vector3d u = up.normalized();
+  const Eigen::Vector3d e1 = HorizontalForward(u);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw_rad, u).toRotationMatrix();
+  // The axle point a = −d·e1 (each camera's own coordinates) moves by forward_m along the
+  // heading at half the turn: R·a + t = a + forward_m · Rot(yaw/2)·e1.
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R;
+  T.translation() =
+      axle_behind_camera_m * (R * e1 - e1) + forward_m * (Eigen::AngleAxisd(0.5 * yaw_rad, u) * e1);
+  return T;
+}
+
+Eigen::Vector2d VehicleMotionParameters(const Eigen::Isometry3d& T, const Eigen::Vector3d& up,
+                                        double axle_behind_camera_m) {
+  const Eigen::Vector3d u = up.normalized();
+  const Eigen::Vector3d e1 = HorizontalForward(u);
+  const Eigen::Quaterniond q(T.linear());
+  const double yaw = 2.0 * std::atan2(q.vec().dot(u), q.w());
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, u).toRotationMatrix();
+  const Eigen::Vector3d axle_step = T.translation() - axle_behind_camera_m * (R * e1 - e1);
+  const double forward = axle_step.dot(Eigen::AngleAxisd(0.5 * yaw, u) * e1);
+  return Eigen::Vector2d(std::remainder(yaw, 2.0 * kPi), forward);
 }
 
 }  // namespace vo

@@ -18,12 +18,16 @@
 // errors, then the lower index). The best one's inliers are refined (Gauss-Newton on (ω, v),
 // numeric Jacobians), re-classified, and refined once more.
 //
-// Ground vehicle (up_curr given): the correction is planar, a rotation about the world's up
-// direction and a translation across it (3 parameters instead of 6), and the 1-point hypotheses
-// are rotations about up. A wheeled robot neither rolls nor pitches nor lifts off the floor by
-// itself, and the few points left in front of a plain wall cannot tell those motions from yaw
-// and sideways translation: unconstrained, the fit turns part of a turn into roll and pitch
-// (measured on l_hallway texture seed 2: 18° of roll after the end wall).
+// Ground vehicle (up_curr given): the motion is planar, and the 1-point hypotheses are rotations
+// about up. With no_sideways_slip (the default) it is a wheeled vehicle's VehicleMotion: a yaw
+// and a forward distance, both regularised towards the prior's (σ_rot, σ_t); otherwise the
+// prior corrected by a yaw and a translation across up (3 parameters). A wheeled robot neither
+// rolls nor pitches nor lifts off the floor by itself, and the few points left in front of a plain
+// wall cannot tell those motions from yaw and sideways translation: unconstrained, the fit turns
+// part of a turn into roll and pitch (measured on l_hallway texture seed 2: 18° of roll after the
+// end wall). Nor can they tell a yaw from a sideways step: a free fit slid the camera 3.4 cm
+// sideways per frame where it moved 1.2 cm and under-stated the turn by 40 % (seed 2, stride 2); a
+// wheel does not slide.
 //
 // Cost: O(n²) reprojections for n correspondences (n is small where it is used: RANSAC failed)
 // plus a few 6×6 solves. Deterministic: the same input gives bit-identical output.
@@ -52,6 +56,14 @@ struct PriorMotionOptions {
   int max_iterations = 10;                  // Gauss-Newton iterations per refinement, >= 1
   double min_depth_m = 1e-3;                // transformed points closer than this (z, metres)
                                             // are outliers, > 0
+  bool no_sideways_slip = true;       // with an up direction (ground vehicle): the vehicle's wheels
+                                      // do not slide sideways, the motion is a yaw and a forward
+                                      // distance (VehicleMotion, 2 parameters) instead of a yaw and
+                                      // a free translation across up (3); false = the latter
+  double axle_behind_camera_m = 0.0;  // where the vehicle turns: its axle's distance behind
+                                      // the camera along the horizontal forward axis (metres,
+                                      // finite); 0 = the camera above the axle. The rig's
+                                      // calibration, not a tuning knob
 
   bool IsValid(std::string* error) const;
 };
@@ -75,6 +87,17 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
                                           const Eigen::Isometry3d& T_prev_curr_prior,
                                           const PriorMotionOptions& options = PriorMotionOptions(),
                                           const Eigen::Vector3d* up_curr = nullptr);
+
+// A wheeled ground vehicle's camera motion p_prev = T · p_curr (camera frames): a yaw yaw_rad
+// about `up` (the world's up in the camera frame, any length > 0) and forward_m of travel of
+// the axle point, axle_behind_camera_m behind the camera on its horizontal forward axis, along
+// the chord of the turn (the heading at half the yaw): a unicycle without sideways slip.
+Eigen::Isometry3d VehicleMotion(const Eigen::Vector3d& up, double axle_behind_camera_m,
+                                double yaw_rad, double forward_m);
+// The (yaw_rad, forward_m) of VehicleMotion closest to T: the twist of T's rotation about up,
+// and the axle's step projected on the chord's direction. Exact for a VehicleMotion.
+Eigen::Vector2d VehicleMotionParameters(const Eigen::Isometry3d& T, const Eigen::Vector3d& up,
+                                        double axle_behind_camera_m);
 
 // The planar part of a motion T_a_b (p_a = T_a_b · p_b) of a ground vehicle whose up direction
 // in frame a is up_a (any length > 0): the rotation's twist about up (its swing, roll and
