@@ -31,6 +31,11 @@ bool Fail(const std::ostringstream& msg, std::string* error) {
 
 bool IsFinite(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
 
+// The world's up (+z of the hallway frame) in the camera frame of T_world_cam.
+Eigen::Vector3d WorldUpInCamera(const Eigen::Isometry3d& T_world_cam) {
+  return T_world_cam.linear().transpose() * Eigen::Vector3d::UnitZ();
+}
+
 // Rotation and translation blend: slerp(q_a, q_b, w), (1 − w) t_a + w t_b.
 Eigen::Isometry3d Blend(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b, double w) {
   if (w <= 0.0) return T_a;
@@ -440,13 +445,9 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
     std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
     depth_m = z[z.size() / 2];
   }
-  Eigen::Isometry3d T_prev_curr =
-      CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m);
   // A ground vehicle turns about up only: the shift's vertical part (zoom, parallax) is no tilt.
-  if (prior == nullptr && options_.tracking.ground_vehicle && world_up_known_) {
-    T_prev_curr =
-        PlanarPart(T_prev_curr, T_world_prev_.linear().transpose() * Eigen::Vector3d::UnitZ());
-  }
+  const Eigen::Isometry3d T_prev_curr = PlanarBridge(
+      CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m), prior);
   if (!IsFinite(T_prev_curr)) return predicted;
   // The shift the prior itself predicts: the correction's rotation seen at the image centre.
   const double residual_px =
@@ -467,10 +468,16 @@ Eigen::Isometry3d StereoOdometry::PriorMotion(const MotionPrior* prior) const {
   return has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity();
 }
 
+Eigen::Isometry3d StereoOdometry::PlanarBridge(const Eigen::Isometry3d& T_prev_curr,
+                                               const MotionPrior* prior) const {
+  if (prior != nullptr || !options_.tracking.ground_vehicle || !world_up_known_) {
+    return T_prev_curr;
+  }
+  return PlanarPart(T_prev_curr, WorldUpInCamera(T_world_prev_));
+}
+
 Eigen::Isometry3d StereoOdometry::BridgeMotion(const MotionPrior* prior) const {
-  const Eigen::Isometry3d T = PriorMotion(prior);
-  if (prior != nullptr || !options_.tracking.ground_vehicle || !world_up_known_) return T;
-  return PlanarPart(T, T_world_prev_.linear().transpose() * Eigen::Vector3d::UnitZ());
+  return PlanarBridge(PriorMotion(prior), prior);
 }
 
 Eigen::Isometry3d StereoOdometry::PredictedPose(const MotionPrior* prior) const {
@@ -573,9 +580,7 @@ PriorMotionResult StereoOdometry::FewPointMotion(
   // floor), as the reference's pose puts it.
   const Eigen::Isometry3d* T_world_ref = window_.Pose(reference_.frame_index);
   const bool planar = options_.tracking.ground_vehicle && world_up_known_ && T_world_ref != nullptr;
-  const Eigen::Vector3d up_ref =
-      planar ? Eigen::Vector3d(T_world_ref->linear().transpose() * Eigen::Vector3d::UnitZ())
-             : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d up_ref = planar ? WorldUpInCamera(*T_world_ref) : Eigen::Vector3d::UnitZ();
   *few_prior = planar ? PlanarPart(T_ref_curr_prior, up_ref) : T_ref_curr_prior;
   const Eigen::Vector3d up_curr = few_prior->linear().transpose() * up_ref;
   return EstimateMotionWithPrior(camera_, correspondences, *few_prior, options_.tracking.few_point,

@@ -562,8 +562,11 @@ class StereoOdometry {
   Eigen::Isometry3d PriorMotion(const MotionPrior* prior) const;
   // The predicted T_world_cam0 of the newest frame: the previous output moved by the prior.
   Eigen::Isometry3d PredictedPose(const MotionPrior* prior) const;
-  // The prior's motion for a frame without a measured motion: PriorMotion, planar
-  // (PlanarPart about the world's up) for a ground vehicle unless the caller gave the prior.
+  // A bridged frame-to-frame motion made planar (PlanarPart about the world's up) for a ground
+  // vehicle, unless the caller gave the prior; as it is otherwise.
+  Eigen::Isometry3d PlanarBridge(const Eigen::Isometry3d& T_prev_curr,
+                                 const MotionPrior* prior) const;
+  // The prior's motion for a frame without a measured motion: PlanarBridge(PriorMotion).
   Eigen::Isometry3d BridgeMotion(const MotionPrior* prior) const;
   // The pose of a frame without a measured motion: the predicted pose, corrected by the image
   // shift from the previous frame where it is found (sets result->rotation_from_shift).

@@ -13,8 +13,9 @@ constexpr double kNumericStep = 1e-6;     // central-difference step of the Jaco
 constexpr double kConvergedStep = 1e-10;  // stop when |δ|² falls below this
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
-// The correction's parameters y and their map to x = (ω, v) = B · y: the identity (6
-// parameters), or the planar basis (a rotation about up, two translations across it).
+// The parameters y and their map to x = (ω, v) = B · y: the identity (6 parameters), the
+// planar basis (a rotation about up, two translations across it), or its first two columns
+// (a vehicle's yaw and forward distance).
 using Basis = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
 // The horizontal forward axis of a camera whose up direction is u (unit): its z axis made
@@ -23,6 +24,14 @@ Eigen::Vector3d HorizontalForward(const Eigen::Vector3d& u) {
   Eigen::Vector3d e1 = Eigen::Vector3d::UnitZ() - u.z() * u;
   if (e1.norm() < 1e-6) e1 = Eigen::Vector3d::UnitX() - u.x() * u;
   return e1.normalized();
+}
+
+// The rotation angle about u (unit) that turns the direction of b onto that of a, both seen
+// across u (their components along u dropped; the callers check that neither vanishes).
+double YawBetween(const Eigen::Vector3d& b, const Eigen::Vector3d& a, const Eigen::Vector3d& u) {
+  const Eigen::Vector3d bh = b - b.dot(u) * u;
+  const Eigen::Vector3d ah = a - a.dot(u) * u;
+  return std::atan2(bh.cross(ah).dot(u), bh.dot(ah));
 }
 
 // Columns of B for a ground vehicle whose up direction in the current camera frame is `up`
@@ -251,19 +260,17 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
       // the axle too, so the rotation about up that turns b's horizontal direction onto the
       // point's (seen from the moved camera) is repeated until it settles.
       const Eigen::Vector3d& u = model.up;
-      const Eigen::Vector3d bh = b - b.dot(u) * u;
       double yaw = 0.0;
-      bool settled = bh.norm() > 0.0;
+      bool settled = (b - b.dot(u) * u).norm() > 0.0;
       for (int it = 0; settled && it < 5; ++it) {
         x.head<3>() = yaw * u;
         const Eigen::Isometry3d T = model.At(x);
         const Eigen::Vector3d p = T.linear().transpose() * (corr[i].p_prev_cam0 - T.translation());
-        const Eigen::Vector3d ph = p - p.dot(u) * u;
-        if (!(ph.norm() > 0.0) || p.dot(b) <= 0.0) {
+        if (!((p - p.dot(u) * u).norm() > 0.0) || p.dot(b) <= 0.0) {
           settled = false;
           break;
         }
-        const double step = std::atan2(bh.cross(ph).dot(u), bh.dot(ph));
+        const double step = YawBetween(b, p, u);
         yaw += step;
         if (std::abs(step) < 1e-12) break;
       }
@@ -272,10 +279,8 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
     } else if (up_curr != nullptr) {
       // Planar: the rotation about up that turns b's horizontal direction onto a's.
       const Eigen::Vector3d u = B.block<3, 1>(0, 0);
-      const Eigen::Vector3d bh = b - b.dot(u) * u;
-      const Eigen::Vector3d ah = a - a.dot(u) * u;
-      if (!(bh.norm() > 0.0) || !(ah.norm() > 0.0)) continue;
-      x.head<3>() = std::atan2(bh.cross(ah).dot(u), bh.dot(ah)) * u;
+      if (!((b - b.dot(u) * u).norm() > 0.0) || !((a - a.dot(u) * u).norm() > 0.0)) continue;
+      x.head<3>() = YawBetween(b, a, u) * u;
     } else {
       const Eigen::AngleAxisd Q(Eigen::Quaterniond::FromTwoVectors(b, a));
       x.head<3>() = Q.angle() * Q.axis();
