@@ -138,7 +138,7 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
          "translation_error_m,rotation_error_deg,motion_measured,reinitialised,prediction,"
          "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_"
          "disparities,"
-         "disparity_pixels\n";
+         "disparity_pixels,chained_to_frame,chain_inliers\n";
   // One row per frame; frames before the first initialised one have no pose and no error.
   const double kNan = std::nan("");
   auto row = [&](size_t frame, double time_s, const std::string& status,
@@ -156,7 +156,8 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
         << "," << vo::ToString(r.prediction) << "," << r.num_first_pass_inliers << ","
         << Fmt(r.image_shift_px.x(), 2) << "," << Fmt(r.image_shift_px.y(), 2) << ","
         << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << ","
-        << r.num_disparities << "," << r.disparity_pixels << "\n";
+        << r.num_disparities << "," << r.disparity_pixels << "," << r.chained_to_frame << ","
+        << r.chain_inliers << "\n";
   };
   for (size_t i = 0; i < first; ++i) {
     const vo::OdometryResult& r = records.frames[i].result;

@@ -316,6 +316,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"tracking.few_point_motion", Bool(&t.few_point_motion)},
       {"tracking.few_point_min_features", Number(&t.few_point_min_features, 1, 100000)},
       {"tracking.ground_vehicle", Bool(&t.ground_vehicle)},
+      {"tracking.chain_lost_frames", Bool(&t.chain_lost_frames)},
       {"tracking.few_point.min_inliers", Number(&t.few_point.min_inliers, 1, 100000)},
       {"tracking.few_point.min_inlier_fraction",
        Number(&t.few_point.min_inlier_fraction, 0.0, 1.0)},

@@ -329,6 +329,8 @@ void StereoOdometry::Reset() {
   consecutive_lost_ = 0;
   previous_measured_ = false;
   reference_ = Reference();
+  lost_chain_ = Reference();
+  has_chained_pose_ = false;
   T_world_prev_ = Eigen::Isometry3d::Identity();
   velocity_ = Eigen::Isometry3d::Identity();
   has_velocity_ = false;
@@ -420,6 +422,10 @@ Eigen::Isometry3d CorrectPriorWithImageShift(const StereoCamera& camera,
 }
 
 Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, OdometryResult* result) {
+  if (has_chained_pose_) {  // measured against the lost-frame chain (ChainLostFrame)
+    has_chained_pose_ = false;
+    return chained_pose_;
+  }
   const Eigen::Isometry3d predicted = T_world_prev_ * BridgeMotion(prior);
   const RobustTrackingOptions& o = options_.tracking;
   if (options_.matcher.prediction == PredictionMode::kNone || !o.rotation_from_shift ||
@@ -531,6 +537,7 @@ OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame fram
   }
   initialised_ = true;
   consecutive_lost_ = 0;
+  lost_chain_.valid = false;
   last_features_ = frame.features;
   reference_.valid = true;
   reference_.frame_index = result.frame_index;
@@ -555,9 +562,8 @@ std::vector<Eigen::Vector2d> PredictFeaturePositions(const StereoCamera& camera,
 }
 
 std::vector<Eigen::Vector2d> StereoOdometry::PredictPositions(
-    const Eigen::Isometry3d& T_ref_curr) const {
-  return PredictFeaturePositions(camera_, reference_.frame.features, T_ref_curr,
-                                 options_.ransac.min_depth_m);
+    const std::vector<Feature>& ref_features, const Eigen::Isometry3d& T_ref_curr) const {
+  return PredictFeaturePositions(camera_, ref_features, T_ref_curr, options_.ransac.min_depth_m);
 }
 
 StereoOdometry::MotionAttempt StereoOdometry::EstimateMotion(
@@ -588,9 +594,8 @@ PriorMotionResult StereoOdometry::FewPointMotion(
 }
 
 StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
-    const MatchFrame& frame, const Eigen::Isometry3d* T_ref_curr_prior, OdometryResult* result,
-    std::string* matcher_error) {
-  const MatchFrame& ref = reference_.frame;
+    const MatchFrame& ref, const MatchFrame& frame, const Eigen::Isometry3d* T_ref_curr_prior,
+    OdometryResult* result, std::string* matcher_error, bool few_point_tie) {
   const RobustTrackingOptions& o = options_.tracking;
   // One pass: match around `prediction`, then RANSAC. Times go to `match_ms` / `motion_ms`.
   auto pass = [&](const MatchPrediction& prediction, PredictionSource source, double* match_ms,
@@ -621,7 +626,7 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
   MatchPrediction prediction;
   PredictionSource source = PredictionSource::kNone;
   if (T_ref_curr_prior != nullptr) {
-    prediction.uv_px = PredictPositions(*T_ref_curr_prior);
+    prediction.uv_px = PredictPositions(ref.features, *T_ref_curr_prior);
     prediction.radius_scale = o.prior_radius_scale;
     source = PredictionSource::kMotionPrior;
   }
@@ -657,7 +662,7 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
       if (attempt.inliers() > best.inliers()) {
         best = std::move(attempt);
       } else if (best.inliers() == 0 && attempt.inliers() == 0 && o.few_point_motion &&
-                 T_ref_curr_prior != nullptr) {
+                 few_point_tie && T_ref_curr_prior != nullptr) {
         // Neither pass has a RANSAC consensus (too few features: the few-point solver will
         // decide). The prior's pass must not win by default: a prior that lags a turn centres
         // its gates where the features are not and picks up neighbours that agree with it.
@@ -679,7 +684,7 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
   if (o.guided_rematch && best.ransac.ok() && IsFinite(best.ransac.T_prev_curr)) {
     t = Clock::now();
     MatchPrediction guided;
-    guided.uv_px = PredictPositions(best.ransac.T_prev_curr);
+    guided.uv_px = PredictPositions(ref.features, best.ransac.T_prev_curr);
     guided.radius_scale = o.guided_radius_scale;
     guided.coherence_test = false;
     double match_ms = 0.0, motion_ms = 0.0;
@@ -690,6 +695,66 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
     if (attempt.inliers() >= best.inliers()) best = std::move(attempt);
   }
   return best;
+}
+
+bool StereoOdometry::AgreesWithImageShift(const std::vector<Feature>& ref_features,
+                                          const Eigen::Isometry3d& T_ref_curr,
+                                          const Eigen::Isometry3d& T_ref_curr_prior, bool shift_ok,
+                                          const Eigen::Vector2d& shift_px) const {
+  if (!shift_ok) return true;
+  // The image shift the motions predict at the image centre (the reference's median depth)
+  // against the measured one.
+  std::vector<double> z;
+  for (const Feature& f : ref_features) {
+    if (f.has_depth() && f.p_cam0.allFinite()) z.push_back(f.p_cam0.z());
+  }
+  double depth_m = -1.0;
+  if (!z.empty()) {
+    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+    depth_m = z[z.size() / 2];
+  }
+  const double motion_px = (PredictedCentreShift(camera_, T_ref_curr, depth_m) - shift_px).norm();
+  const double prior_px =
+      (PredictedCentreShift(camera_, T_ref_curr_prior, depth_m) - shift_px).norm();
+  return motion_px <= prior_px + options_.tracking.few_point_max_shift_disagreement_px;
+}
+
+bool StereoOdometry::ChainLostFrame(const MatchFrame& frame, const MotionPrior* prior,
+                                    OdometryResult* result, Eigen::Isometry3d* T_world_curr) {
+  if (!options_.tracking.chain_lost_frames || !lost_chain_.valid ||
+      lost_chain_.frame_index >= result->frame_index ||
+      options_.matcher.prediction == PredictionMode::kNone ||
+      matcher_->type() == MatcherType::kKalman) {
+    return false;
+  }
+  const Eigen::Isometry3d T_chain_curr_prior = T_world_chain_.inverse() * PredictedPose(prior);
+  OdometryResult pass;  // the chain's prediction fields are not this frame's against the reference
+  std::string matcher_error;
+  const MotionAttempt attempt = MatchAndEstimate(
+      lost_chain_.frame, frame, IsFinite(T_chain_curr_prior) ? &T_chain_curr_prior : nullptr, &pass,
+      &matcher_error, /*few_point_tie=*/false);
+  result->times.predict_ms += pass.times.predict_ms;
+  result->times.match_ms += pass.times.match_ms;
+  result->times.motion_ms += pass.times.motion_ms;
+  result->times.guided_ms += pass.times.guided_ms;
+  const RansacResult& ransac = attempt.ransac;
+  if (!matcher_error.empty() || attempt.inliers() < options_.min_inliers ||
+      !IsFinite(ransac.T_prev_curr)) {
+    return false;
+  }
+  *T_world_curr = T_world_chain_ * ransac.T_prev_curr;
+  result->chained_to_frame = lost_chain_.frame_index;
+  result->chain_inliers = ransac.num_inliers;
+  // The measured motion moves the constant velocity as a tracked one does (by its support).
+  const Eigen::Isometry3d per_frame =
+      Root(ransac.T_prev_curr, result->frame_index - lost_chain_.frame_index);
+  const double weight = std::min(
+      1.0, static_cast<double>(ransac.num_inliers) / options_.tracking.reliable_min_inliers);
+  if (IsFinite(per_frame)) {
+    velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
+    has_velocity_ = true;
+  }
+  return true;
 }
 
 OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, MotionAttempt attempt,
@@ -717,25 +782,9 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
       (few_features || static_cast<int>(correspondences.size()) < options_.min_inliers)) {
     Eigen::Isometry3d few_prior;
     const PriorMotionResult few = FewPointMotion(correspondences, *T_ref_curr_prior, &few_prior);
-    bool agrees = few.ok;
-    if (few.ok && result.image_shift_ok) {
-      // The image shift the motions predict at the image centre (reference's median depth)
-      // against the measured one.
-      std::vector<double> z;
-      for (const Feature& f : ref_features) {
-        if (f.has_depth() && f.p_cam0.allFinite()) z.push_back(f.p_cam0.z());
-      }
-      double depth_m = -1.0;
-      if (!z.empty()) {
-        std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
-        depth_m = z[z.size() / 2];
-      }
-      const double few_px =
-          (PredictedCentreShift(camera_, few.T_prev_curr, depth_m) - result.image_shift_px).norm();
-      const double prior_px =
-          (PredictedCentreShift(camera_, few_prior, depth_m) - result.image_shift_px).norm();
-      agrees = few_px <= prior_px + tracking.few_point_max_shift_disagreement_px;
-    }
+    const bool agrees =
+        few.ok && AgreesWithImageShift(ref_features, few.T_prev_curr, few_prior,
+                                       result.image_shift_ok, result.image_shift_px);
     if (agrees) {
       ransac.status = RansacResult::Status::kOk;
       ransac.message.clear();
@@ -775,16 +824,31 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
         << ")";
     if (!ransac.message.empty()) why << ": " << ransac.message;
     result.times.motion_ms += MsSince(motion_start);
+    // The reference cannot measure this frame: the lost frames before it may (the pose and the
+    // constant velocity from that chain; BridgedPose takes the pose).
+    if (ChainLostFrame(frame, prior, &result, &chained_pose_)) {
+      has_chained_pose_ = true;
+      why << "; pose chained to lost frame " << result.chained_to_frame << " ("
+          << result.chain_inliers << " inliers)";
+    }
     // After a loss, a frame that has plenty of features but cannot be matched to the last good
     // one (even with the coarse-to-fine search) starts again at once: waiting longer would
     // only extrapolate further.
     const bool rich = static_cast<int>(frame.features.size()) >= 2 * options_.min_features;
     if (consecutive_lost_ >= options_.reinit_after_lost_frames || (consecutive_lost_ > 0 && rich)) {
-      // The reference is stale: start again from this frame at its predicted pose.
+      // The reference is stale: start again from this frame at its predicted (or chained) pose.
       return Initialise(std::move(result), std::move(frame),
                         why.str() + "; re-initialised at the predicted pose", start, prior);
     }
-    return Lost(std::move(result), why.str(), start, prior);
+    OdometryResult lost = Lost(std::move(result), why.str(), start, prior);
+    if (options_.tracking.chain_lost_frames &&
+        static_cast<int>(frame.features.size()) >= options_.min_features) {
+      lost_chain_.valid = true;  // the next lost frame is matched against this one
+      lost_chain_.frame_index = lost.frame_index;
+      lost_chain_.frame = std::move(frame);
+      T_world_chain_ = lost.T_world_cam0;
+    }
+    return lost;
   }
 
   // Initial pose: blend of the RANSAC/Horn motion and the constant-velocity prediction.
@@ -860,6 +924,7 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     result.message = msg.str();
   }
   consecutive_lost_ = 0;
+  lost_chain_.valid = false;
   last_features_ = frame.features;
   reference_.frame_index = result.frame_index;
   reference_.frame = std::move(frame);
@@ -1006,8 +1071,8 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   const Eigen::Isometry3d T_ref_curr_prior = T_world_ref.inverse() * PredictedPose(prior);
   const bool has_prior = (prior != nullptr || has_velocity_) && IsFinite(T_ref_curr_prior);
   std::string matcher_error;
-  MotionAttempt attempt =
-      MatchAndEstimate(frame, has_prior ? &T_ref_curr_prior : nullptr, &result, &matcher_error);
+  MotionAttempt attempt = MatchAndEstimate(
+      reference_.frame, frame, has_prior ? &T_ref_curr_prior : nullptr, &result, &matcher_error);
   if (!matcher_error.empty()) {
     last_reference_features_ = reference_.frame.features;
     result.reference_frame_index = static_cast<int>(reference_.frame_index);

@@ -65,6 +65,10 @@
 // wall is followed, not extrapolated. The reference frame, the tracks and the window are kept.
 // The next frames are matched against that reference (the last good frame) with the
 // coarse-to-fine pass, so the motion across the gap is measured; success gives kRecovered.
+// A lost frame that the reference cannot measure is matched against the previous lost frame
+// with features (tracking.chain_lost_frames): a turn in front of a plain wall leaves the
+// reference's view behind, but the frames of the gap overlap each other, so their motion is
+// measured link by link (the frame stays lost; OdometryResult::chained_to_frame).
 // When the motion still fails after reinit_after_lost_frames lost frames, or the current frame
 // is rich (at least 2 · min_features features) yet cannot be matched after a loss, the pipeline
 // re-initialises on the current frame at its bridged pose (kRecovered, reinitialised = true):
@@ -216,12 +220,25 @@ struct RobustTrackingOptions {
   // rotation from the image shift is a yaw only (the shift's vertical part is zoom and
   // parallax). Needs the up direction from the first frame's orientation (the floor found);
   // without it, 6-DoF. Measured on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs,
-  // results/robustness/): with few_point_motion, mean end-pose error 0.431 -> 0.393 m, median
-  // 0.206 -> 0.168 m, runs <= 0.29 m 22 -> 26, frames without motion 256 -> 132 against the
-  // defaults, the plain corridor better at 3 of 4 strides; but camera.pitch_deg 10 goes
-  // 0.49 -> 1.13 %, so not the default yet. On its own (few_point_motion off) the mean goes
-  // 0.431 -> 0.448 m.
+  // results/robustness/, with the lost-frame chain): with few_point_motion, mean end-pose error
+  // 0.442 -> 0.328 m, median 0.182 -> 0.146 m, runs <= 0.29 m 22 -> 27, frames without motion
+  // 256 -> 132 against the defaults; but camera.pitch_deg 10 goes 0.73 -> 1.13 % (drift on the
+  // straight approach that the 6-DoF window BA keeps), so not the default yet. On its own
+  // (few_point_motion off) the mean goes 0.442 -> 0.439 m.
   bool ground_vehicle = false;
+  // A lost frame with at least min_features features is matched against the previous lost
+  // frame that had them (the chain), when matching against the reference failed: a turn in
+  // front of a plain wall takes the camera past the reference's view, and the frames of the
+  // gap, which do overlap each other, then measure the motion through it (rotation and
+  // translation, RANSAC with at least min_inliers inliers) instead of extrapolating the prior.
+  // The frame stays lost (no link to the window; it counts in lost_frames), its pose is the
+  // chain's pose times that motion, and the motion moves the constant-velocity prior as a
+  // tracked one does. Not with matcher.prediction none (the paper's form) or the Kalman
+  // matcher (stateful). Measured on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs,
+  // results/robustness/): defaults' median end-pose error 0.206 -> 0.182 m, max 1.958 ->
+  // 1.663 m, mean 0.431 -> 0.442 m; plain_corridor better at every stride (0.268-0.569 ->
+  // 0.222-0.492 m); with few_point_motion and ground_vehicle mean 0.393 -> 0.328 m.
+  bool chain_lost_frames = true;
   PriorMotionOptions few_point;  // that solver (fewer inliers than its min_inliers and
                                  // min_inlier_fraction: lost)
   double few_point_max_shift_disagreement_px =
@@ -413,6 +430,10 @@ struct OdometryResult {
                                      // prior (RobustTrackingOptions::few_point_motion)
   bool rotation_from_shift = false;  // lost or re-initialised, its pose is the prior corrected
                                      // by the image shift from the previous frame
+  int64_t chained_to_frame = -1;     // lost or re-initialised, its pose was measured against
+                                     // this earlier lost frame (tracking.chain_lost_frames;
+                                     // -1: not chained) ...
+  int chain_inliers = 0;             // ... with this many RANSAC inliers
   PredictionSource prediction = PredictionSource::kNone;  // centre of the used matches' search
   bool image_shift_ok = false;  // the coarse-to-fine image shift ran and found a shift
   Eigen::Vector2d image_shift_px = Eigen::Vector2d::Zero();  // that shift (pixels), when ok
@@ -543,20 +564,38 @@ class StereoOdometry {
   MotionAttempt EstimateMotion(const std::vector<Feature>& ref_features,
                                const std::vector<Feature>& curr_features,
                                std::vector<Match> matches, PredictionSource source) const;
-  // Matches `frame` against the reference with the prediction passes (see the header
-  // comment); fills the prediction fields and times of `result`.
-  // T_ref_curr_prior: the prior's motion from the reference to `frame` (null = none known).
-  MotionAttempt MatchAndEstimate(const MatchFrame& frame, const Eigen::Isometry3d* T_ref_curr_prior,
-                                 OdometryResult* result, std::string* matcher_error);
+  // Matches `frame` against `ref` (the reference, or the lost-frame chain) with the prediction
+  // passes (see the header comment); fills the prediction fields and times of `result`.
+  // T_ref_curr_prior: the prior's motion from `ref` to `frame` (null = none known).
+  // few_point_tie: with few_point_motion, a 0-0 tie of the passes goes to the one the
+  // few-point motion supports more (only against the reference, whose pose is in the window).
+  MotionAttempt MatchAndEstimate(const MatchFrame& ref, const MatchFrame& frame,
+                                 const Eigen::Isometry3d* T_ref_curr_prior, OdometryResult* result,
+                                 std::string* matcher_error, bool few_point_tie = true);
+  // tracking.chain_lost_frames: `frame`, which the reference could not measure, against the
+  // chain (the last lost frame with features). True with *T_world_curr when RANSAC finds at
+  // least min_inliers inliers; the motion then moves the constant velocity. Times go to
+  // `result`.
+  bool ChainLostFrame(const MatchFrame& frame, const MotionPrior* prior, OdometryResult* result,
+                      Eigen::Isometry3d* T_world_curr);
+  // Whether a motion T_ref_curr measured from few matches agrees with the frame's
+  // coarse-to-fine image shift (when found: shift_ok): the shift it predicts at the image
+  // centre (ref_features' median depth) is no farther from the measured one than the prior's
+  // prediction, by more than tracking.few_point_max_shift_disagreement_px.
+  bool AgreesWithImageShift(const std::vector<Feature>& ref_features,
+                            const Eigen::Isometry3d& T_ref_curr,
+                            const Eigen::Isometry3d& T_ref_curr_prior, bool shift_ok,
+                            const Eigen::Vector2d& shift_px) const;
   // The few-point motion (prior_motion.h) of `correspondences` from the prior
   // T_ref_curr_prior, made planar for a ground vehicle (tracking.ground_vehicle with the up
   // known); *few_prior: the prior the solver used.
   PriorMotionResult FewPointMotion(const std::vector<StereoCorrespondence>& correspondences,
                                    const Eigen::Isometry3d& T_ref_curr_prior,
                                    Eigen::Isometry3d* few_prior) const;
-  // Positions of the reference features in the current image under T_ref_curr (NaN where a
-  // point falls behind the camera or has no depth).
-  std::vector<Eigen::Vector2d> PredictPositions(const Eigen::Isometry3d& T_ref_curr) const;
+  // Positions of ref_features in the current image under T_ref_curr (NaN where a point falls
+  // behind the camera or has no depth).
+  std::vector<Eigen::Vector2d> PredictPositions(const std::vector<Feature>& ref_features,
+                                                const Eigen::Isometry3d& T_ref_curr) const;
   // The prior's motion since the previous output: the caller's prior, else the constant
   // velocity, else none (identity).
   Eigen::Isometry3d PriorMotion(const MotionPrior* prior) const;
@@ -568,8 +607,9 @@ class StereoOdometry {
                                  const MotionPrior* prior) const;
   // The prior's motion for a frame without a measured motion: PlanarBridge(PriorMotion).
   Eigen::Isometry3d BridgeMotion(const MotionPrior* prior) const;
-  // The pose of a frame without a measured motion: the predicted pose, corrected by the image
-  // shift from the previous frame where it is found (sets result->rotation_from_shift).
+  // The pose of a frame without a measured motion: the chain's measured pose when
+  // ChainLostFrame found one for it (chained_pose_), else the predicted pose, corrected by the
+  // image shift from the previous frame where it is found (sets result->rotation_from_shift).
   Eigen::Isometry3d BridgedPose(const MotionPrior* prior, OdometryResult* result);
 
   // A lost frame: pose = constant-velocity prediction, reference and tracks kept.
@@ -607,6 +647,11 @@ class StereoOdometry {
   bool previous_measured_ = false;  // the previous call's motion was measured (the prior is
                                     // a measured motion, not a bridge: few_point_motion)
   Reference reference_;
+  Reference lost_chain_;  // the last lost frame with at least min_features features, since the
+                          // last tracked one (tracking.chain_lost_frames), ...
+  Eigen::Isometry3d T_world_chain_ = Eigen::Isometry3d::Identity();  // ... and its output pose
+  bool has_chained_pose_ = false;  // ChainLostFrame measured this frame's pose: chained_pose_
+  Eigen::Isometry3d chained_pose_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();  // previous call's output
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();      // constant-velocity model: last
                                                                 // estimated per-frame T_prev_curr

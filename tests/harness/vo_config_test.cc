@@ -63,7 +63,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
       {"ransac", "RansacOptions", sizeof(vo::RansacOptions), 96, 17},
       {"ba", "BundleAdjustmentOptions", sizeof(vo::BundleAdjustmentOptions), 88, 13},
       {"orientation", "PlaneOrientationOptions", sizeof(vo::PlaneOrientationOptions), 80, 9},
-      {"tracking", "RobustTrackingOptions", sizeof(vo::RobustTrackingOptions), 256, 17},
+      {"tracking", "RobustTrackingOptions", sizeof(vo::RobustTrackingOptions), 256, 18},
       {"tracking.few_point", "PriorMotionOptions", sizeof(vo::PriorMotionOptions), 80, 10},
       {"tracking.image_shift", "ImageShiftOptions", sizeof(vo::ImageShiftOptions), 56, 8},
   };

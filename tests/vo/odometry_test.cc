@@ -829,6 +829,49 @@ TEST(OdometryPredictionTest, ThePapersUnpredictedFormLosesTheFastTurn) {
               ::testing::Not(IsNearPose(TrueTurnMotion(0, 11), 0.5 * kDeg, 0.02)));
 }
 
+// The view jumps: the camera stands still for frames 0-3, frame 4 looks 50° to the right (of
+// the 70° field of view, 20° are left, at the image's edge: neither the prior nor the
+// coarse-to-fine search reaches them), and from there it turns 3° left and drives 4 cm per
+// frame. Frame 4 cannot be measured; frame 5 cannot be matched against the reference (frame
+// 3) either, but it can against frame 4.
+Eigen::Isometry3d JumpPose(int i) {
+  if (i <= 3) return MakePose(R_hall_cam(0.0), Eigen::Vector3d(0.0, 0.2, 1.0));
+  double yaw = -50.0 * kDeg;
+  Eigen::Vector3d t(0.0, 0.2, 1.0);
+  for (int k = 5; k <= i; ++k) {
+    yaw += 3.0 * kDeg;
+    t += 0.04 * Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0);
+  }
+  return MakePose(R_hall_cam(yaw), t);
+}
+
+TEST(OdometryPredictionTest, LostFramesAreChainedSoTheMotionThroughTheGapIsMeasured) {
+  static const std::vector<StereoFrame> frames = RenderSequence(JumpPose);
+  auto true_motion = [](int a, int b) { return JumpPose(a).inverse() * JumpPose(b); };
+  const std::vector<OdometryResult> r = RunFrames(frames, OdometryOptions(), {});
+  EXPECT_TRUE(IsLostFrame(r[4])) << r[4].message;
+  EXPECT_EQ(r[4].chained_to_frame, -1);  // the first lost frame has nothing to chain to
+  // Frame 5: the reference cannot measure it, the lost frame 4 can: its pose is frame 4's
+  // times the measured motion (3°, 4 cm), where the constant velocity says "standing still".
+  EXPECT_TRUE(IsLostFrame(r[5])) << r[5].message;
+  EXPECT_EQ(r[5].chained_to_frame, 4) << r[5].message;
+  EXPECT_GE(r[5].chain_inliers, OdometryOptions().min_inliers);
+  EXPECT_THAT(EstimatedMotion(r, 4, 5), IsNearPose(true_motion(4, 5), 0.3 * kDeg, 0.01));
+  // After it, tracking goes on at the measured pace.
+  for (int i = 6; i <= 11; ++i) {
+    EXPECT_TRUE(r[i].motion_measured) << i << ": " << r[i].message;
+  }
+  EXPECT_THAT(EstimatedMotion(r, 4, 11), IsNearPose(true_motion(4, 11), 0.5 * kDeg, 0.02));
+
+  // Without the chain, frame 5 takes the prior (no translation): 4 cm short.
+  OdometryOptions off;
+  off.tracking.chain_lost_frames = false;
+  const std::vector<OdometryResult> u = RunFrames(frames, off, {});
+  EXPECT_EQ(u[5].chained_to_frame, -1);
+  EXPECT_THAT(EstimatedMotion(u, 4, 5),
+              ::testing::Not(IsNearPose(true_motion(4, 5), 0.3 * kDeg, 0.01)));
+}
+
 TEST(OdometryPredictionTest, LostFramesAndReinitialisationsAreCountedExactly) {
   // Black frames 4-6 in the corridor: three frames without a measured motion, frame 7 measured
   // across the gap, no re-initialisation.
