@@ -721,7 +721,8 @@ bool StereoOdometry::AgreesWithImageShift(const std::vector<Feature>& ref_featur
 
 bool StereoOdometry::ChainLostFrame(const MatchFrame& frame, const MotionPrior* prior,
                                     OdometryResult* result, Eigen::Isometry3d* T_world_curr) {
-  if (!options_.tracking.chain_lost_frames || !lost_chain_.valid ||
+  // A caller's prior (wheel odometry, a gyro) bridges a lost frame as given.
+  if (!options_.tracking.chain_lost_frames || prior != nullptr || !lost_chain_.valid ||
       lost_chain_.frame_index >= result->frame_index ||
       options_.matcher.prediction == PredictionMode::kNone ||
       matcher_->type() == MatcherType::kKalman) {

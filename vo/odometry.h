@@ -233,11 +233,12 @@ struct RobustTrackingOptions {
   // translation, RANSAC with at least min_inliers inliers) instead of extrapolating the prior.
   // The frame stays lost (no link to the window; it counts in lost_frames), its pose is the
   // chain's pose times that motion, and the motion moves the constant-velocity prior as a
-  // tracked one does. Not with matcher.prediction none (the paper's form) or the Kalman
-  // matcher (stateful). Measured on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs,
-  // results/robustness/): defaults' median end-pose error 0.206 -> 0.182 m, max 1.958 ->
-  // 1.663 m, mean 0.431 -> 0.442 m; plain_corridor better at every stride (0.268-0.569 ->
-  // 0.222-0.492 m); with few_point_motion and ground_vehicle mean 0.393 -> 0.328 m.
+  // tracked one does. Not with matcher.prediction none (the paper's form), the Kalman matcher
+  // (stateful), or a caller's MotionPrior (it bridges a lost frame as given). Measured on l_hallway
+  // texture seeds 1-10 x strides 1/2/3/5 (40 runs, results/robustness/): defaults' median end-pose
+  // error 0.206 -> 0.182 m, max 1.958 -> 1.663 m, mean 0.431 -> 0.442 m; plain_corridor better at
+  // every stride (0.268-0.569 -> 0.222-0.492 m); with few_point_motion and ground_vehicle mean
+  // 0.393 -> 0.328 m.
   bool chain_lost_frames = true;
   PriorMotionOptions few_point;  // that solver (fewer inliers than its min_inliers and
                                  // min_inlier_fraction: lost)

@@ -870,6 +870,18 @@ TEST(OdometryPredictionTest, LostFramesAreChainedSoTheMotionThroughTheGapIsMeasu
   EXPECT_EQ(u[5].chained_to_frame, -1);
   EXPECT_THAT(EstimatedMotion(u, 4, 5),
               ::testing::Not(IsNearPose(true_motion(4, 5), 0.3 * kDeg, 0.01)));
+
+  // A caller's prior (here: standing still throughout) bridges the lost frames as given.
+  StereoOdometry with_prior(HallwayCamera(), OdometryOptions());
+  MotionPrior still;  // identity
+  std::vector<OdometryResult> p;
+  for (int i = 0; i <= 5; ++i) {
+    p.push_back(
+        with_prior.Process(frames[i].left, frames[i].right, 0.1 * i, i > 0 ? &still : nullptr));
+  }
+  EXPECT_TRUE(IsLostFrame(p[5])) << p[5].message;
+  EXPECT_EQ(p[5].chained_to_frame, -1);
+  EXPECT_THAT(p[5].T_prev_curr, IsNearPose(Eigen::Isometry3d::Identity(), 1e-9, 1e-9));
 }
 
 TEST(OdometryPredictionTest, LostFramesAndReinitialisationsAreCountedExactly) {
