@@ -313,6 +313,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"tracking.rotation_min_peak_ratio", Number(&t.rotation_min_peak_ratio, 1.0, 1000.0)},
       {"tracking.rotation_min_residual_px", Number(&t.rotation_min_residual_px, 0.0, 1000.0)},
       {"tracking.reliable_min_inliers", Number(&t.reliable_min_inliers, 3, 100000)},
+      {"tracking.prior_update_exponent", Number(&t.prior_update_exponent, 1.0, 100.0)},
       {"tracking.few_point_motion", Bool(&t.few_point_motion)},
       {"tracking.few_point_min_features", Number(&t.few_point_min_features, 1, 100000)},
       {"tracking.ground_vehicle", Bool(&t.ground_vehicle)},

@@ -163,6 +163,8 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
     msg << "rotation_min_residual_px must be finite and >= 0, got " << rotation_min_residual_px;
   } else if (reliable_min_inliers < 3) {
     msg << "reliable_min_inliers must be >= 3, got " << reliable_min_inliers;
+  } else if (!(prior_update_exponent >= 1.0) || !std::isfinite(prior_update_exponent)) {
+    msg << "prior_update_exponent must be finite and >= 1, got " << prior_update_exponent;
   } else if (!(few_point_max_shift_disagreement_px >= 0.0) ||
              !std::isfinite(few_point_max_shift_disagreement_px)) {
     msg << "few_point_max_shift_disagreement_px must be finite and >= 0, got "
@@ -719,6 +721,12 @@ bool StereoOdometry::AgreesWithImageShift(const std::vector<Feature>& ref_featur
   return motion_px <= prior_px + options_.tracking.few_point_max_shift_disagreement_px;
 }
 
+double StereoOdometry::PriorUpdateWeight(int num_inliers) const {
+  const RobustTrackingOptions& o = options_.tracking;
+  return std::pow(std::min(1.0, static_cast<double>(num_inliers) / o.reliable_min_inliers),
+                  o.prior_update_exponent);
+}
+
 bool StereoOdometry::ChainLostFrame(const MatchFrame& frame, const MotionPrior* prior,
                                     OdometryResult* result, Eigen::Isometry3d* T_world_curr) {
   // A caller's prior (wheel odometry, a gyro) bridges a lost frame as given.
@@ -749,8 +757,7 @@ bool StereoOdometry::ChainLostFrame(const MatchFrame& frame, const MotionPrior* 
   // The measured motion moves the constant velocity as a tracked one does (by its support).
   const Eigen::Isometry3d per_frame =
       Root(ransac.T_prev_curr, result->frame_index - lost_chain_.frame_index);
-  const double weight = std::min(
-      1.0, static_cast<double>(ransac.num_inliers) / options_.tracking.reliable_min_inliers);
+  const double weight = PriorUpdateWeight(ransac.num_inliers);
   if (IsFinite(per_frame)) {
     velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
     has_velocity_ = true;
@@ -906,11 +913,9 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
   // Weight of this motion in the prior: 1 from reliable_min_inliers inliers up, less below
   // (a weak motion moves the prior only part of the way), 0 when the BA was rejected.
-  const double weight =
-      ba_rejected ? 0.0
-      : result.few_point_motion
-          ? tracking.few_point_prior_update
-          : std::min(1.0, static_cast<double>(ransac.num_inliers) / tracking.reliable_min_inliers);
+  const double weight = ba_rejected               ? 0.0
+                        : result.few_point_motion ? tracking.few_point_prior_update
+                                                  : PriorUpdateWeight(ransac.num_inliers);
   if (IsFinite(per_frame) && (weight > 0.0 || !has_velocity_)) {
     velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
     has_velocity_ = true;

@@ -195,10 +195,21 @@ struct RobustTrackingOptions {
                                            // motion past plain walls), so the prior stands
   int reliable_min_inliers = 30;           // a motion with at least this many inliers replaces the
                                            // constant-velocity prior; one with fewer moves it only
-                                           // inliers / this of the way (slerp), one whose bundle
+                                           // part of the way (slerp), one whose bundle
                                            // adjustment was rejected not at all; >= 3. 30 =
                                            // confident_min_inliers: a motion the matcher trusts is
                                            // one the prior may repeat
+  double prior_update_exponent = 2.0;      // ... namely (inliers / reliable_min_inliers) to
+                                           // this power of the way, >= 1: a weak motion is
+                                           // also more often grossly wrong (12 inliers at the edge
+                                           // of a plain wall: 1-4 deg of yaw where the robot drove
+                                           // straight), not only noisier, so half the support
+                                           // moves the prior a quarter of the way. Measured on
+                                           // l_hallway texture seeds 1-10 x strides 1/2/3/5 (40
+                                           // runs, defaults): exponent 1 / 1.5 / 2 / 3 gave mean
+                                           // end-pose error 0.442 / 0.419 / 0.398 / 0.393 m,
+                                           // median 0.182 / 0.157 / 0.141 / 0.143 m; 3 took
+                                           // camera.pitch_deg 10 to 1.40 % (2: 0.73 %)
   bool few_point_motion = false;   // OFF by default (measured, l_hallway texture seeds 1-10:
                                    // stride 1 lost frames 113 -> 38, median end-pose error
                                    // 0.347 -> 0.152 m, but strides 2 and 3 worse on seeds 2, 5,
@@ -220,11 +231,12 @@ struct RobustTrackingOptions {
   // rotation from the image shift is a yaw only (the shift's vertical part is zoom and
   // parallax). Needs the up direction from the first frame's orientation (the floor found);
   // without it, 6-DoF. Measured on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs,
-  // results/robustness/, with the lost-frame chain): with few_point_motion, mean end-pose error
-  // 0.442 -> 0.328 m, median 0.182 -> 0.146 m, runs <= 0.29 m 22 -> 27, frames without motion
-  // 256 -> 132 against the defaults; but camera.pitch_deg 10 goes 0.73 -> 1.13 % (drift on the
-  // straight approach that the 6-DoF window BA keeps), so not the default yet. On its own
-  // (few_point_motion off) the mean goes 0.442 -> 0.439 m.
+  // results/robustness/, with the lost-frame chain and prior_update_exponent 2): with
+  // few_point_motion, mean end-pose error 0.375 -> 0.326 m, runs <= 0.29 m 26 -> 27, frames
+  // without motion 256 -> 132 against the defaults (median 0.136 -> 0.146 m); but
+  // camera.pitch_deg 10 goes 0.73 -> 1.13 % (drift on the straight approach that the 6-DoF
+  // window BA keeps), so not the default yet. On its own (few_point_motion off) the mean goes
+  // 0.375 -> 0.387 m.
   bool ground_vehicle = false;
   // A lost frame with at least min_features features is matched against the previous lost
   // frame that had them (the chain), when matching against the reference failed: a turn in
@@ -235,10 +247,10 @@ struct RobustTrackingOptions {
   // chain's pose times that motion, and the motion moves the constant-velocity prior as a
   // tracked one does. Not with matcher.prediction none (the paper's form), the Kalman matcher
   // (stateful), or a caller's MotionPrior (it bridges a lost frame as given). Measured on l_hallway
-  // texture seeds 1-10 x strides 1/2/3/5 (40 runs, results/robustness/): defaults' median end-pose
-  // error 0.206 -> 0.182 m, max 1.958 -> 1.663 m, mean 0.431 -> 0.442 m; plain_corridor better at
-  // every stride (0.268-0.569 -> 0.222-0.492 m); with few_point_motion and ground_vehicle mean
-  // 0.393 -> 0.328 m.
+  // texture seeds 1-10 x strides 1/2/3/5 (40 runs, results/robustness/, linear prior update):
+  // defaults' median end-pose error 0.206 -> 0.182 m, max 1.958 -> 1.663 m, mean 0.431 -> 0.442 m;
+  // plain_corridor better at every stride (0.268-0.569 -> 0.222-0.492 m); with few_point_motion and
+  // ground_vehicle mean 0.393 -> 0.328 m.
   bool chain_lost_frames = true;
   PriorMotionOptions few_point;  // that solver (fewer inliers than its min_inliers and
                                  // min_inlier_fraction: lost)
@@ -583,6 +595,9 @@ class StereoOdometry {
   // coarse-to-fine image shift (when found: shift_ok): the shift it predicts at the image
   // centre (ref_features' median depth) is no farther from the measured one than the prior's
   // prediction, by more than tracking.few_point_max_shift_disagreement_px.
+  // How far a measured motion with num_inliers RANSAC inliers moves the constant velocity:
+  // (num_inliers / reliable_min_inliers)^prior_update_exponent, at most 1.
+  double PriorUpdateWeight(int num_inliers) const;
   bool AgreesWithImageShift(const std::vector<Feature>& ref_features,
                             const Eigen::Isometry3d& T_ref_curr,
                             const Eigen::Isometry3d& T_ref_curr_prior, bool shift_ok,

@@ -1066,6 +1066,8 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
   rejects([](OdometryOptions* o) { o->ba_window_frames = 2; }, "ba_window_frames");
   rejects([](OdometryOptions* o) { o->ba_window_frames = 11; }, "ba_window_frames");
   rejects([](OdometryOptions* o) { o->prior_weight = -0.1; }, "prior_weight");
+  rejects([](OdometryOptions* o) { o->tracking.prior_update_exponent = 0.5; },
+          "prior_update_exponent");
   rejects([](OdometryOptions* o) { o->prior_weight = 1.5; }, "prior_weight");
   rejects([](OdometryOptions* o) { o->min_inliers = 2; }, "min_inliers");
   rejects([](OdometryOptions* o) { o->min_features = 0; }, "min_features");
