@@ -332,7 +332,6 @@ void StereoOdometry::Reset() {
   previous_measured_ = false;
   reference_ = Reference();
   lost_chain_ = Reference();
-  has_chained_pose_ = false;
   T_world_prev_ = Eigen::Isometry3d::Identity();
   velocity_ = Eigen::Isometry3d::Identity();
   has_velocity_ = false;
@@ -423,11 +422,9 @@ Eigen::Isometry3d CorrectPriorWithImageShift(const StereoCamera& camera,
   return T_prev_curr_prior * T_cprime_c;
 }
 
-Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, OdometryResult* result) {
-  if (has_chained_pose_) {  // measured against the lost-frame chain (ChainLostFrame)
-    has_chained_pose_ = false;
-    return chained_pose_;
-  }
+Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, OdometryResult* result,
+                                              const Eigen::Isometry3d* chained) {
+  if (chained != nullptr) return *chained;  // measured against the lost-frame chain
   const Eigen::Isometry3d predicted = T_world_prev_ * BridgeMotion(prior);
   const RobustTrackingOptions& o = options_.tracking;
   if (options_.matcher.prediction == PredictionMode::kNone || !o.rotation_from_shift ||
@@ -493,13 +490,14 @@ Eigen::Isometry3d StereoOdometry::PredictedPose(const MotionPrior* prior) const 
 }
 
 OdometryResult StereoOdometry::Lost(OdometryResult result, const std::string& message,
-                                    TimePoint start, const MotionPrior* prior) {
+                                    TimePoint start, const MotionPrior* prior,
+                                    const Eigen::Isometry3d* chained) {
   result.status = TrackingStatus::kLost;
   result.message = message;
   ++consecutive_lost_;
   // Frames are skipped from the matcher's point of view (the Kalman tracker keeps state).
   matcher_->Reset();
-  const Eigen::Isometry3d T_world_cam0 = BridgedPose(prior, &result);
+  const Eigen::Isometry3d T_world_cam0 = BridgedPose(prior, &result, chained);
   if (result.rotation_from_shift) result.message += "; pose: prior + rotation from the image shift";
   return Finish(std::move(result), T_world_cam0, start);
 }
@@ -516,7 +514,8 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
 
 OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame frame,
                                           const std::string& reason, TimePoint start,
-                                          const MotionPrior* prior) {
+                                          const MotionPrior* prior,
+                                          const Eigen::Isometry3d* chained) {
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
   if (!initialised_) {
     // World = hallway frame with its origin at the first camera centre, or the first camera.
@@ -525,7 +524,7 @@ OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame fram
     result.message = reason;
   } else {
     // Re-initialisation after a loss: keep the predicted pose and the constant velocity.
-    T_world_cam0 = BridgedPose(prior, &result);
+    T_world_cam0 = BridgedPose(prior, &result, chained);
     if (!IsFinite(T_world_cam0)) T_world_cam0 = T_world_prev_;
     result.status = TrackingStatus::kRecovered;
     result.reinitialised = true;
@@ -757,12 +756,15 @@ bool StereoOdometry::ChainLostFrame(const MatchFrame& frame, const MotionPrior* 
   // The measured motion moves the constant velocity as a tracked one does (by its support).
   const Eigen::Isometry3d per_frame =
       Root(ransac.T_prev_curr, result->frame_index - lost_chain_.frame_index);
-  const double weight = PriorUpdateWeight(ransac.num_inliers);
-  if (IsFinite(per_frame)) {
+  MoveVelocity(per_frame, PriorUpdateWeight(ransac.num_inliers));
+  return true;
+}
+
+void StereoOdometry::MoveVelocity(const Eigen::Isometry3d& per_frame, double weight) {
+  if (IsFinite(per_frame) && (weight > 0.0 || !has_velocity_)) {
     velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
     has_velocity_ = true;
   }
-  return true;
 }
 
 OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, MotionAttempt attempt,
@@ -834,8 +836,9 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     result.times.motion_ms += MsSince(motion_start);
     // The reference cannot measure this frame: the lost frames before it may (the pose and the
     // constant velocity from that chain; BridgedPose takes the pose).
-    if (ChainLostFrame(frame, prior, &result, &chained_pose_)) {
-      has_chained_pose_ = true;
+    Eigen::Isometry3d T_world_chained;
+    const bool chained = ChainLostFrame(frame, prior, &result, &T_world_chained);
+    if (chained) {
       why << "; pose chained to lost frame " << result.chained_to_frame << " ("
           << result.chain_inliers << " inliers)";
     }
@@ -846,9 +849,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     if (consecutive_lost_ >= options_.reinit_after_lost_frames || (consecutive_lost_ > 0 && rich)) {
       // The reference is stale: start again from this frame at its predicted (or chained) pose.
       return Initialise(std::move(result), std::move(frame),
-                        why.str() + "; re-initialised at the predicted pose", start, prior);
+                        why.str() + "; re-initialised at the predicted pose", start, prior,
+                        chained ? &T_world_chained : nullptr);
     }
-    OdometryResult lost = Lost(std::move(result), why.str(), start, prior);
+    OdometryResult lost =
+        Lost(std::move(result), why.str(), start, prior, chained ? &T_world_chained : nullptr);
     if (options_.tracking.chain_lost_frames &&
         static_cast<int>(frame.features.size()) >= options_.min_features) {
       lost_chain_.valid = true;  // the next lost frame is matched against this one
@@ -916,10 +921,7 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const double weight = ba_rejected               ? 0.0
                         : result.few_point_motion ? tracking.few_point_prior_update
                                                   : PriorUpdateWeight(ransac.num_inliers);
-  if (IsFinite(per_frame) && (weight > 0.0 || !has_velocity_)) {
-    velocity_ = has_velocity_ ? Blend(velocity_, per_frame, weight) : per_frame;
-    has_velocity_ = true;
-  }
+  MoveVelocity(per_frame, weight);
   result.motion_measured = true;
 
   result.status = consecutive_lost_ > 0 ? TrackingStatus::kRecovered : TrackingStatus::kTracking;

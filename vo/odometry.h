@@ -623,18 +623,25 @@ class StereoOdometry {
                                  const MotionPrior* prior) const;
   // The prior's motion for a frame without a measured motion: PlanarBridge(PriorMotion).
   Eigen::Isometry3d BridgeMotion(const MotionPrior* prior) const;
-  // The pose of a frame without a measured motion: the chain's measured pose when
-  // ChainLostFrame found one for it (chained_pose_), else the predicted pose, corrected by the
-  // image shift from the previous frame where it is found (sets result->rotation_from_shift).
-  Eigen::Isometry3d BridgedPose(const MotionPrior* prior, OdometryResult* result);
+  // The pose of a frame without a measured motion: `chained` when ChainLostFrame measured one
+  // (non-null), else the predicted pose, corrected by the image shift from the previous frame
+  // where it is found (sets result->rotation_from_shift).
+  Eigen::Isometry3d BridgedPose(const MotionPrior* prior, OdometryResult* result,
+                                const Eigen::Isometry3d* chained = nullptr);
 
-  // A lost frame: pose = constant-velocity prediction, reference and tracks kept.
+  // A lost frame: pose = constant-velocity prediction (or `chained`, see BridgedPose),
+  // reference and tracks kept.
   OdometryResult Lost(OdometryResult result, const std::string& message, TimePoint start,
-                      const MotionPrior* prior = nullptr);
+                      const MotionPrior* prior = nullptr,
+                      const Eigen::Isometry3d* chained = nullptr);
   // (Re-)initialises on `frame`: first time at the initial orientation, later at the predicted
-  // pose (kRecovered). `reason` goes into the message.
+  // (or chained) pose (kRecovered). `reason` goes into the message.
   OdometryResult Initialise(OdometryResult result, MatchFrame frame, const std::string& reason,
-                            TimePoint start, const MotionPrior* prior = nullptr);
+                            TimePoint start, const MotionPrior* prior = nullptr,
+                            const Eigen::Isometry3d* chained = nullptr);
+  // The constant-velocity model moved `weight` of the way (slerp) to a measured per-frame
+  // motion (the first one is taken as it is; a non-finite one is ignored).
+  void MoveVelocity(const Eigen::Isometry3d& per_frame, double weight);
   // Everything after matching: RANSAC, tracks, blend, BA. `result` carries the counts so far.
   // T_ref_curr_prior: the prior's motion from the reference to this frame (null = none), the
   // blend's partner; `prior`: the caller's prior (for the pose of a lost frame), may be null.
@@ -666,10 +673,8 @@ class StereoOdometry {
   Reference lost_chain_;  // the last lost frame with at least min_features features, since the
                           // last tracked one (tracking.chain_lost_frames), ...
   Eigen::Isometry3d T_world_chain_ = Eigen::Isometry3d::Identity();  // ... and its output pose
-  bool has_chained_pose_ = false;  // ChainLostFrame measured this frame's pose: chained_pose_
-  Eigen::Isometry3d chained_pose_ = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();  // previous call's output
-  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();      // constant-velocity model: last
+  Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();   // previous call's output
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // constant-velocity model: last
                                                                 // estimated per-frame T_prev_curr
   bool has_velocity_ = false;
   int scene_num_disparities_ = 0;  // next frame's search range from the scene; 0 = full
