@@ -318,6 +318,8 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"tracking.few_point_min_features", Number(&t.few_point_min_features, 1, 100000)},
       {"tracking.ground_vehicle", Bool(&t.ground_vehicle)},
       {"tracking.chain_lost_frames", Bool(&t.chain_lost_frames)},
+      {"tracking.vehicle_max_weak_tilt_deg", Number(&t.vehicle_max_weak_tilt_deg, 1e-6, 180.0)},
+      {"tracking.vehicle_max_weak_lift_m", Number(&t.vehicle_max_weak_lift_m, 1e-6, 100.0)},
       {"tracking.few_point.min_inliers", Number(&t.few_point.min_inliers, 1, 100000)},
       {"tracking.few_point.min_inlier_fraction",
        Number(&t.few_point.min_inlier_fraction, 0.0, 1.0)},

@@ -169,6 +169,10 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
              !std::isfinite(few_point_max_shift_disagreement_px)) {
     msg << "few_point_max_shift_disagreement_px must be finite and >= 0, got "
         << few_point_max_shift_disagreement_px;
+  } else if (!(vehicle_max_weak_tilt_deg > 0.0) || !std::isfinite(vehicle_max_weak_tilt_deg)) {
+    msg << "vehicle_max_weak_tilt_deg must be finite and > 0, got " << vehicle_max_weak_tilt_deg;
+  } else if (!(vehicle_max_weak_lift_m > 0.0) || !std::isfinite(vehicle_max_weak_lift_m)) {
+    msg << "vehicle_max_weak_lift_m must be finite and > 0, got " << vehicle_max_weak_lift_m;
   } else if (few_point_min_features < 1) {
     msg << "few_point_min_features must be >= 1, got " << few_point_min_features;
   } else if (!(few_point_prior_update >= 0.0 && few_point_prior_update <= 1.0)) {
@@ -378,6 +382,14 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
   current_left_ = cv::Mat();
   result.times.total_ms = MsSince(start);
   return result;
+}
+
+bool IsVehicleLike(const Eigen::Isometry3d& T_a_b, const Eigen::Vector3d& up_a, double max_tilt_deg,
+                   double max_lift_m) {
+  const Eigen::Isometry3d planar = PlanarPart(T_a_b, up_a);
+  const double tilt_rad = Eigen::AngleAxisd(planar.linear().transpose() * T_a_b.linear()).angle();
+  const double lift_m = std::abs(up_a.normalized().dot(T_a_b.translation()));
+  return tilt_rad <= max_tilt_deg * M_PI / 180.0 && lift_m <= max_lift_m;
 }
 
 Eigen::Vector2d PredictedCentreShift(const StereoCamera& camera,
@@ -786,6 +798,15 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const bool few_features = static_cast<int>(frame.features.size()) < options_.min_features;
   bool ransac_failed = few_features || !ransac.ok() || ransac.num_inliers < options_.min_inliers ||
                        !IsFinite(ransac.T_prev_curr);
+  // A ground vehicle neither tilts nor lifts: a weak motion that does is a wrong consensus.
+  const Eigen::Isometry3d* T_world_ref_pose = window_.Pose(reference_.frame_index);
+  if (!ransac_failed && tracking.ground_vehicle && world_up_known_ && T_world_ref_pose != nullptr &&
+      ransac.num_inliers < tracking.reliable_min_inliers &&
+      !IsVehicleLike(ransac.T_prev_curr, WorldUpInCamera(*T_world_ref_pose),
+                     tracking.vehicle_max_weak_tilt_deg, tracking.vehicle_max_weak_lift_m)) {
+    ransac_failed = true;
+    ransac.message = "a weak motion that tilts or lifts the ground vehicle";
+  }
   if (ransac_failed && tracking.few_point_motion && T_ref_curr_prior != nullptr &&
       previous_measured_ && consecutive_lost_ == 0 &&
       options_.matcher.prediction != PredictionMode::kNone && !correspondences.empty() &&

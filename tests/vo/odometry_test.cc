@@ -283,6 +283,38 @@ TEST(OdometrySeamTest, PredictedCentreShiftIsExact) {
   EXPECT_NEAR(PredictedCentreShift(cam, step, -1.0).x(), 0.0, 1e-12);
 }
 
+// The ground-vehicle gate (tracking.vehicle_max_weak_tilt_deg / _lift_m): a yaw about up and
+// a step across it pass whatever their size; a tilt (rotation about an axis across up) or a
+// lift along up passes up to its limit and not beyond, also for a pitched camera.
+TEST(OdometrySeamTest, VehicleLikeMotionIsAYawAndAStepInThePlane) {
+  for (double camera_pitch_deg : {0.0, 10.0}) {
+    // The world's up in the camera frame (cv axes: y down), for a camera pitched down.
+    const Eigen::Vector3d up =
+        Eigen::AngleAxisd(-camera_pitch_deg * kDeg, Eigen::Vector3d::UnitX()) *
+        Eigen::Vector3d(0.0, -1.0, 0.0);
+    const Eigen::Vector3d across = up.cross(Eigen::Vector3d::UnitZ()).normalized();
+    const Eigen::Vector3d forward = across.cross(up).normalized();
+    auto motion = [&](double yaw_deg, double tilt_deg, double step_m, double lift_m) {
+      return MakePose(
+          (Eigen::AngleAxisd(yaw_deg * kDeg, up) * Eigen::AngleAxisd(tilt_deg * kDeg, across))
+              .toRotationMatrix(),
+          step_m * forward + 0.3 * step_m * across + lift_m * up);
+    };
+    const std::string at = "camera pitch " + std::to_string(camera_pitch_deg);
+    EXPECT_TRUE(IsVehicleLike(motion(0.0, 0.0, 0.0, 0.0), up, 2.0, 0.03)) << at;
+    EXPECT_TRUE(IsVehicleLike(motion(45.0, 0.0, 0.5, 0.0), up, 2.0, 0.03)) << at;
+    EXPECT_TRUE(IsVehicleLike(motion(-20.0, 1.9, 0.1, 0.0), up, 2.0, 0.03)) << at;
+    EXPECT_FALSE(IsVehicleLike(motion(-20.0, 2.1, 0.1, 0.0), up, 2.0, 0.03)) << at;
+    EXPECT_FALSE(IsVehicleLike(motion(0.0, -9.0, 0.0, 0.0), up, 2.0, 0.03)) << at;
+    EXPECT_TRUE(IsVehicleLike(motion(5.0, 0.0, 0.1, 0.029), up, 2.0, 0.03)) << at;
+    EXPECT_FALSE(IsVehicleLike(motion(5.0, 0.0, 0.1, -0.031), up, 2.0, 0.03)) << at;
+    EXPECT_TRUE(IsVehicleLike(motion(5.0, 0.0, 0.1, -0.031), 3.0 * up, 2.0, 0.04)) << at;
+    Eigen::Isometry3d bad = motion(5.0, 0.0, 0.1, 0.0);
+    bad.translation().x() = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_FALSE(IsVehicleLike(bad, up, 2.0, 0.03)) << at;
+  }
+}
+
 TEST(OdometrySeamTest, TooFewMatchesIsLostThenReinitialises) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
@@ -1068,6 +1100,13 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
   rejects([](OdometryOptions* o) { o->prior_weight = -0.1; }, "prior_weight");
   rejects([](OdometryOptions* o) { o->tracking.prior_update_exponent = 0.5; },
           "prior_update_exponent");
+  rejects([](OdometryOptions* o) { o->tracking.vehicle_max_weak_tilt_deg = 0.0; },
+          "vehicle_max_weak_tilt_deg");
+  rejects(
+      [](OdometryOptions* o) {
+        o->tracking.vehicle_max_weak_lift_m = std::numeric_limits<double>::infinity();
+      },
+      "vehicle_max_weak_lift_m");
   rejects([](OdometryOptions* o) { o->prior_weight = 1.5; }, "prior_weight");
   rejects([](OdometryOptions* o) { o->min_inliers = 2; }, "min_inliers");
   rejects([](OdometryOptions* o) { o->min_features = 0; }, "min_features");
