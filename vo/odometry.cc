@@ -173,6 +173,18 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
     msg << "vehicle_max_weak_tilt_deg must be finite and > 0, got " << vehicle_max_weak_tilt_deg;
   } else if (!(vehicle_max_weak_lift_m > 0.0) || !std::isfinite(vehicle_max_weak_lift_m)) {
     msg << "vehicle_max_weak_lift_m must be finite and > 0, got " << vehicle_max_weak_lift_m;
+  } else if (!(vehicle_rotation_min_shift_score >= -1.0 &&
+               vehicle_rotation_min_shift_score <= 1.0)) {
+    msg << "vehicle_rotation_min_shift_score must be in [-1, 1], got "
+        << vehicle_rotation_min_shift_score;
+  } else if (!(vehicle_rotation_min_peak_ratio >= 1.0) ||
+             !std::isfinite(vehicle_rotation_min_peak_ratio)) {
+    msg << "vehicle_rotation_min_peak_ratio must be finite and >= 1, got "
+        << vehicle_rotation_min_peak_ratio;
+  } else if (!(vehicle_max_vertical_shift_ratio >= 0.0) ||
+             !std::isfinite(vehicle_max_vertical_shift_ratio)) {
+    msg << "vehicle_max_vertical_shift_ratio must be finite and >= 0, got "
+        << vehicle_max_vertical_shift_ratio;
   } else if (few_point_min_features < 1) {
     msg << "few_point_min_features must be >= 1, got " << few_point_min_features;
   } else if (!(few_point_prior_update >= 0.0 && few_point_prior_update <= 1.0)) {
@@ -434,6 +446,31 @@ Eigen::Isometry3d CorrectPriorWithImageShift(const StereoCamera& camera,
   return T_prev_curr_prior * T_cprime_c;
 }
 
+Eigen::Isometry3d VehicleMotionFromImageShift(const StereoCamera& camera,
+                                              const Eigen::Vector3d& up_prev,
+                                              double axle_behind_camera_m,
+                                              const Eigen::Isometry3d& T_prev_curr_prior,
+                                              const Eigen::Vector2d& shift_px, double depth_m) {
+  const Eigen::Vector2d yaw_forward =
+      VehicleMotionParameters(T_prev_curr_prior, up_prev, axle_behind_camera_m);
+  if (!yaw_forward.allFinite() || !shift_px.allFinite() || !up_prev.allFinite()) {
+    return T_prev_curr_prior;
+  }
+  const double forward_m = yaw_forward.y();
+  double yaw = yaw_forward.x();
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::Isometry3d T = VehicleMotion(up_prev, axle_behind_camera_m, yaw, forward_m);
+    const Eigen::Isometry3d corrected =
+        PlanarPart(CorrectPriorWithImageShift(camera, T, shift_px, depth_m), up_prev);
+    const double next = VehicleMotionParameters(corrected, up_prev, axle_behind_camera_m).x();
+    if (!std::isfinite(next)) return T_prev_curr_prior;
+    const bool converged = std::abs(next - yaw) <= 1e-12;
+    yaw = next;
+    if (converged) break;
+  }
+  return VehicleMotion(up_prev, axle_behind_camera_m, yaw, forward_m);
+}
+
 Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, OdometryResult* result,
                                               const Eigen::Isometry3d* chained) {
   if (chained != nullptr) return *chained;  // measured against the lost-frame chain
@@ -447,10 +484,15 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
   const Clock::time_point t = Clock::now();
   const ImageShiftResult shift = EstimateImageShift(previous_left_, current_left_, o.image_shift);
   result->times.predict_ms += MsSince(t);
-  if (!shift.ok || !(shift.score >= o.rotation_min_shift_score) ||
-      !(shift.second_best_ratio >= o.rotation_min_peak_ratio)) {
-    return predicted;
-  }
+  // A ground vehicle (its motion a yaw and a forward step, the camera swinging about the axle)
+  // reads the shift with that model: a sharp peak is trusted at a lower score, and a shift whose
+  // vertical part (no pitch: zoom, parallax) is large against its horizontal part is no turn.
+  const bool vehicle = prior == nullptr && o.ground_vehicle && world_up_known_;
+  const bool strong = shift.score >= o.rotation_min_shift_score &&
+                      shift.second_best_ratio >= o.rotation_min_peak_ratio;
+  const bool sharp = vehicle && shift.score >= o.vehicle_rotation_min_shift_score &&
+                     shift.second_best_ratio >= o.vehicle_rotation_min_peak_ratio;
+  if (!shift.ok || !(strong || sharp)) return predicted;
   // The prior's own frame-to-frame motion (not T_world_prev⁻¹ · predicted, which would feed
   // rounding in the composed poses back into the prior, frame after frame), corrected at the
   // median depth of this frame's features (last_features_; none: far away).
@@ -462,9 +504,22 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
     std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
     depth_m = z[z.size() / 2];
   }
-  // A ground vehicle turns about up only: the shift's vertical part (zoom, parallax) is no tilt.
-  const Eigen::Isometry3d T_prev_curr = PlanarBridge(
-      CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m), prior);
+  Eigen::Isometry3d T_prev_curr;
+  if (vehicle) {
+    const Eigen::Vector2d residual =
+        shift.shift_px - PredictedCentreShift(camera_, T_prev_curr_prior, depth_m);
+    if (!(std::abs(residual.y()) <=
+          std::max(o.rotation_min_residual_px,
+                   o.vehicle_max_vertical_shift_ratio * std::abs(residual.x())))) {
+      return predicted;
+    }
+    T_prev_curr = VehicleMotionFromImageShift(camera_, WorldUpInCamera(T_world_prev_),
+                                              o.few_point.axle_behind_camera_m, T_prev_curr_prior,
+                                              shift.shift_px, depth_m);
+  } else {
+    T_prev_curr = PlanarBridge(
+        CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m), prior);
+  }
   if (!IsFinite(T_prev_curr)) return predicted;
   // The shift the prior itself predicts: the correction's rotation seen at the image centre.
   const double residual_px =

@@ -990,6 +990,45 @@ TEST(OdometryPredictionTest, ImageShiftCorrectionRecoversAPan) {
   }
 }
 
+TEST(OdometryPredictionTest, VehicleMotionFromImageShiftRecoversATurnWithTheSwing) {
+  // A vehicle with its axle 0.15 m behind the camera turns in front of a wall; the prior knows
+  // its forward step but not the turn. The shift of the centre point (at the wall's depth) under
+  // the true motion gives back the true yaw, swing included; read as a rotation alone
+  // (CorrectPriorWithImageShift) the near wall's parallax is taken as turn.
+  const StereoCamera cam = HallwayCamera();
+  const double axle_m = 0.15;
+  for (double camera_pitch_deg : {0.0, 10.0}) {
+    const Eigen::Vector3d up =
+        Eigen::AngleAxisd(-camera_pitch_deg * kDeg, Eigen::Vector3d::UnitX()) *
+        Eigen::Vector3d(0.0, -1.0, 0.0);
+    for (double yaw_deg : {-11.0, -2.0, 0.7, 4.5}) {
+      for (double forward_m : {0.0, 0.04}) {
+        const Eigen::Isometry3d T_true = VehicleMotion(up, axle_m, yaw_deg * kDeg, forward_m);
+        const Eigen::Isometry3d T_prior = VehicleMotion(up, axle_m, 0.0, forward_m);
+        const double depth_m = 0.85;
+        const Eigen::Vector3d p_curr = T_true.inverse() * Eigen::Vector3d(0.0, 0.0, depth_m);
+        const Eigen::Vector2d shift(cam.fx_px * p_curr.x() / p_curr.z(),
+                                    cam.fy_px * p_curr.y() / p_curr.z());
+        const std::string at = "pitch " + std::to_string(camera_pitch_deg) + " yaw " +
+                               std::to_string(yaw_deg) + " forward " + std::to_string(forward_m);
+        const Eigen::Isometry3d T =
+            VehicleMotionFromImageShift(cam, up, axle_m, T_prior, shift, depth_m);
+        EXPECT_THAT(T, IsNearPose(T_true, 1e-9, 1e-10)) << at;
+        const Eigen::Isometry3d T_rotation_only =
+            PlanarPart(CorrectPriorWithImageShift(cam, T_prior, shift, depth_m), up);
+        const double over_read =
+            VehicleMotionParameters(T_rotation_only, up, axle_m).x() / (yaw_deg * kDeg);
+        EXPECT_GT(over_read, 1.1) << at;  // ~1 + 0.15 / 0.85
+      }
+    }
+    // No shift information (non-finite): the prior comes back.
+    const Eigen::Isometry3d T_prior = VehicleMotion(up, axle_m, 0.02, 0.03);
+    EXPECT_THAT(VehicleMotionFromImageShift(cam, up, axle_m, T_prior,
+                                            Eigen::Vector2d(std::nan(""), 0.0), 0.85),
+                IsNearPose(T_prior, 0.0, 0.0));
+  }
+}
+
 TEST(OdometryPredictionTest, AdaptiveDetectionFindsCornersBesideOneStrongEdge) {
   // A low-contrast view with one high-contrast square: the square's corners set the relative
   // Harris threshold so high that little else passes; the adaptive second detection (off by
@@ -1100,6 +1139,12 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
   rejects([](OdometryOptions* o) { o->prior_weight = -0.1; }, "prior_weight");
   rejects([](OdometryOptions* o) { o->tracking.prior_update_exponent = 0.5; },
           "prior_update_exponent");
+  rejects([](OdometryOptions* o) { o->tracking.vehicle_rotation_min_shift_score = 1.5; },
+          "vehicle_rotation_min_shift_score");
+  rejects([](OdometryOptions* o) { o->tracking.vehicle_rotation_min_peak_ratio = 0.9; },
+          "vehicle_rotation_min_peak_ratio");
+  rejects([](OdometryOptions* o) { o->tracking.vehicle_max_vertical_shift_ratio = -1.0; },
+          "vehicle_max_vertical_shift_ratio");
   rejects([](OdometryOptions* o) { o->tracking.vehicle_max_weak_tilt_deg = 0.0; },
           "vehicle_max_weak_tilt_deg");
   rejects(
