@@ -15,7 +15,10 @@ CONFIGS = [("default", "svd_ncc_gabor, prediction: motion_prior (the library def
            ("ncc_mutual", "ncc_mutual, prediction: motion_prior"),
            ("few_point", "svd_ncc_gabor, tracking.few_point_motion: true"),
            ("few_point_ground", "svd_ncc_gabor, tracking.few_point_motion: true, "
-            "ground_vehicle: true")]
+            "ground_vehicle: true"),
+           ("ground", "svd_ncc_gabor, tracking.ground_vehicle: true"),
+           ("few_point_ground_rig", "svd_ncc_gabor, tracking.few_point_motion: true, "
+            "ground_vehicle: true, few_point.axle_behind_camera_m: 0.15 (the rig's camera.forward_m)")]
 KEYS = ["end_pose_error_m", "end_pose_error_pct", "ate_rmse_m", "lost_frames",
         "reinitialisations", "vo_ms_median"]
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Robustness sweep of issue #9, the figures in results/robustness/summary.md: l_hallway with
 # texture seeds 1-10 (only textures.seed changed) x frame strides 1, 2, 3, 5 (and 8 on seed 7)
-# x six VO configurations, plus camera.pitch_deg 10, a 640x480 camera (same field of view) and
+# x eight VO configurations, plus camera.pitch_deg 10, a 640x480 camera (same field of view) and
 # the low-texture plain_corridor scene at strides 1, 2, 3, 5.
 # Each hallway is rendered once (vobench render, KITTI layout) and every run reads the same
 # frames (vobench run --dataset --stride), which gives the same trajectories as simulating each
@@ -42,8 +42,13 @@ printf 'matcher:\n  type: ncc_mutual\n' > "$WORK/ncc_mutual.yaml"
 printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n' > "$WORK/few_point.yaml"
 printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n' \
   > "$WORK/few_point_ground.yaml"
+printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  ground_vehicle: true\n' > "$WORK/ground.yaml"
+# Both, with the rig's calibration: the camera 0.15 m ahead of the wheel axle (camera.forward_m, set in
+# scenes/l_hallway.yaml, the default for plain_corridor), which the KITTI-layout dataset does not carry.
+printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
+  > "$WORK/few_point_ground_rig.yaml"
 runs=()
-for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual few_point few_point_ground}; do
+for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual few_point few_point_ground ground few_point_ground_rig}; do
   for s in 1 2 3 4 5 6 7 8 9 10; do for k in 1 2 3 5; do runs+=("seed$s $k $c"); done; done
   runs+=("seed7 8 $c" "pitch10 1 $c" "vga 1 $c")
   for k in 1 2 3 5; do runs+=("corridor $k $c"); done
