@@ -855,13 +855,12 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
                        !IsFinite(ransac.T_prev_curr);
   // A ground vehicle neither tilts nor lifts: a weak motion that does is a wrong consensus.
   const Eigen::Isometry3d* T_world_ref_pose = window_.Pose(reference_.frame_index);
-  if (!ransac_failed && tracking.ground_vehicle && world_up_known_ && T_world_ref_pose != nullptr &&
+  const bool not_vehicle_like =
+      !ransac_failed && tracking.ground_vehicle && world_up_known_ && T_world_ref_pose != nullptr &&
       ransac.num_inliers < tracking.reliable_min_inliers &&
       !IsVehicleLike(ransac.T_prev_curr, WorldUpInCamera(*T_world_ref_pose),
-                     tracking.vehicle_max_weak_tilt_deg, tracking.vehicle_max_weak_lift_m)) {
-    ransac_failed = true;
-    ransac.message = "a weak motion that tilts or lifts the ground vehicle";
-  }
+                     tracking.vehicle_max_weak_tilt_deg, tracking.vehicle_max_weak_lift_m);
+  if (not_vehicle_like) ransac_failed = true;
   if (ransac_failed && tracking.few_point_motion && T_ref_curr_prior != nullptr &&
       previous_measured_ && consecutive_lost_ == 0 &&
       options_.matcher.prediction != PredictionMode::kNone && !correspondences.empty() &&
@@ -902,11 +901,14 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   if (!result.few_point_motion && ransac_failed) {
     std::ostringstream why;
     why << "motion failed: "
-        << (few_features  ? "too few features for RANSAC, no few-point motion"
-            : ransac.ok() ? "too few inliers"
-                          : ToString(ransac.status))
+        << (few_features       ? "too few features for RANSAC, no few-point motion"
+            : not_vehicle_like ? "a weak motion tilts or lifts the ground vehicle (more than "
+                                 "tracking.vehicle_max_weak_tilt_deg / _lift_m)"
+            : ransac.ok()      ? "too few inliers"
+                               : ToString(ransac.status))
         << " (" << ransac.num_inliers << " inliers of " << correspondences.size()
         << " correspondences, " << matches.size() << " matches; need " << options_.min_inliers
+        << (not_vehicle_like ? ", and tracking.reliable_min_inliers to pass without the check" : "")
         << ")";
     if (!ransac.message.empty()) why << ": " << ransac.message;
     result.times.motion_ms += MsSince(motion_start);

@@ -83,9 +83,9 @@ struct SeamFrame {
 
 // Exact projections of the visible points into frame i (at most 250, in a frame-dependent
 // order so feature indices differ between frames).
-SeamFrame MakeSeamFrame(const StereoCamera& cam, const std::vector<Eigen::Vector3d>& points,
-                        int i) {
-  const Eigen::Isometry3d T_cam_world = SeamPose(i).inverse();
+SeamFrame MakeSeamFrameAt(const StereoCamera& cam, const std::vector<Eigen::Vector3d>& points,
+                          const Eigen::Isometry3d& T_world_cam, int i) {
+  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
   SeamFrame frame;
   SplitMix64 rng(1000 + i);
   std::vector<int> order(points.size());
@@ -107,6 +107,11 @@ SeamFrame MakeSeamFrame(const StereoCamera& cam, const std::vector<Eigen::Vector
     if (frame.features.size() >= 250) break;
   }
   return frame;
+}
+
+SeamFrame MakeSeamFrame(const StereoCamera& cam, const std::vector<Eigen::Vector3d>& points,
+                        int i) {
+  return MakeSeamFrameAt(cam, points, SeamPose(i), i);
 }
 
 // Matches by point id; `outlier_every` > 0 corrupts every n-th match into a wrong pairing.
@@ -313,6 +318,57 @@ TEST(OdometrySeamTest, VehicleLikeMotionIsAYawAndAStepInThePlane) {
     bad.translation().x() = std::numeric_limits<double>::quiet_NaN();
     EXPECT_FALSE(IsVehicleLike(bad, up, 2.0, 0.03)) << at;
   }
+}
+
+// tracking.ground_vehicle refuses a weak motion that tilts the vehicle. The seam's world with a
+// floor 1 m below the first camera (so the first frame finds up); frame 5 is seen from its pose
+// pitched by 5° and matched by 20 exact matches only (weak: fewer than reliable_min_inliers).
+TEST(OdometrySeamTest, GroundVehicleRefusesAWeakMotionThatTilts) {
+  const StereoCamera cam = HallwayCamera();
+  std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  for (double x = -3.0; x <= 3.0; x += 0.5) {
+    for (double z = 2.5; z <= 9.0; z += 0.5) points.emplace_back(x, 1.0, z);
+  }
+  std::vector<SeamFrame> frames;
+  for (int i = 0; i < 5; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
+  const Eigen::Isometry3d T_world_tilted =
+      SeamPose(5) *
+      MakePose(Eigen::AngleAxisd(5.0 * kDeg, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+               Eigen::Vector3d::Zero());
+  frames.push_back(MakeSeamFrameAt(cam, points, T_world_tilted, 5));
+  const std::vector<Match> all = SeamMatches(frames[4], frames[5], 0);
+  ASSERT_GE(all.size(), 60u);
+  const std::vector<Match> weak(all.begin(), all.begin() + 20);
+  auto run = [&](bool ground_vehicle, const std::vector<Match>& matches_5) {
+    OdometryOptions options;
+    options.tracking.ground_vehicle = ground_vehicle;
+    options.tracking.few_point_motion = false;
+    StereoOdometry vo(cam, options);
+    const OdometryResult r0 = vo.ProcessFeatures(frames[0].features, {}, 0.0);
+    EXPECT_TRUE(r0.initial_orientation_ok) << r0.message;
+    for (int i = 1; i < 5; ++i) {
+      const OdometryResult r =
+          vo.ProcessFeatures(frames[i].features, SeamMatches(frames[i - 1], frames[i], 0), 0.1 * i);
+      EXPECT_EQ(r.status, TrackingStatus::kTracking) << r.message;
+    }
+    return vo.ProcessFeatures(frames[5].features, matches_5, 0.5);
+  };
+  const Eigen::Isometry3d true_motion = SeamPose(4).inverse() * T_world_tilted;
+  // A ground vehicle: refused, the frame goes on without a measured motion.
+  const OdometryResult refused = run(true, weak);
+  EXPECT_TRUE(IsLostFrame(refused)) << refused.message;
+  EXPECT_FALSE(refused.motion_measured);
+  EXPECT_NE(refused.message.find("tilts or lifts the ground vehicle"), std::string::npos)
+      << refused.message;
+  // Without the option the same 20 matches are a motion (the tilted one, exactly).
+  const OdometryResult free_camera = run(false, weak);
+  EXPECT_EQ(free_camera.status, TrackingStatus::kTracking) << free_camera.message;
+  EXPECT_EQ(free_camera.num_inliers, 20);
+  EXPECT_THAT(free_camera.T_prev_curr, IsNearPose(true_motion, 1e-3, 1e-3));
+  // With every match the motion is reliable and stands, tilt or not.
+  const OdometryResult strong = run(true, all);
+  EXPECT_EQ(strong.status, TrackingStatus::kTracking) << strong.message;
+  EXPECT_THAT(strong.T_prev_curr, IsNearPose(true_motion, 1e-3, 1e-3));
 }
 
 TEST(OdometrySeamTest, TooFewMatchesIsLostThenReinitialises) {
