@@ -516,9 +516,8 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
     T_prev_curr = VehicleMotionFromImageShift(camera_, WorldUpInCamera(T_world_prev_),
                                               o.few_point.axle_behind_camera_m, T_prev_curr_prior,
                                               shift.shift_px, depth_m);
-  } else {
-    T_prev_curr = PlanarBridge(
-        CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m), prior);
+  } else {  // (not a ground vehicle whose up is known: PlanarBridge would change nothing)
+    T_prev_curr = CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m);
   }
   if (!IsFinite(T_prev_curr)) return predicted;
   // The shift the prior itself predicts: the correction's rotation seen at the image centre.
@@ -854,11 +853,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   bool ransac_failed = few_features || !ransac.ok() || ransac.num_inliers < options_.min_inliers ||
                        !IsFinite(ransac.T_prev_curr);
   // A ground vehicle neither tilts nor lifts: a weak motion that does is a wrong consensus.
-  const Eigen::Isometry3d* T_world_ref_pose = window_.Pose(reference_.frame_index);
+  const Eigen::Isometry3d* T_world_ref = window_.Pose(reference_.frame_index);
   const bool not_vehicle_like =
-      !ransac_failed && tracking.ground_vehicle && world_up_known_ && T_world_ref_pose != nullptr &&
+      !ransac_failed && tracking.ground_vehicle && world_up_known_ && T_world_ref != nullptr &&
       ransac.num_inliers < tracking.reliable_min_inliers &&
-      !IsVehicleLike(ransac.T_prev_curr, WorldUpInCamera(*T_world_ref_pose),
+      !IsVehicleLike(ransac.T_prev_curr, WorldUpInCamera(*T_world_ref),
                      tracking.vehicle_max_weak_tilt_deg, tracking.vehicle_max_weak_lift_m);
   if (not_vehicle_like) ransac_failed = true;
   if (ransac_failed && tracking.few_point_motion && T_ref_curr_prior != nullptr &&
@@ -956,7 +955,6 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
 
   // Tracks from the inlier matches (track ids and ages written into the features), the
   // frame's initial pose into the window.
-  const Eigen::Isometry3d* T_world_ref = window_.Pose(reference_.frame_index);
   if (T_world_ref == nullptr) {  // cannot happen: the reference is the window's newest frame
     result.times.motion_ms += MsSince(motion_start);
     return Lost(std::move(result), "the reference frame has no pose in the window", start, prior);
