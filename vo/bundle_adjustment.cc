@@ -292,6 +292,7 @@ struct BackendProblem {
   std::vector<Eigen::Vector3d> points;
   std::vector<int> observations;  // indices into the input's observations
   std::vector<bool> pose_in_problem;
+  std::vector<std::pair<int, int>> planar_links;  // (earlier, later) pose of each planar block
 };
 
 // Ceres' linear solver for BundleAdjustmentOptions::linear_solver (see BaLinearSolver).
@@ -347,6 +348,11 @@ BackendResult SolveWithCeres(const StereoCamera& cam, const BundleAdjustmentProb
     problem.AddResidualBlock(cost, loss, bp->poses[o.frame_index].data(),
                              bp->points[o.point_index].data());
   }
+  for (const auto& [a, b] : bp->planar_links) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlanarMotionResidual, 4, 7, 7>(
+                                 new PlanarMotionResidual(input.planar)),
+                             nullptr, bp->poses[a].data(), bp->poses[b].data());
+  }
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (size_t i = 0; i < bp->poses.size(); ++i) {
     if (!bp->pose_in_problem[i]) continue;
@@ -397,8 +403,8 @@ BackendResult SolveWithSchurLm(const StereoCamera& cam, const BundleAdjustmentPr
   std::vector<bool> pose_is_free(bp->poses.size(), false);
   for (size_t i = 0; i < bp->poses.size(); ++i)
     pose_is_free[i] = static_cast<int>(i) >= options.num_fixed_poses;
-  const SchurLmSummary lm =
-      SolveSchurLm(cam, options, residuals, pose_is_free, &bp->poses, &bp->points);
+  const SchurLmSummary lm = SolveSchurLm(cam, options, residuals, pose_is_free, &bp->poses,
+                                         &bp->points, bp->planar_links, input.planar);
   BackendResult r;
   r.initial_cost = lm.initial_cost;
   r.num_iterations = lm.num_successful_steps + lm.num_unsuccessful_steps;
@@ -434,6 +440,8 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
   if (!options.IsValid(&error))
     msg << error;
   else if (!cam.IsValid(&error))
+    msg << error;
+  else if (input.planar.enabled && !input.planar.IsValid(&error))
     msg << error;
   else if (num_frames < options.num_fixed_poses)
     msg << "need at least num_fixed_poses = " << options.num_fixed_poses << " poses, got "
@@ -517,6 +525,15 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
     bp.pose_in_problem[input.observations[k].frame_index] = true;
   }
   s.num_residual_blocks = static_cast<int>(bp.observations.size());
+  if (input.planar.enabled) {
+    int previous = -1;
+    for (int i = 0; i < num_frames; ++i) {
+      if (!bp.pose_in_problem[i]) continue;
+      if (previous >= 0 && i >= options.num_fixed_poses) bp.planar_links.emplace_back(previous, i);
+      previous = i;
+    }
+    s.num_planar_links = static_cast<int>(bp.planar_links.size());
+  }
 
   // --- plain rms of the used observations (before) ---
   // sqrt(Σ |e|² / #image observations) over the used observations (and, with

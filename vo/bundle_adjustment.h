@@ -19,6 +19,11 @@
 // bundle_adjustment.cc and schur_lm.h), or, for the Ceres backend, by
 // ceres::AutoDiffCostFunction (analytic_jacobians = false).
 //
+// Ground vehicle (optional, BundleAdjustmentProblem::planar): residuals between consecutive
+// poses that keep the camera's motion that of a wheeled vehicle on a floor (no roll or pitch
+// change, no lift, no sideways slip of the axle; planar_motion_prior.h), without a robust
+// loss. Both backends evaluate the same templated residual.
+//
 // Gauge. The num_fixed_poses oldest poses (default 1: the oldest of the window) are held
 // constant (Problem::SetParameterBlockConstant); the stereo baseline fixes the scale.
 //
@@ -51,6 +56,7 @@
 #include <vector>
 
 #include "vo/camera.h"
+#include "vo/planar_motion_prior.h"
 #include "vo/tracks.h"
 
 namespace vo {
@@ -115,6 +121,10 @@ struct BundleAdjustmentProblem {
   std::vector<Eigen::Isometry3d> T_world_cam0;  // per frame: p_world = T_world_cam0 * p_cam0
   std::vector<Eigen::Vector3d> points_world;    // per point (metres, world frame)
   std::vector<BaObservation> observations;
+  // A ground vehicle's motion prior (planar_motion_prior.h), off by default: when enabled, one
+  // 4-residual block links each pose that takes part to the previous one that does (in this
+  // order), unless both are held constant.
+  PlanarMotionPrior planar;
 };
 
 struct BundleAdjustmentSummary {
@@ -137,6 +147,7 @@ struct BundleAdjustmentSummary {
   int num_iterations = 0;       // Levenberg-Marquardt iterations (successful + unsuccessful;
                                 // the start counts as one successful, as in Ceres)
   int num_residual_blocks = 0;  // observations in the problem
+  int num_planar_links = 0;     // planar motion prior blocks in the problem
   int num_points_optimized = 0;
   std::string linear_solver;  // linear solver used: Ceres', e.g. "SPARSE_SCHUR (SUITE_SPARSE)",
                               // or "SCHUR_LM (dense Cholesky)"

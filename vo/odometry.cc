@@ -1,5 +1,6 @@
 #include "vo/odometry.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +14,17 @@ namespace vo {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The vehicle's up in the camera frame (tracking.vehicle_planar_ba): σ of the first frame's
+// floor fit, and of a reliable tracked RANSAC motion's translation (metres) and rotation
+// (degrees) as evidence of it (a translation across up, a rotation about it). Texture seed 7's
+// floor fit is 0.77° off. The RANSAC motions (before the window BA) jitter by ~1 cm sideways
+// and ~0.3° per frame; with σ 1 mm / 0.05° the estimate swung by 70° on the pitched camera's
+// straight approach. A 4 cm step then gives its direction to ~14°, a 3° turn its axis to ~6°:
+// the motions move the floor fit over tens of frames (seed 7: 0.77° -> 0.35° off).
+constexpr double kVehicleUpPriorSigmaDeg = 1.0;
+constexpr double kVehicleUpTranslationSigmaM = 1e-2;
+constexpr double kVehicleUpRotationSigmaDeg = 0.3;
 
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -185,6 +197,13 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
              !std::isfinite(vehicle_max_vertical_shift_ratio)) {
     msg << "vehicle_max_vertical_shift_ratio must be finite and >= 0, got "
         << vehicle_max_vertical_shift_ratio;
+  } else if (!(vehicle_ba_tilt_sigma_deg > 0.0) || !std::isfinite(vehicle_ba_tilt_sigma_deg) ||
+             !(vehicle_ba_lift_sigma_m > 0.0) || !std::isfinite(vehicle_ba_lift_sigma_m) ||
+             !(vehicle_ba_slip_sigma_m > 0.0) || !std::isfinite(vehicle_ba_slip_sigma_m)) {
+    msg << "vehicle_ba_tilt_sigma_deg, vehicle_ba_lift_sigma_m and vehicle_ba_slip_sigma_m must "
+           "be finite and > 0, got "
+        << vehicle_ba_tilt_sigma_deg << ", " << vehicle_ba_lift_sigma_m << ", "
+        << vehicle_ba_slip_sigma_m;
   } else if (few_point_min_features < 1) {
     msg << "few_point_min_features must be >= 1, got " << few_point_min_features;
   } else if (!(few_point_prior_update >= 0.0 && few_point_prior_update <= 1.0)) {
@@ -354,6 +373,8 @@ void StereoOdometry::Reset() {
   scene_num_disparities_ = 0;
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   world_up_known_ = false;
+  vehicle_up_cam_.setZero();
+  vehicle_up_information_.setZero();
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
   last_matches_.clear();
@@ -575,7 +596,44 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
                    !options_.orientation_requires_wall);
   R_hall_cam0_initial_ = ok ? orientation_result_.R_hall_cam0 : Eigen::Matrix3d::Identity();
   world_up_known_ = ok;
+  if (ok) {
+    vehicle_up_cam_ = R_hall_cam0_initial_.transpose() * Eigen::Vector3d::UnitZ();
+    const double sigma = kVehicleUpPriorSigmaDeg * M_PI / 180.0;
+    vehicle_up_information_ =
+        (Eigen::Matrix3d::Identity() - vehicle_up_cam_ * vehicle_up_cam_.transpose()) /
+        (sigma * sigma);
+  }
   return ok;
+}
+
+void StereoOdometry::UpdateVehicleUp(const Eigen::Isometry3d& T_ref_curr) {
+  if (!world_up_known_ || !IsFinite(T_ref_curr)) return;
+  const Eigen::Vector3d t = T_ref_curr.translation();
+  const Eigen::AngleAxisd aa(T_ref_curr.linear());
+  const Eigen::Vector3d w = aa.angle() * aa.axis();
+  const double sigma_w = kVehicleUpRotationSigmaDeg * M_PI / 180.0;
+  vehicle_up_information_ +=
+      t * t.transpose() / (kVehicleUpTranslationSigmaM * kVehicleUpTranslationSigmaM) +
+      (w.squaredNorm() * Eigen::Matrix3d::Identity() - w * w.transpose()) / (sigma_w * sigma_w);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(vehicle_up_information_);
+  if (eig.info() != Eigen::Success) return;
+  Eigen::Vector3d up = eig.eigenvectors().col(0);  // the smallest eigenvalue's
+  if (up.dot(vehicle_up_cam_) < 0.0) up = -up;
+  if (up.allFinite()) vehicle_up_cam_ = up.normalized();
+}
+
+PlanarMotionPrior StereoOdometry::WindowPlanarPrior() const {
+  const RobustTrackingOptions& o = options_.tracking;
+  PlanarMotionPrior prior;
+  prior.enabled =
+      o.ground_vehicle && o.vehicle_planar_ba && world_up_known_ && vehicle_up_cam_.norm() > 0.5;
+  if (!prior.enabled) return prior;
+  prior.up_cam = vehicle_up_cam_;
+  prior.axle_behind_camera_m = o.few_point.axle_behind_camera_m;
+  prior.tilt_sigma_rad = o.vehicle_ba_tilt_sigma_deg * M_PI / 180.0;
+  prior.lift_sigma_m = o.vehicle_ba_lift_sigma_m;
+  prior.slip_sigma_m = o.vehicle_ba_slip_sigma_m;
+  return prior;
 }
 
 OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame frame,
@@ -972,7 +1030,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   // Windowed bundle adjustment, the oldest pose(s) fixed (sliding_window.h).
   const Clock::time_point ba_start = Clock::now();
   const WindowRefinement refinement =
-      result.few_point_motion ? WindowRefinement() : window_.Refine(camera_, result.frame_index);
+      result.few_point_motion ? WindowRefinement()
+                              : window_.Refine(camera_, result.frame_index, WindowPlanarPrior());
   if (refinement.attempted) result.times.ba_ms = MsSince(ba_start);
   const bool ba_rejected = refinement.rejected;
   if (ba_rejected) result.message = refinement.message;
@@ -999,6 +1058,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
                                                   : PriorUpdateWeight(ransac.num_inliers);
   MoveVelocity(per_frame, weight);
   result.motion_measured = true;
+  // A reliable measured motion refines the vehicle's up (not a few-point or bundle-adjusted
+  // one: both are made planar about the current estimate).
+  if (tracking.ground_vehicle && tracking.vehicle_planar_ba && !result.few_point_motion &&
+      !ba_rejected && ransac.num_inliers >= tracking.reliable_min_inliers)
+    UpdateVehicleUp(ransac.T_prev_curr);
 
   result.status = consecutive_lost_ > 0 ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
   if (consecutive_lost_ > 0) {

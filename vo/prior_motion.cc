@@ -5,6 +5,8 @@
 #include <limits>
 #include <sstream>
 
+#include "vo/planar_motion_prior.h"
+
 namespace vo {
 namespace {
 
@@ -18,13 +20,9 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 // (a vehicle's yaw and forward distance).
 using Basis = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-// The horizontal forward axis of a camera whose up direction is u (unit): its z axis made
-// perpendicular to u (its x axis when they are parallel).
-Eigen::Vector3d HorizontalForward(const Eigen::Vector3d& u) {
-  Eigen::Vector3d e1 = Eigen::Vector3d::UnitZ() - u.z() * u;
-  if (e1.norm() < 1e-6) e1 = Eigen::Vector3d::UnitX() - u.x() * u;
-  return e1.normalized();
-}
+// The horizontal forward axis of a camera whose up direction is u (unit), as the BA's planar
+// prior uses it.
+Eigen::Vector3d HorizontalForward(const Eigen::Vector3d& u) { return HorizontalForwardAxis(u); }
 
 // The rotation angle about u (unit) that turns the direction of b onto that of a, both seen
 // across u (their components along u dropped; the callers check that neither vanishes).

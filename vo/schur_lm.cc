@@ -1,5 +1,7 @@
 #include "vo/schur_lm.h"
 
+#include <ceres/jet.h>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -7,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <utility>
 
@@ -104,6 +107,43 @@ void QuaternionPlus(const double* q, const double* delta, double* out) {
   x_plus_delta = delta_q * x;
 }
 
+// ceres::EigenQuaternionManifold::PlusJacobian at q (4×3, rows x y z w).
+Eigen::Matrix<double, 4, 3> QuaternionPlusJacobian(const double* q) {
+  const double x = q[0], y = q[1], z = q[2], w = q[3];
+  Eigen::Matrix<double, 4, 3> J;
+  J << w, z, -y,  //
+      -z, w, x,   //
+      y, -x, w,   //
+      -x, -y, -z;
+  return J;
+}
+
+// A planar motion prior block (planar_motion_prior.h) of poses a and b: its residual and its
+// Jacobians w.r.t. the two tangents [δθ δt], by ceres::Jet over the 14 ambient parameters
+// times the manifold's Plus Jacobian (what ceres::AutoDiffCostFunction and the manifold give
+// the Ceres backend).
+void PlanarResidualAndJacobians(const PlanarMotionResidual& f, const PoseBlock7& a,
+                                const PoseBlock7& b, Eigen::Vector4d* r,
+                                Eigen::Matrix<double, 4, 6>* J_a,
+                                Eigen::Matrix<double, 4, 6>* J_b) {
+  using Jet = ceres::Jet<double, 14>;
+  Jet pa[7], pb[7], out[4];
+  for (int c = 0; c < 7; ++c) {
+    pa[c] = Jet(a[c], c);
+    pb[c] = Jet(b[c], 7 + c);
+  }
+  f(pa, pb, out);
+  Eigen::Matrix<double, 4, 14> J;
+  for (int k = 0; k < 4; ++k) {
+    (*r)(k) = out[k].a;
+    J.row(k) = out[k].v.transpose();
+  }
+  J_a->leftCols<3>() = J.block<4, 4>(0, 0) * QuaternionPlusJacobian(a.data());
+  J_a->rightCols<3>() = J.block<4, 3>(0, 4);
+  J_b->leftCols<3>() = J.block<4, 4>(0, 7) * QuaternionPlusJacobian(b.data());
+  J_b->rightCols<3>() = J.block<4, 3>(0, 11);
+}
+
 // The residual block r = [u_l, v_l, u_r, v_r] − observed (rows 2, 3 zero for a left-only
 // observation) of the point at v = p_world − t_world_cam0 and, optionally, the distinct rows of
 // ∂r/∂p_world: a.row(0) of u_l, a.row(1) of v_l (and of v_r, the same), a.row(2) of u_r (zero
@@ -170,7 +210,8 @@ class Solver {
  public:
   Solver(const StereoCamera& cam, const BundleAdjustmentOptions& options,
          const std::vector<SchurLmResidual>& residuals, const std::vector<bool>& pose_is_free,
-         std::vector<PoseBlock7>* poses, std::vector<Eigen::Vector3d>* points);
+         std::vector<PoseBlock7>* poses, std::vector<Eigen::Vector3d>* points,
+         const std::vector<std::pair<int, int>>& planar_links, const PlanarMotionPrior& planar);
   SchurLmSummary Run();
 
  private:
@@ -190,10 +231,20 @@ class Solver {
     Eigen::Vector3d g;   // Aᵀ √ρ' r
     Eigen::Vector3d v2;  // 2 (p_world − t_world_cam0)
   };
+  // A planar prior block: its poses and their free-pose slots (-1 = constant).
+  struct Link {
+    int pose_a = -1, pose_b = -1, slot_a = -1, slot_b = -1;
+  };
+  // A planar prior block linearised: residual and Jacobians w.r.t. the two pose tangents.
+  struct LinkLinearisation {
+    Eigen::Vector4d r;
+    Eigen::Matrix<double, 4, 6> J_a, J_b;
+  };
   // The linearisation at one point of parameter space: per block, and per slot (6) and per
   // point (3) the gradient Jᵀr and the squared Jacobian column norms diag(JᵀJ).
   struct Linearisation {
     std::vector<BlockLinearisation> blocks;
+    std::vector<LinkLinearisation> links;
     std::vector<Vector6> grad_pose, col_sq_pose;
     std::vector<Eigen::Vector3d> grad_point, col_sq_point;
   };
@@ -217,6 +268,8 @@ class Solver {
   std::vector<int> point_index_;  // caller's index of each compact point
   std::vector<int> point_begin_;  // blocks of compact point p: [point_begin_[p], [p + 1])
   std::vector<Block> blocks_;     // ordered by point, then by residual index
+  std::vector<Link> links_;       // planar prior blocks
+  std::unique_ptr<PlanarMotionResidual> planar_;  // their residual (when there are links)
 
   // Current parameters x and the candidate x ⊞ δ (compact points).
   std::vector<PoseBlock7> x_poses_, cand_poses_;
@@ -240,7 +293,9 @@ class Solver {
 
 Solver::Solver(const StereoCamera& cam, const BundleAdjustmentOptions& options,
                const std::vector<SchurLmResidual>& residuals, const std::vector<bool>& pose_is_free,
-               std::vector<PoseBlock7>* poses, std::vector<Eigen::Vector3d>* points)
+               std::vector<PoseBlock7>* poses, std::vector<Eigen::Vector3d>* points,
+               const std::vector<std::pair<int, int>>& planar_links,
+               const PlanarMotionPrior& planar)
     : cam_(cam), options_(options), residuals_(residuals), out_poses_(poses), out_points_(points) {
   const int num_poses = static_cast<int>(poses->size());
   const int num_points = static_cast<int>(points->size());
@@ -266,6 +321,15 @@ Solver::Solver(const StereoCamera& cam, const BundleAdjustmentOptions& options,
       free_poses_.push_back(i);
     }
   }
+  for (const auto& [a, b] : planar_links) {
+    if (a < 0 || a >= num_poses || b < 0 || b >= num_poses || !pose_used[a] || !pose_used[b]) {
+      std::ostringstream msg;
+      msg << "planar link (" << a << ", " << b << ") refers to a pose no residual refers to";
+      Abort(msg.str());
+    }
+    links_.push_back(Link{a, b, slot[a], slot[b]});
+  }
+  if (!links_.empty()) planar_ = std::make_unique<PlanarMotionResidual>(planar);
   for (int j = 0; j < num_points; ++j) {
     if (compact[j] < 0) continue;
     compact[j] = static_cast<int>(point_index_.size());
@@ -298,6 +362,7 @@ Solver::Solver(const StereoCamera& cam, const BundleAdjustmentOptions& options,
   for (auto* v : {&scale_point_, &lm_point_, &step_point_}) v->assign(np, Eigen::Vector3d::Zero());
   for (Linearisation* lin : {&lin_, &cand_lin_}) {
     lin->blocks.resize(blocks_.size());
+    lin->links.resize(links_.size());
     lin->grad_pose.resize(nf);
     lin->col_sq_pose.resize(nf);
     lin->grad_point.resize(np);
@@ -366,6 +431,19 @@ bool Solver::Evaluate(const std::vector<PoseBlock7>& poses,
         c.z() * c.z() * H(0, 0) - 2.0 * c.x() * c.z() * H(0, 2) + c.x() * c.x() * H(2, 2),
         c.y() * c.y() * H(0, 0) - 2.0 * c.x() * c.y() * H(0, 1) + c.x() * c.x() * H(1, 1));
     lin->col_sq_pose[b.slot].tail<3>() += H.diagonal();
+  }
+  for (size_t k = 0; k < links_.size(); ++k) {
+    const Link& link = links_[k];
+    LinkLinearisation& l = lin->links[k];
+    PlanarResidualAndJacobians(*planar_, poses[link.pose_a], poses[link.pose_b], &l.r, &l.J_a,
+                               &l.J_b);
+    total += 0.5 * l.r.squaredNorm();
+    for (const auto& [slot, J] :
+         {std::make_pair(link.slot_a, &l.J_a), std::make_pair(link.slot_b, &l.J_b)}) {
+      if (slot < 0) continue;
+      lin->grad_pose[slot] += J->transpose() * l.r;
+      lin->col_sq_pose[slot] += J->colwise().squaredNorm().transpose();
+    }
   }
   if (!std::isfinite(total)) return false;
   *cost = total;
@@ -479,6 +557,25 @@ bool Solver::ComputeStep(double radius, bool reuse_diagonal, double* model_cost_
       }
     }
   }
+  // Planar prior blocks: pose terms only (JᵀJ, the pose–pose coupling, Jᵀr).
+  for (size_t k = 0; k < links_.size(); ++k) {
+    const Link& link = links_[k];
+    const LinkLinearisation& l = lin_.links[k];
+    if (link.slot_a >= 0) {
+      S_blocks_[link.slot_a * nf + link.slot_a] += l.J_a.transpose() * l.J_a;
+      S_rhs_[link.slot_a] += l.J_a.transpose() * l.r;
+    }
+    if (link.slot_b >= 0) {
+      S_blocks_[link.slot_b * nf + link.slot_b] += l.J_b.transpose() * l.J_b;
+      S_rhs_[link.slot_b] += l.J_b.transpose() * l.r;
+    }
+    if (link.slot_a >= 0 && link.slot_b >= 0) {
+      if (link.slot_a > link.slot_b)
+        S_blocks_[link.slot_a * nf + link.slot_b] += l.J_a.transpose() * l.J_b;
+      else
+        S_blocks_[link.slot_b * nf + link.slot_a] += l.J_b.transpose() * l.J_a;
+    }
+  }
   // Reduced camera system by dense Cholesky (lower triangle), then the points back-substituted.
   if (nf > 0) {
     for (int a = 0; a < nf; ++a) {
@@ -514,6 +611,14 @@ bool Solver::ComputeStep(double radius, bool reuse_diagonal, double* model_cost_
       u += l.v2.cross(d.head<3>()) - d.tail<3>();
     }
     change -= u.dot(l.g) + 0.5 * u.dot(l.H * u);
+  }
+  for (size_t k = 0; k < links_.size(); ++k) {
+    const Link& link = links_[k];
+    const LinkLinearisation& l = lin_.links[k];
+    Eigen::Vector4d jd = Eigen::Vector4d::Zero();
+    if (link.slot_a >= 0) jd += l.J_a * step_pose_[link.slot_a];
+    if (link.slot_b >= 0) jd += l.J_b * step_pose_[link.slot_b];
+    change -= jd.dot(l.r) + 0.5 * jd.squaredNorm();
   }
   *model_cost_change = change;
   return change > 0.0;
@@ -688,8 +793,10 @@ bool StereoResidualAndJacobians(const StereoCamera& cam, const Eigen::Matrix3d& 
 SchurLmSummary SolveSchurLm(const StereoCamera& cam, const BundleAdjustmentOptions& options,
                             const std::vector<SchurLmResidual>& residuals,
                             const std::vector<bool>& pose_is_free, std::vector<PoseBlock7>* poses,
-                            std::vector<Eigen::Vector3d>* points) {
-  Solver solver(cam, options, residuals, pose_is_free, poses, points);
+                            std::vector<Eigen::Vector3d>* points,
+                            const std::vector<std::pair<int, int>>& planar_links,
+                            const PlanarMotionPrior& planar) {
+  Solver solver(cam, options, residuals, pose_is_free, poses, points, planar_links, planar);
   return solver.Run();
 }
 

@@ -51,6 +51,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vo/bundle_adjustment.h"
@@ -89,11 +90,17 @@ using PoseBlock7 = std::array<double, 7>;  // [qx qy qz qw tx ty tz] of T_world_
 // and the points residuals refer to; the others are left untouched. Uses max_num_iterations,
 // the three tolerances, loss and loss_scale_px of `options` (its other fields are Ceres' or
 // the caller's). The start must be evaluable (every depth > 1e-9), else kFailure. Indices
-// must be in range and the sizes consistent (programmer errors: abort).
+// must be in range and the sizes consistent (programmer errors: abort). `planar_links` (pose
+// pairs, both referred to by a residual) add a PlanarMotionResidual of `planar` each
+// (planar_motion_prior.h; plain squares, its Jacobian from ceres::Jet and the manifold's Plus
+// Jacobian, as the Ceres backend's AutoDiffCostFunction): they enter the cost, the gradient,
+// the Jacobi scaling and the reduced camera system (a pose–pose block couples the two poses).
 SchurLmSummary SolveSchurLm(const StereoCamera& cam, const BundleAdjustmentOptions& options,
                             const std::vector<SchurLmResidual>& residuals,
                             const std::vector<bool>& pose_is_free, std::vector<PoseBlock7>* poses,
-                            std::vector<Eigen::Vector3d>* points);
+                            std::vector<Eigen::Vector3d>* points,
+                            const std::vector<std::pair<int, int>>& planar_links = {},
+                            const PlanarMotionPrior& planar = PlanarMotionPrior());
 
 // One residual block and its Jacobians, unweighted: r = [u_l, v_l, u_r, v_r] − observed (rows
 // 2, 3 and their Jacobian rows zero for a left-only observation), J_pose w.r.t. the pose's

@@ -32,6 +32,7 @@ BundleAdjustmentProblem SelectBaPoints(BundleAdjustmentProblem problem, int max_
   std::vector<int> new_index(num_points, -1);
   BundleAdjustmentProblem selected;
   selected.T_world_cam0 = std::move(problem.T_world_cam0);
+  selected.planar = problem.planar;
   for (int j : order) {
     new_index[j] = static_cast<int>(selected.points_world.size());
     selected.points_world.push_back(problem.points_world[j]);
@@ -79,7 +80,8 @@ TrackUpdateResult SlidingWindow::Add(int64_t frame_index, std::vector<Feature>* 
   return update;
 }
 
-WindowRefinement SlidingWindow::Refine(const StereoCamera& camera, int64_t newest_frame_index) {
+WindowRefinement SlidingWindow::Refine(const StereoCamera& camera, int64_t newest_frame_index,
+                                       const PlanarMotionPrior& planar) {
   WindowRefinement r;
   const auto newest_pose = T_world_cam0_by_frame_.find(newest_frame_index);
   if (!options_.use_bundle_adjustment || T_world_cam0_by_frame_.size() < 2 ||
@@ -89,9 +91,10 @@ WindowRefinement SlidingWindow::Refine(const StereoCamera& camera, int64_t newes
   r.attempted = true;
   const Eigen::Isometry3d T_initial = newest_pose->second;
   std::vector<int64_t> frame_ids;
-  const BundleAdjustmentProblem problem =
+  BundleAdjustmentProblem problem =
       SelectBaPoints(MakeWindowProblem(tracks_, T_world_cam0_by_frame_, &frame_ids),
                      options_.max_points, options_.ba.min_frames_per_point);
+  problem.planar = planar;
   if (static_cast<int>(problem.T_world_cam0.size()) <= options_.ba.num_fixed_poses) return r;
   const BundleAdjustmentSummary ba = RunBundleAdjustment(camera, problem, options_.ba);
   bool usable = ba.ok() && ba.T_world_cam0.size() == frame_ids.size();

@@ -60,7 +60,10 @@ class SlidingWindow {
                         const std::vector<Match>& inlier_matches,
                         const Eigen::Isometry3d& T_world_cam0_initial);
   // Bundle adjustment of the window, `newest_frame_index` the frame just added.
-  WindowRefinement Refine(const StereoCamera& camera, int64_t newest_frame_index);
+  // `planar`: a ground vehicle's motion prior between consecutive window poses (off unless
+  // enabled; BundleAdjustmentProblem::planar).
+  WindowRefinement Refine(const StereoCamera& camera, int64_t newest_frame_index,
+                          const PlanarMotionPrior& planar = PlanarMotionPrior());
 
   // Pose of a frame of the window (null when it is not in the window).
   const Eigen::Isometry3d* Pose(int64_t frame_index) const;

@@ -18,7 +18,9 @@ CONFIGS = [("default", "svd_ncc_gabor, prediction: motion_prior (the library def
             "ground_vehicle: true"),
            ("ground", "svd_ncc_gabor, tracking.ground_vehicle: true"),
            ("few_point_ground_rig", "svd_ncc_gabor, tracking.few_point_motion: true, "
-            "ground_vehicle: true, few_point.axle_behind_camera_m: 0.15 (the rig's camera.forward_m)")]
+            "ground_vehicle: true, few_point.axle_behind_camera_m: 0.15 (the rig's camera.forward_m)"),
+           ("few_point_ground_rig_planar", "svd_ncc_gabor, tracking.few_point_motion: true, "
+            "ground_vehicle: true, vehicle_planar_ba: true, few_point.axle_behind_camera_m: 0.15")]
 KEYS = ["end_pose_error_m", "end_pose_error_pct", "ate_rmse_m", "lost_frames",
         "reinitialisations", "vo_ms_median"]
 

@@ -4,11 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
+#include <functional>
 
 #include "tests/test_util.h"
 #include "tests/vo/vo_test_util.h"
-#include "vo/ransac.h"  // vo::SplitMix64
+#include "vo/prior_motion.h"  // vo::VehicleMotion
+#include "vo/ransac.h"        // vo::SplitMix64
 
 namespace vo {
 namespace {
@@ -43,9 +46,10 @@ struct Scene {
   BundleAdjustmentProblem start;  // perturbed poses (all but the first) and points
 };
 
-// 5 frames moving 0.15 m forward with 2° of yaw each; 200 points at 2–10 m in front, observed
-// in stereo wherever they project into both images.
-Scene MakeScene(uint64_t seed, double sigma_px) {
+// 5 frames moving 0.15 m forward with 2° of yaw each (or the given kNumFrames poses); 200
+// points at 2–10 m in front, observed in stereo wherever they project into both images.
+Scene MakeScene(uint64_t seed, double sigma_px,
+                const std::vector<Eigen::Isometry3d>* poses = nullptr) {
   const StereoCamera cam = TestCamera();
   SplitMix64 rng(seed);
   Scene s;
@@ -53,7 +57,7 @@ Scene MakeScene(uint64_t seed, double sigma_px) {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = Eigen::AngleAxisd(0.035 * i, Eigen::Vector3d::UnitY()).toRotationMatrix();
     T.translation() = Eigen::Vector3d(0.01 * i, 0.0, 0.15 * i);
-    s.truth.T_world_cam0.push_back(T);
+    s.truth.T_world_cam0.push_back(poses != nullptr ? (*poses)[i] : T);
   }
   while (static_cast<int>(s.truth.points_world.size()) < kNumPoints) {
     const Eigen::Vector3d p(6.0 * rng.Uniform() - 3.0, 3.0 * rng.Uniform() - 1.5,
@@ -115,6 +119,14 @@ class BundleAdjustmentTest : public ::testing::TestWithParam<BaSolver> {
     options.solver = GetParam();
     return options;
   }
+  // Tolerances tight enough to reach an exact solution.
+  BundleAdjustmentOptions ExactOptions() const {
+    BundleAdjustmentOptions options = Options();
+    options.max_num_iterations = 50;
+    options.function_tolerance = 1e-14;
+    options.parameter_tolerance = 1e-14;
+    return options;
+  }
 };
 
 INSTANTIATE_TEST_SUITE_P(Backends, BundleAdjustmentTest,
@@ -125,11 +137,7 @@ INSTANTIATE_TEST_SUITE_P(Backends, BundleAdjustmentTest,
 
 TEST_P(BundleAdjustmentTest, NoiseFreeRecoversGroundTruth) {
   const Scene s = MakeScene(1, 0.0);
-  BundleAdjustmentOptions options = Options();
-  options.max_num_iterations = 50;
-  options.function_tolerance = 1e-14;
-  options.parameter_tolerance = 1e-14;
-  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start, options);
+  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start, ExactOptions());
   ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_GT(r.rms_reprojection_before_px, 5.0);
   EXPECT_LT(r.rms_reprojection_after_px, kExactRmsPx);
@@ -489,6 +497,172 @@ TEST(BundleAdjustmentBackendTest, SchurLmMatchesCeresInOtherConfigurations) {
   ceres = Solve(unseen, options, BaSolver::kCeres);
   ExpectSameSolution(ceres, Solve(unseen, options, BaSolver::kSchurLm));
   EXPECT_TRUE(ceres.T_world_cam0.back().matrix() == unseen.T_world_cam0.back().matrix());
+}
+
+// --- the planar motion prior of a ground vehicle ---
+constexpr double kPitchRad = 10.0 * M_PI / 180.0;
+constexpr double kAxleM = 0.15;
+
+// The vehicle's up in a camera pitched down by 10° (x right, y down, z forward).
+Eigen::Vector3d PitchedUp() {
+  return Eigen::AngleAxisd(kPitchRad, Eigen::Vector3d::UnitX()) * Eigen::Vector3d(0, -1, 0);
+}
+
+PlanarMotionPrior Prior() {
+  PlanarMotionPrior prior;
+  prior.enabled = true;
+  prior.up_cam = PitchedUp();
+  prior.axle_behind_camera_m = kAxleM;
+  return prior;
+}
+
+// A wheeled vehicle's poses: each step turns by `yaw_rad` and drives 0.15 m (VehicleMotion).
+std::vector<Eigen::Isometry3d> VehiclePoses(double yaw_rad) {
+  std::vector<Eigen::Isometry3d> poses{Eigen::Isometry3d::Identity()};
+  poses[0].linear() = Eigen::AngleAxisd(-kPitchRad, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (int i = 1; i < kNumFrames; ++i)
+    poses.push_back(poses.back() * VehicleMotion(PitchedUp(), kAxleM, yaw_rad * i, 0.15));
+  return poses;
+}
+
+Eigen::Vector4d PlanarResidual(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b,
+                               const PlanarMotionPrior& prior) {
+  auto block = [](const Eigen::Isometry3d& T) {
+    const Eigen::Quaterniond q(T.linear());
+    return std::array<double, 7>{
+        q.x(), q.y(), q.z(), q.w(), T.translation().x(), T.translation().y(), T.translation().z()};
+  };
+  const std::array<double, 7> a = block(T_a), b = block(T_b);
+  Eigen::Vector4d r;
+  const PlanarMotionResidual residual(prior);
+  residual(a.data(), b.data(), r.data());
+  return r;
+}
+
+TEST(PlanarMotionPriorTest, ZeroForAVehicleMotionAndTheSizeOfATiltALiftAndASlip) {
+  const PlanarMotionPrior prior = Prior();
+  const Eigen::Vector3d u = PitchedUp();
+  const Eigen::Vector3d e1 = HorizontalForwardAxis(u), e2 = u.cross(e1);
+  Eigen::Isometry3d T_a = Eigen::Isometry3d::Identity();
+  T_a.translation() = Eigen::Vector3d(0.3, -0.2, 1.0);
+  T_a.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (double yaw : {-0.6, -0.05, 0.0, 0.02, 0.3, 1.2}) {
+    for (double forward : {0.0, 0.04, -0.1}) {
+      SCOPED_TRACE(testing::Message() << "yaw " << yaw << " forward " << forward);
+      const Eigen::Isometry3d T_ab = VehicleMotion(u, kAxleM, yaw, forward);
+      EXPECT_LT(PlanarResidual(T_a, T_a * T_ab, prior).norm(), 1e-10);
+      // A tilt about the forward axis (roll) then about the lateral one (pitch): the sine over
+      // σ in r1 resp. r0 (R u moves towards ∓e2 resp. ±e1).
+      Eigen::Isometry3d tilted = T_ab;
+      tilted.linear() = Eigen::AngleAxisd(0.01, e1) * T_ab.linear();
+      Eigen::Vector4d r = PlanarResidual(T_a, T_a * tilted, prior);
+      EXPECT_NEAR(std::hypot(r(0), r(1)), std::sin(0.01) / prior.tilt_sigma_rad, 1e-6);
+      // A lift of 1 cm along up.
+      Eigen::Isometry3d lifted = T_ab;
+      lifted.translation() += 0.01 * u;
+      r = PlanarResidual(T_a, T_a * lifted, prior);
+      EXPECT_NEAR(r(2), 0.01 / prior.lift_sigma_m, 1e-9);
+      EXPECT_NEAR(r(0), 0.0, 1e-9);
+      EXPECT_NEAR(r(3), 0.0, 1e-9);
+      // A sideways step of 1 cm across the heading at half the turn.
+      Eigen::Isometry3d slipped = T_ab;
+      slipped.translation() += 0.01 * (Eigen::AngleAxisd(0.5 * yaw, u) * e2);
+      r = PlanarResidual(T_a, T_a * slipped, prior);
+      EXPECT_NEAR(r(3), 0.01 / prior.slip_sigma_m, 1e-9);
+      EXPECT_NEAR(r.head<3>().norm(), 0.0, 1e-9);
+    }
+  }
+}
+
+TEST(PlanarMotionPriorTest, InvalidPriorIsRejected) {
+  Scene s = MakeScene(31, kPixelSigma, nullptr);
+  for (auto spoil : std::vector<std::function<void(PlanarMotionPrior*)>>{
+           [](PlanarMotionPrior* p) { p->up_cam.setZero(); },
+           [](PlanarMotionPrior* p) { p->up_cam.x() = NAN; },
+           [](PlanarMotionPrior* p) { p->axle_behind_camera_m = -0.1; },
+           [](PlanarMotionPrior* p) { p->tilt_sigma_rad = 0.0; },
+           [](PlanarMotionPrior* p) { p->slip_sigma_m = INFINITY; }}) {
+    s.start.planar = Prior();
+    spoil(&s.start.planar);
+    const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start);
+    EXPECT_EQ(r.status, BundleAdjustmentSummary::Status::kInvalidInput);
+    EXPECT_THAT(r.message, testing::HasSubstr("planar motion prior"));
+  }
+}
+
+TEST_P(BundleAdjustmentTest, PlanarPriorKeepsTheTrueVehicleMotionOnExactData) {
+  const std::vector<Eigen::Isometry3d> poses = VehiclePoses(0.03);
+  Scene s = MakeScene(32, 0.0, &poses);
+  s.start.planar = Prior();
+  const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start, ExactOptions());
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_EQ(r.num_planar_links, kNumFrames - 1);
+  EXPECT_LT(r.rms_reprojection_after_px, kExactRmsPx);
+  for (int i = 0; i < kNumFrames; ++i)
+    EXPECT_THAT(r.T_world_cam0[i], IsNearPose(poses[i], kExactTolRad, kExactTolM)) << i;
+}
+
+// Few, far points (a plain wall's few features at 6-10 m): the visual evidence alone lets the
+// poses tilt and lift; with the prior they stay a vehicle's.
+TEST_P(BundleAdjustmentTest, PlanarPriorKeepsAWeaklyObservedVehicleLevel) {
+  const std::vector<Eigen::Isometry3d> poses = VehiclePoses(0.02);
+  Scene s = MakeScene(33, 1.0, &poses);
+  // Keep only the points farther than 6 m, at most 15.
+  BundleAdjustmentProblem weak = s.start;
+  weak.observations.clear();
+  int kept = 0;
+  for (size_t j = 0; j < s.truth.points_world.size() && kept < 15; ++j) {
+    if ((poses[0].inverse() * s.truth.points_world[j]).z() < 6.0) continue;
+    ++kept;
+    for (const BaObservation& o : s.start.observations)
+      if (o.point_index == static_cast<int>(j)) weak.observations.push_back(o);
+  }
+  ASSERT_EQ(kept, 15);
+  const BundleAdjustmentSummary free = RunBundleAdjustment(TestCamera(), weak, Options());
+  weak.planar = Prior();
+  const BundleAdjustmentSummary planar = RunBundleAdjustment(TestCamera(), weak, Options());
+  ASSERT_TRUE(free.ok()) << free.message;
+  ASSERT_TRUE(planar.ok()) << planar.message;
+  double free_tilt = 0.0, planar_tilt = 0.0, free_lift = 0.0, planar_lift = 0.0;
+  for (int i = 1; i < kNumFrames; ++i) {
+    const Eigen::Vector4d rf =
+        PlanarResidual(free.T_world_cam0[i - 1], free.T_world_cam0[i], Prior());
+    const Eigen::Vector4d rp =
+        PlanarResidual(planar.T_world_cam0[i - 1], planar.T_world_cam0[i], Prior());
+    free_tilt = std::max(free_tilt, rf.head<2>().norm() * Prior().tilt_sigma_rad);
+    planar_tilt = std::max(planar_tilt, rp.head<2>().norm() * Prior().tilt_sigma_rad);
+    free_lift = std::max(free_lift, std::abs(rf(2)) * Prior().lift_sigma_m);
+    planar_lift = std::max(planar_lift, std::abs(rp(2)) * Prior().lift_sigma_m);
+  }
+  EXPECT_GT(free_tilt, 3e-3);  // the start's 0.02 rad perturbations are not fully undone
+  EXPECT_LT(planar_tilt, 1e-3);
+  EXPECT_LT(planar_lift, 2e-3);
+  EXPECT_LT(planar_tilt, 0.3 * free_tilt);
+}
+
+TEST(BundleAdjustmentBackendTest, SchurLmMatchesCeresWithThePlanarPrior) {
+  const std::vector<Eigen::Isometry3d> poses = VehiclePoses(0.03);
+  Scene s = MakeScene(34, kPixelSigma, &poses);
+  Corrupt(0.05, 35, &s.start);
+  s.start.planar = Prior();
+  s.start.planar.tilt_sigma_rad = 0.001;  // the prior and the images disagree: both count
+  BundleAdjustmentOptions options;
+  const BundleAdjustmentSummary ceres = Solve(s.start, options, BaSolver::kCeres);
+  const BundleAdjustmentSummary lm = Solve(s.start, options, BaSolver::kSchurLm);
+  ExpectSameSolution(ceres, lm);
+  EXPECT_EQ(lm.num_planar_links, kNumFrames - 1);
+  EXPECT_EQ(ceres.num_planar_links, kNumFrames - 1);
+  // Two constant poses (one link between constants is left out) and a pose no point is seen
+  // in (linked past).
+  options.num_fixed_poses = 2;
+  BundleAdjustmentProblem gap = s.start;
+  for (BaObservation& o : gap.observations)
+    if (o.frame_index == 3) o.frame_index = 4;  // frame 3 unseen; frame 4 sees its points
+  gap.T_world_cam0[4] = gap.T_world_cam0[3];
+  const BundleAdjustmentSummary ceres_gap = Solve(gap, options, BaSolver::kCeres);
+  const BundleAdjustmentSummary lm_gap = Solve(gap, options, BaSolver::kSchurLm);
+  ExpectSameSolution(ceres_gap, lm_gap);
+  EXPECT_EQ(lm_gap.num_planar_links, 2);  // (1, 2) and (2, 4)
 }
 
 TEST(BundleAdjustmentBackendTest, SolverNames) {

@@ -1208,6 +1208,10 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
         o->tracking.vehicle_max_weak_lift_m = std::numeric_limits<double>::infinity();
       },
       "vehicle_max_weak_lift_m");
+  rejects([](OdometryOptions* o) { o->tracking.vehicle_ba_tilt_sigma_deg = 0.0; },
+          "vehicle_ba_tilt_sigma_deg");
+  rejects([](OdometryOptions* o) { o->tracking.vehicle_ba_slip_sigma_m = NAN; },
+          "vehicle_ba_slip_sigma_m");
   rejects([](OdometryOptions* o) { o->prior_weight = 1.5; }, "prior_weight");
   rejects([](OdometryOptions* o) { o->min_inliers = 2; }, "min_inliers");
   rejects([](OdometryOptions* o) { o->min_features = 0; }, "min_features");

@@ -1,0 +1,90 @@
+// A ground vehicle's motion prior for the windowed bundle adjustment (bundle_adjustment.h,
+// BundleAdjustmentProblem::planar): the camera is mounted rigidly on a vehicle that drives on a
+// floor, so between two poses of the window the camera turns about the vehicle's up only (no
+// change of roll or pitch), does not move along up (no lift), and the axle's midpoint, the
+// point axle_behind_camera_m behind the camera, moves along its heading (no sideways slip of a
+// wheeled vehicle; the same model as VehicleMotion in prior_motion.h: the chord of a step
+// points along the heading at half the turn).
+//
+// Residual of two poses a, b (T_world_cam0 blocks [qx qy qz qw tx ty tz], bundle_adjustment.h),
+// with T_ab = T_world_aᵀ T_world_b = (R, t) and u the up in the camera frame (unit, the same in
+// both cameras), e1 the horizontal forward axis (HorizontalForward(u)) and e2 = u × e1:
+//   r0, r1 = e1·(R u), e2·(R u) / tilt_sigma_rad       (sines of the tilt; 0 for a yaw about u)
+//   r2     = u·t / lift_sigma_m                        (the step along up)
+//   r3     = l·(t − d (R e1 − e1)) / slip_sigma_m       (the axle's step across its heading),
+// with d = axle_behind_camera_m, ψ = 2 atan2(q_vec·u, q_w) the yaw about u (q with q_w >= 0)
+// and l = cos(ψ/2) e2 − sin(ψ/2) e1 the lateral axis at half the turn. Each residual is
+// dimensionless; the cost ½|r|² is added to the reprojection cost (pixels²) without a robust
+// loss, so σ weighs the prior against one pixel of reprojection error.
+//
+// The residual is a template so that both backends evaluate the same function: the Ceres
+// backend through ceres::AutoDiffCostFunction, schur_lm.cc through ceres::Jet and the pose
+// manifold's Plus Jacobian (the same derivatives to rounding).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <string>
+
+namespace vo {
+
+struct PlanarMotionPrior {
+  bool enabled = false;                              // false: no residuals are added
+  Eigen::Vector3d up_cam = Eigen::Vector3d::Zero();  // the vehicle's up in the camera frame
+                                                     // (normalised here; must not vanish)
+  double axle_behind_camera_m = 0.0;  // the axle's midpoint behind the camera (metres, >= 0)
+  double tilt_sigma_rad = 0.002;      // σ of a change of roll or pitch between two poses, > 0
+  double lift_sigma_m = 0.002;        // σ of a step along up (metres), > 0
+  double slip_sigma_m = 0.002;        // σ of the axle's sideways step (metres), > 0
+
+  bool IsValid(std::string* error) const;
+};
+
+// The horizontal forward axis of a camera whose up is u (unit): its z axis made perpendicular
+// to u (its x axis when they are parallel). prior_motion.cc's vehicle model uses the same.
+Eigen::Vector3d HorizontalForwardAxis(const Eigen::Vector3d& u);
+
+// The residual above as a functor (AutoDiffCostFunction<PlanarMotionResidual, 4, 7, 7>).
+class PlanarMotionResidual {
+ public:
+  explicit PlanarMotionResidual(const PlanarMotionPrior& prior)
+      : u_(prior.up_cam.normalized()),
+        e1_(HorizontalForwardAxis(u_)),
+        e2_(u_.cross(e1_)),
+        axle_(prior.axle_behind_camera_m),
+        w_tilt_(1.0 / prior.tilt_sigma_rad),
+        w_lift_(1.0 / prior.lift_sigma_m),
+        w_slip_(1.0 / prior.slip_sigma_m) {}
+
+  template <typename T>
+  bool operator()(const T* pose_a, const T* pose_b, T* r) const {
+    using Vec3 = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Quaternion<T> qa(pose_a[3], pose_a[0], pose_a[1], pose_a[2]);
+    const Eigen::Quaternion<T> qb(pose_b[3], pose_b[0], pose_b[1], pose_b[2]);
+    const Vec3 ta(pose_a[4], pose_a[5], pose_a[6]);
+    const Vec3 tb(pose_b[4], pose_b[5], pose_b[6]);
+    Eigen::Quaternion<T> q = qa.conjugate() * qb;
+    if (q.w() < T(0)) q.coeffs() = -q.coeffs();
+    const Vec3 t = qa.conjugate() * (tb - ta);
+    const Vec3 u = u_.cast<T>(), e1 = e1_.cast<T>(), e2 = e2_.cast<T>();
+    const Vec3 Ru = q * u;
+    r[0] = e1.dot(Ru) * T(w_tilt_);
+    r[1] = e2.dot(Ru) * T(w_tilt_);
+    r[2] = u.dot(t) * T(w_lift_);
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    const T half_yaw = atan2(q.vec().dot(u), q.w());
+    const Vec3 lateral = cos(half_yaw) * e2 - sin(half_yaw) * e1;
+    const Vec3 axle_step = t - T(axle_) * (q * e1 - e1);
+    r[3] = lateral.dot(axle_step) * T(w_slip_);
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d u_, e1_, e2_;
+  double axle_, w_tilt_, w_lift_, w_slip_;
+};
+
+}  // namespace vo
