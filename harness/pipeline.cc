@@ -20,6 +20,7 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
   sequence->expected_frames = simulator->EstimatedFrames();
   sequence->scenario_yaml = sim::ScenarioToYaml(scenario);
   sequence->outline_scene = scenario.scene_path;
+  sequence->axle_behind_camera_m = scenario.camera.forward_m;
   sequence->next = [simulator, f = sim::StereoFrame()](DatasetFrame* frame,
                                                        std::string* err) mutable {
     if (!simulator->Next(&f, err)) return false;
@@ -27,6 +28,14 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
     return true;
   };
   return true;
+}
+
+vo::OdometryOptions WithRigAxle(const vo::OdometryOptions& options, double axle_behind_camera_m) {
+  vo::OdometryOptions o = options;
+  if (o.tracking.ground_vehicle && o.tracking.few_point.axle_behind_camera_m == 0.0 &&
+      axle_behind_camera_m >= 0.0)
+    o.tracking.few_point.axle_behind_camera_m = axle_behind_camera_m;
+  return o;
 }
 
 bool ReadAllFrames(const FrameSource& source, int max_frames, int expected_frames,

@@ -35,7 +35,16 @@ struct StereoSequence {
   int expected_frames = 0;    // frames the source will give (for progress; 0 = unknown)
   std::string scenario_yaml;  // effective scenario (simulated sequences; "" otherwise)
   std::string outline_scene;  // MJCF scene whose walls outline the trajectory plot ("" = none)
+  double axle_behind_camera_m = -1.0;  // the rig's wheel axle behind the camera (metres) when
+                                       // the source knows it (a simulated scenario's
+                                       // camera.forward_m); < 0 = unknown
 };
+
+// The VO options a run of `sequence` uses: `options`, except that a ground vehicle
+// (tracking.ground_vehicle) whose axle is left at 0 (few_point.axle_behind_camera_m, the
+// library default) takes the rig's axle when the sequence knows it. The run folder's
+// vo_options.yaml records the value used.
+vo::OdometryOptions WithRigAxle(const vo::OdometryOptions& options, double axle_behind_camera_m);
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,

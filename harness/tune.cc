@@ -583,6 +583,7 @@ bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSeque
   }
   sequence->name = scenario.name;
   sequence->camera = simulated.camera;
+  sequence->axle_behind_camera_m = simulated.axle_behind_camera_m;
   const FrameSource without_depth = [&](DatasetFrame* frame, std::string* err) {
     if (!simulated.next(frame, err)) return false;
     frame->depth_m = cv::Mat();  // not needed: the score uses the poses only
@@ -606,7 +607,8 @@ constexpr double kUnusableScore = 1e9;
 bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& options,
                    const TuneObjective& objective, SequenceScore* score, std::string* error) {
   std::string why;
-  auto odometry = vo::StereoOdometry::Create(sequence.camera, options, &why);
+  auto odometry = vo::StereoOdometry::Create(
+      sequence.camera, WithRigAxle(options, sequence.axle_behind_camera_m), &why);
   if (!odometry) {
     *error = sequence.name + ": invalid VO options or camera: " + why;
     return false;

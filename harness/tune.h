@@ -118,6 +118,7 @@ struct TuneSequence {
   std::string name;
   vo::StereoCamera camera;
   std::vector<DatasetFrame> frames;
+  double axle_behind_camera_m = -1.0;  // the rig's (StereoSequence), < 0 = unknown
 };
 bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSequence* sequence,
                           std::string* error);

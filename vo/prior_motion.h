@@ -63,7 +63,10 @@ struct PriorMotionOptions {
   double axle_behind_camera_m = 0.0;  // where the vehicle turns: its axle's distance behind
                                       // the camera along the horizontal forward axis (metres,
                                       // finite); 0 = the camera above the axle. The rig's
-                                      // calibration, not a tuning knob
+                                      // calibration, not a tuning knob; vobench's simulated
+                                      // runs and tune put the rig's camera.forward_m here when
+                                      // ground_vehicle is on and this is left at 0
+                                      // (harness::WithRigAxle)
 
   bool IsValid(std::string* error) const;
 };

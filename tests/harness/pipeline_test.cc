@@ -174,4 +174,16 @@ TEST(PipelineTest, PerFrameCsvMarksTheFramesBeforeTheFirstInitialisedOne) {
   EXPECT_EQ(statuses[5], vo::ToString(vo::TrackingStatus::kRecovered));
 }
 
+// A ground vehicle whose axle is left at the library's 0 takes the rig's; an axle given, a
+// non-vehicle configuration or an unknown rig keep the options.
+TEST(PipelineTest, AGroundVehicleTakesTheRigsAxleWhenItsOwnIsLeftAtZero) {
+  vo::OdometryOptions o;
+  EXPECT_EQ(harness::WithRigAxle(o, 0.15).tracking.few_point.axle_behind_camera_m, 0.0);
+  o.tracking.ground_vehicle = true;
+  EXPECT_EQ(harness::WithRigAxle(o, 0.15).tracking.few_point.axle_behind_camera_m, 0.15);
+  EXPECT_EQ(harness::WithRigAxle(o, -1.0).tracking.few_point.axle_behind_camera_m, 0.0);
+  o.tracking.few_point.axle_behind_camera_m = 0.05;
+  EXPECT_EQ(harness::WithRigAxle(o, 0.15).tracking.few_point.axle_behind_camera_m, 0.05);
+}
+
 }  // namespace

@@ -178,4 +178,27 @@ TEST(VoConfigTest, DuplicateKeysAndFoldersAreRefused) {
   EXPECT_EQ(error, folder + ": is a folder, expected a YAML VO config file");
 }
 
+// A simulated run with the ground-vehicle model and no axle uses the rig's camera.forward_m,
+// and its run folder records it.
+TEST(RunTest, GroundVehicleRunTakesTheSimulatedRigsAxle) {
+  TempDir dir("run_axle");
+  sim::Scenario scenario;
+  std::string error;
+  ASSERT_TRUE(harness::ResolveScenario("l_hallway", &scenario, &error)) << error;
+  scenario.camera.forward_m = 0.2;
+  harness::RunOptions options;
+  options.out_dir = dir / "run";
+  options.progress = false;
+  options.plots = false;
+  options.max_frames = 3;
+  vo::OdometryOptions vo_options;
+  vo_options.tracking.ground_vehicle = true;
+  harness::RunSummary s;
+  ASSERT_TRUE(harness::RunScenario(scenario, vo_options, options, &s, &error)) << error;
+  vo::OdometryOptions written;
+  ASSERT_TRUE(harness::LoadVoConfig(options.out_dir + "/vo_options.yaml", &written, &error))
+      << error;
+  EXPECT_EQ(written.tracking.few_point.axle_behind_camera_m, 0.2);
+}
+
 }  // namespace
