@@ -1,6 +1,5 @@
 #include "vo/odometry.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -373,8 +372,7 @@ void StereoOdometry::Reset() {
   scene_num_disparities_ = 0;
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   world_up_known_ = false;
-  vehicle_up_cam_.setZero();
-  vehicle_up_information_.setZero();
+  vehicle_up_ = VehicleUpEstimate();
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
   last_matches_.clear();
@@ -597,38 +595,23 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
   R_hall_cam0_initial_ = ok ? orientation_result_.R_hall_cam0 : Eigen::Matrix3d::Identity();
   world_up_known_ = ok;
   if (ok) {
-    vehicle_up_cam_ = R_hall_cam0_initial_.transpose() * Eigen::Vector3d::UnitZ();
-    const double sigma = kVehicleUpPriorSigmaDeg * M_PI / 180.0;
-    vehicle_up_information_ =
-        (Eigen::Matrix3d::Identity() - vehicle_up_cam_ * vehicle_up_cam_.transpose()) /
-        (sigma * sigma);
+    vehicle_up_ = VehicleUpEstimate(R_hall_cam0_initial_.transpose() * Eigen::Vector3d::UnitZ(),
+                                    kVehicleUpPriorSigmaDeg * M_PI / 180.0);
   }
   return ok;
 }
 
 void StereoOdometry::UpdateVehicleUp(const Eigen::Isometry3d& T_ref_curr) {
-  if (!world_up_known_ || !IsFinite(T_ref_curr)) return;
-  const Eigen::Vector3d t = T_ref_curr.translation();
-  const Eigen::AngleAxisd aa(T_ref_curr.linear());
-  const Eigen::Vector3d w = aa.angle() * aa.axis();
-  const double sigma_w = kVehicleUpRotationSigmaDeg * M_PI / 180.0;
-  vehicle_up_information_ +=
-      t * t.transpose() / (kVehicleUpTranslationSigmaM * kVehicleUpTranslationSigmaM) +
-      (w.squaredNorm() * Eigen::Matrix3d::Identity() - w * w.transpose()) / (sigma_w * sigma_w);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(vehicle_up_information_);
-  if (eig.info() != Eigen::Success) return;
-  Eigen::Vector3d up = eig.eigenvectors().col(0);  // the smallest eigenvalue's
-  if (up.dot(vehicle_up_cam_) < 0.0) up = -up;
-  if (up.allFinite()) vehicle_up_cam_ = up.normalized();
+  vehicle_up_.AddMotion(T_ref_curr, kVehicleUpTranslationSigmaM,
+                        kVehicleUpRotationSigmaDeg * M_PI / 180.0);
 }
 
 PlanarMotionPrior StereoOdometry::WindowPlanarPrior() const {
   const RobustTrackingOptions& o = options_.tracking;
   PlanarMotionPrior prior;
-  prior.enabled =
-      o.ground_vehicle && o.vehicle_planar_ba && world_up_known_ && vehicle_up_cam_.norm() > 0.5;
+  prior.enabled = o.ground_vehicle && o.vehicle_planar_ba && world_up_known_ && vehicle_up_.known();
   if (!prior.enabled) return prior;
-  prior.up_cam = vehicle_up_cam_;
+  prior.up_cam = vehicle_up_.up();
   prior.axle_behind_camera_m = o.few_point.axle_behind_camera_m;
   prior.tilt_sigma_rad = o.vehicle_ba_tilt_sigma_deg * M_PI / 180.0;
   prior.lift_sigma_m = o.vehicle_ba_lift_sigma_m;

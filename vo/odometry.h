@@ -712,7 +712,7 @@ class StereoOdometry {
   // The constant-velocity model moved `weight` of the way (slerp) to a measured per-frame
   // motion (the first one is taken as it is; a non-finite one is ignored).
   void MoveVelocity(const Eigen::Isometry3d& per_frame, double weight);
-  // The vehicle's up (vehicle_up_cam_) refined by a reliable tracked motion T_ref_curr.
+  // The vehicle's up (vehicle_up_) refined by a reliable tracked motion T_ref_curr.
   void UpdateVehicleUp(const Eigen::Isometry3d& T_ref_curr);
   // The window BA's planar motion prior (disabled unless ground_vehicle, vehicle_planar_ba and
   // a known up).
@@ -741,12 +741,9 @@ class StereoOdometry {
   bool initialised_ = false;     // a reference was set at least once since Reset
   bool world_up_known_ = false;  // the world's z is up (the first frame's orientation found
                                  // the floor or a ceiling)
-  // The vehicle's up in the camera frame (tracking.vehicle_planar_ba) and the information
-  // matrix of its estimate: the floor fit's (I − u uᵀ) / σ_0² plus, per reliable tracked
-  // motion (t, ω), t tᵀ / σ_t² + (|ω|² I − ω ωᵀ) / σ_ω²; the up is its eigenvector of the
-  // smallest eigenvalue.
-  Eigen::Vector3d vehicle_up_cam_ = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d vehicle_up_information_ = Eigen::Matrix3d::Zero();
+  // The vehicle's up in the camera frame (tracking.vehicle_planar_ba): the floor fit refined
+  // by the reliable tracked motions.
+  VehicleUpEstimate vehicle_up_;
   int consecutive_lost_ = 0;        // lost frames since the last good one
   bool previous_measured_ = false;  // the previous call's motion was measured (the prior is
                                     // a measured motion, not a bridge: few_point_motion)

@@ -45,6 +45,28 @@ struct PlanarMotionPrior {
 // to u (its x axis when they are parallel). prior_motion.cc's vehicle model uses the same.
 Eigen::Vector3d HorizontalForwardAxis(const Eigen::Vector3d& u);
 
+// The up of a camera mounted on a wheeled vehicle, in the camera's own frame, from a prior
+// direction (a floor fit) and the camera's rigid motions: the vehicle moves across its up and
+// turns about it. Each motion T_ref_curr = (R, t), ω the rotation vector of R, adds
+// t tᵀ / σ_t² + (|ω|² I − ω ωᵀ) / σ_ω² to an information matrix that starts at
+// (I − u₀ u₀ᵀ) / σ₀²; the estimate is the eigenvector of its smallest eigenvalue, on u₀'s side.
+// Straight driving fixes the up's tilt along the heading only; a turn fixes the rest.
+class VehicleUpEstimate {
+ public:
+  VehicleUpEstimate() = default;  // unknown
+  VehicleUpEstimate(const Eigen::Vector3d& prior_up, double prior_sigma_rad);
+
+  // Adds a motion (ignored when not finite or while unknown).
+  void AddMotion(const Eigen::Isometry3d& T_ref_curr, double translation_sigma_m,
+                 double rotation_sigma_rad);
+  bool known() const { return up_.norm() > 0.5; }
+  const Eigen::Vector3d& up() const { return up_; }  // unit; zero while unknown
+
+ private:
+  Eigen::Vector3d up_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d information_ = Eigen::Matrix3d::Zero();
+};
+
 // The residual above as a functor (AutoDiffCostFunction<PlanarMotionResidual, 4, 7, 7>).
 class PlanarMotionResidual {
  public:
