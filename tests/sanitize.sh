@@ -44,7 +44,7 @@ bad_input='^(CliTest|EurocMalformedTest|EvalBadInputTest|KittiMalformedTest|Rend
 # comparisons that fail in the clang -O1 sanitized build without any sanitizer report —
 # Schur-LM vs Ceres to 1e-7 m per point, and RANSAC's pose at one seed within 2 mrad / 5 mm.
 # See the README ("Tests").
-fp_exact='^(BundleAdjustmentBackendTest\.SchurLmMatchesCeresWithNoiseAndOutliers|BundleAdjustmentBackendTest\.SchurLmMatchesCeresInOtherConfigurations|RansacTest\.RecoversMotionWith40PercentOutliersAndHalfPixelNoise)$'
+fp_exact='^(BundleAdjustmentBackendTest\.SchurLmMatchesCeresWithNoiseAndOutliers|BundleAdjustmentBackendTest\.SchurLmMatchesCeresInOtherConfigurations|BundleAdjustmentBackendTest\.SchurLmMatchesCeresWithThePlanarPrior|RansacTest\.RecoversMotionWith40PercentOutliersAndHalfPixelNoise)$'
 if ((full)); then
   cmake --build "$build" -j "$jobs"
   ctest --test-dir "$build" --output-on-failure -j "$jobs" -E "$fp_exact"

@@ -634,10 +634,17 @@ TEST_P(BundleAdjustmentTest, PlanarPriorKeepsAWeaklyObservedVehicleLevel) {
     free_lift = std::max(free_lift, std::abs(rf(2)) * Prior().lift_sigma_m);
     planar_lift = std::max(planar_lift, std::abs(rp(2)) * Prior().lift_sigma_m);
   }
+  std::printf(
+      "weak vehicle: largest tilt per link %.5f rad free, %.5f rad planar; lift %.5f / %.5f m\n",
+      free_tilt, planar_tilt, free_lift, planar_lift);
+  // The scene's random draws depend on the compiler's argument evaluation order (GCC: free
+  // 0.0137 / planar 0.0009 rad, lift 0.10 / 0.0004 m; clang: 0.028 / 0.0020 rad, 0.19 /
+  // 0.0003 m), so the bounds are relative to the prior's σ (0.002 rad, 2 mm) and to the free fit.
   EXPECT_GT(free_tilt, 3e-3);  // the start's 0.02 rad perturbations are not fully undone
-  EXPECT_LT(planar_tilt, 1e-3);
-  EXPECT_LT(planar_lift, 2e-3);
-  EXPECT_LT(planar_tilt, 0.3 * free_tilt);
+  EXPECT_LT(planar_tilt, 1.5 * Prior().tilt_sigma_rad);
+  EXPECT_LT(planar_lift, Prior().lift_sigma_m);
+  EXPECT_LT(planar_tilt, 0.15 * free_tilt);
+  EXPECT_LT(planar_lift, 0.1 * free_lift);
 }
 
 TEST(BundleAdjustmentBackendTest, SchurLmMatchesCeresWithThePlanarPrior) {
