@@ -19,5 +19,6 @@
 #include "harness/dataset/euroc.h"
 #include "harness/dataset/kitti.h"
 #include "harness/dataset/rectification.h"
+#include "harness/dataset/rig.h"
 #include "harness/dataset/tum.h"
 #include "harness/dataset/writer.h"

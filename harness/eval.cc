@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "harness/dataset/rig.h"
 #include "harness/trajectory_io.h"
 
 namespace harness {
@@ -167,15 +168,28 @@ bool OpenDataset(const std::string& dir, const EvalOptions& options, StereoSeque
                                                           : DefaultMaxDifference(options.format);
   *sequence = StereoSequence();
   sequence->name = DatasetName(dir);
-  switch (options.format) {
-    case DatasetFormat::kKitti:
-      return OpenKitti(dir, options, sequence, info, error);
-    case DatasetFormat::kEuroc:
-      return OpenEuroc(dir, options, sequence, info, error);
-    case DatasetFormat::kTum:
-      return OpenTum(dir, options, sequence, info, error);
+  const auto open = [&]() {
+    switch (options.format) {
+      case DatasetFormat::kKitti:
+        return OpenKitti(dir, options, sequence, info, error);
+      case DatasetFormat::kEuroc:
+        return OpenEuroc(dir, options, sequence, info, error);
+      case DatasetFormat::kTum:
+        return OpenTum(dir, options, sequence, info, error);
+    }
+    return Fail(error, "unknown dataset format");
+  };
+  if (!open()) return false;
+  // The camera's mounting, when the folder says (vobench render writes it): a ground vehicle
+  // then takes the rig's axle (WithRigAxle).
+  const fs::path rig_path = fs::path(dir) / kRigFileName;
+  std::error_code ec;
+  if (fs::exists(rig_path, ec)) {
+    RigMounting rig;
+    if (!ReadRigYaml(rig_path.string(), &rig, error)) return false;
+    sequence->axle_behind_camera_m = rig.forward_m;
   }
-  return Fail(error, "unknown dataset format");
+  return true;
 }
 
 bool EvalDataset(const std::string& dir, const EvalOptions& options,

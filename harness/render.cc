@@ -20,6 +20,10 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
   wopt.overwrite = options.overwrite;
   wopt.T_body_cam0 = simulator->calibration().T_body_cam0;
   wopt.rate_hz = scenario.rate_hz;
+  wopt.write_rig = true;
+  wopt.rig.forward_m = scenario.camera.forward_m;
+  wopt.rig.height_m = scenario.camera.height_m;
+  wopt.rig.pitch_deg = scenario.camera.pitch_deg;
   DatasetWriter writer(wopt);
   if (!writer.Open(out_dir, ToStereoCamera(simulator->calibration()), error)) return false;
 

@@ -117,6 +117,8 @@ bool DatasetWriter::Options::IsValid(std::string* error) const {
     return Fail(error, "T_body_cam0 must be finite with a rotation in its linear part");
   if (!std::isfinite(rate_hz) || rate_hz < 0.0)
     return Fail(error, "rate_hz must be finite and >= 0, got " + FormatDouble(rate_hz));
+  std::string why;
+  if (write_rig && !rig.IsValid(&why)) return Fail(error, "rig: " + why);
   return true;
 }
 
@@ -320,6 +322,9 @@ bool DatasetWriter::Finish(std::string* error) {
   if (!WriteTextFile(Join(partial_dir_, "calib.txt"), CalibRow("P0:", P0) + CalibRow("P1:", P1),
                      error) ||
       !WriteKittiTimes(Join(partial_dir_, "times.txt"), times_s_, error))
+    return false;
+  if (options_.write_rig &&
+      !WriteTextFile(Join(partial_dir_, kRigFileName), RigYaml(options_.rig), error))
     return false;
 
   if (has_gt_) {

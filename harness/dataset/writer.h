@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "harness/dataset/common.h"
+#include "harness/dataset/rig.h"
 #include "harness/output_folder.h"
 #include "vo/camera.h"
 
@@ -40,8 +41,10 @@ class DatasetWriter {
     int png_compression = 3;  // zlib level of every PNG, 0 (none) .. 9 (smallest, slowest)
     // EuRoC body frame: the left camera's pose in the body (rotation, metres).
     Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();
-    double rate_hz = 0.0;  // rate written to sensor.yaml (Hz, >= 0); 0 = from the median
-                           // frame interval, rounded to 1 mHz
+    double rate_hz = 0.0;    // rate written to sensor.yaml (Hz, >= 0); 0 = from the median
+                             // frame interval, rounded to 1 mHz
+    bool write_rig = false;  // write rig.yaml (the camera's mounting, harness/dataset/rig.h)
+    RigMounting rig;         // with write_rig
 
     bool IsValid(std::string* error) const;
   };

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/dataset/rig.h"
 #include "harness/metrics.h"
 #include "harness/render.h"
 #include "harness/trajectory_io.h"
@@ -381,6 +382,71 @@ TEST_F(EvalBadInputTest, WellFormedDatasetsRun) {
                                        " --out " + Out() + " -q --no-plots");
     EXPECT_EQ(r.exit_code, 0) << format << ": " << r.output;
     EXPECT_THAT(r.output, HasSubstr("8 of 8 frames associated")) << format;
+  }
+}
+
+// rig.yaml beside a dataset (vobench render writes it): its forward distance becomes the
+// sequence's axle (a ground-vehicle run takes it, WithRigAxle); without it the rig is unknown.
+// RigYaml's text reads back exactly.
+TEST_F(EvalBadInputTest, RigFileGivesTheAxle) {
+  EvalOptions options;
+  options.format = DatasetFormat::kKitti;
+  const std::string data = Data(DatasetFormat::kTum);
+  StereoSequence sequence;
+  EvalInfo info;
+  std::string error;
+  ASSERT_TRUE(OpenDataset(data, options, &sequence, &info, &error)) << error;
+  EXPECT_EQ(sequence.axle_behind_camera_m, -1.0);
+  RigMounting rig;
+  rig.forward_m = 0.1234567890123;
+  rig.height_m = 0.4;
+  rig.pitch_deg = -7.5;
+  WriteText(data + "/rig.yaml", RigYaml(rig));
+  ASSERT_TRUE(OpenDataset(data, options, &sequence, &info, &error)) << error;
+  EXPECT_EQ(sequence.axle_behind_camera_m, rig.forward_m);
+  RigMounting back;
+  ASSERT_TRUE(ReadRigYaml(data + "/rig.yaml", &back, &error)) << error;
+  EXPECT_EQ(back.forward_m, rig.forward_m);
+  EXPECT_EQ(back.height_m, rig.height_m);
+  EXPECT_EQ(back.pitch_deg, rig.pitch_deg);
+}
+
+// End to end: a ground-vehicle run on a dataset with rig.yaml records the rig's axle in its
+// vo_options.yaml; an axle the configuration gives is kept.
+TEST_F(EvalBadInputTest, GroundVehicleRunTakesTheRigFilesAxle) {
+  const std::string data = Data(DatasetFormat::kTum);
+  WriteText(data + "/rig.yaml",
+            "camera_forward_m: 0.2\ncamera_height_m: 0.4\ncamera_pitch_deg: 0\n");
+  const std::string config = (dir_ / "gv.yaml").string();
+  for (const char* axle : {"", "  few_point:\n    axle_behind_camera_m: 0.05\n"}) {
+    WriteText(config, std::string("tracking:\n  ground_vehicle: true\n") + axle);
+    const CommandResult r = RunVobench("eval --dataset " + data + " --format kitti --config " +
+                                       config + " --out " + Out() + " -q --no-plots");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(ReadAll(Out() + "/vo_options.yaml"),
+                HasSubstr(std::string("axle_behind_camera_m: ") + (*axle ? "0.05" : "0.2")));
+  }
+}
+
+// A malformed rig.yaml stops the run with a message naming it and the problem.
+TEST_F(EvalBadInputTest, MalformedRigFile) {
+  const std::string data = Data(DatasetFormat::kTum);
+  const std::string rig = data + "/rig.yaml";
+  const std::string ok_rest = "camera_height_m: 0.4\ncamera_pitch_deg: 0\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"[1, 2]\n", "must be a map"},
+      {"camera_forward_m: [\n", "not valid YAML"},
+      {"camera_height_m: 0.4\ncamera_pitch_deg: 0\n", "missing camera_forward_m"},
+      {"camera_forward_m: ahead\n" + ok_rest, "camera_forward_m must be a number"},
+      {"camera_forward_m: 0.15\naxle_m: 0.1\n" + ok_rest, "unknown key 'axle_m'"},
+      {"camera_forward_m: .nan\n" + ok_rest, "camera_forward_m must be finite"},
+      {"camera_forward_m: 0.15\ncamera_height_m: -0.4\ncamera_pitch_deg: 0\n",
+       "camera_height_m must be finite and > 0"},
+      {"camera_forward_m: 0.15\ncamera_height_m: 0.4\ncamera_pitch_deg: 95\n",
+       "camera_pitch_deg must be in (-90, 90)"}};
+  for (const auto& [text, why] : cases) {
+    WriteText(rig, text);
+    ExpectCliFailure("--dataset " + data + " --format kitti", rig + ": " + why);
   }
 }
 

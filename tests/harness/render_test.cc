@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "harness/dataset.h"
+#include "harness/dataset/rig.h"
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
 
@@ -53,6 +54,14 @@ TEST(RenderTest, DatasetOnDiskEqualsTheSimulationAndIsDeterministic) {
   ASSERT_GT(files.size(), 20u);
   for (const auto& f : files)
     EXPECT_EQ(ReadAll(fs::path(dir / "b") / f), ReadAll(fs::path(dir / "a") / f)) << f;
+  // The camera's mounting, as the scenario gives it (the defaults: 0.15 m ahead of the axle).
+  harness::RigMounting rig;
+  std::string rig_error;
+  ASSERT_TRUE(harness::ReadRigYaml((fs::path(dir / "a") / "rig.yaml").string(), &rig, &rig_error))
+      << rig_error;
+  EXPECT_EQ(rig.forward_m, sim::CameraOptions().forward_m);
+  EXPECT_EQ(rig.height_m, sim::CameraOptions().height_m);
+  EXPECT_EQ(rig.pitch_deg, sim::CameraOptions().pitch_deg);
   for (const char* f :
        {"calib.txt", "times.txt", "poses.txt", "groundtruth_tum.txt", "image_0/000000.png",
         "image_1/000000.png", "depth/000000.png", "mav0/cam0/data.csv", "mav0/cam0/sensor.yaml",

@@ -1,0 +1,36 @@
+// The stereo camera's mounting on a ground vehicle, written beside a dataset as rig.yaml by
+// `vobench render` and read by `vobench run --dataset` / `eval` when present: a KITTI, EuRoC or
+// TUM folder otherwise carries no rig, and a tracking.ground_vehicle run needs the wheel
+// axle's distance behind the camera (tracking.few_point.axle_behind_camera_m, WithRigAxle).
+//
+//   # rig.yaml (metres, degrees)
+//   camera_forward_m: 0.15   # optical centre ahead of the wheel axle
+//   camera_height_m: 0.4     # optical centre above the floor
+//   camera_pitch_deg: 0      # downward tilt of the optical axis
+#pragma once
+
+#include <string>
+
+namespace harness {
+
+struct RigMounting {
+  double forward_m = 0.0;  // optical centre ahead of the wheel axle (m), finite; a camera
+                           // behind the axle (< 0) is recorded, not applied (WithRigAxle)
+  double height_m = 0.0;   // optical centre above the floor (m), > 0
+  double pitch_deg = 0.0;  // downward tilt of the optical axis (degrees), (-90, 90)
+
+  bool IsValid(std::string* error) const;
+};
+
+// The file name inside a dataset folder.
+inline constexpr const char* kRigFileName = "rig.yaml";
+
+// rig.yaml's text for `rig` (round-trips exactly through ReadRigYaml).
+std::string RigYaml(const RigMounting& rig);
+
+// Reads `path`. False, with an error naming the file and the problem, when it cannot be read,
+// is not a YAML map of the three keys with numbers (unknown keys are refused), or the values
+// are out of range.
+bool ReadRigYaml(const std::string& path, RigMounting* rig, std::string* error);
+
+}  // namespace harness
