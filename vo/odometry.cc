@@ -601,11 +601,6 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
   return ok;
 }
 
-void StereoOdometry::UpdateVehicleUp(const Eigen::Isometry3d& T_ref_curr) {
-  vehicle_up_.AddMotion(T_ref_curr, kVehicleUpTranslationSigmaM,
-                        kVehicleUpRotationSigmaDeg * M_PI / 180.0);
-}
-
 PlanarMotionPrior StereoOdometry::WindowPlanarPrior() const {
   const RobustTrackingOptions& o = options_.tracking;
   PlanarMotionPrior prior;
@@ -1045,7 +1040,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   // one: both are made planar about the current estimate).
   if (tracking.ground_vehicle && tracking.vehicle_planar_ba && !result.few_point_motion &&
       !ba_rejected && ransac.num_inliers >= tracking.reliable_min_inliers)
-    UpdateVehicleUp(ransac.T_prev_curr);
+    vehicle_up_.AddMotion(ransac.T_prev_curr, kVehicleUpTranslationSigmaM,
+                          kVehicleUpRotationSigmaDeg * M_PI / 180.0);
 
   result.status = consecutive_lost_ > 0 ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
   if (consecutive_lost_ > 0) {

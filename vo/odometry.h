@@ -712,8 +712,6 @@ class StereoOdometry {
   // The constant-velocity model moved `weight` of the way (slerp) to a measured per-frame
   // motion (the first one is taken as it is; a non-finite one is ignored).
   void MoveVelocity(const Eigen::Isometry3d& per_frame, double weight);
-  // The vehicle's up (vehicle_up_) refined by a reliable tracked motion T_ref_curr.
-  void UpdateVehicleUp(const Eigen::Isometry3d& T_ref_curr);
   // The window BA's planar motion prior (disabled unless ground_vehicle, vehicle_planar_ba and
   // a known up).
   PlanarMotionPrior WindowPlanarPrior() const;
