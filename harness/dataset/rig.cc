@@ -1,10 +1,10 @@
 #include "harness/dataset/rig.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
-#include <fstream>
 #include <sstream>
+#include <vector>
+
+#include "sim/yaml_input.h"
 
 namespace harness {
 
@@ -33,48 +33,26 @@ std::string RigYaml(const RigMounting& rig) {
 }
 
 bool ReadRigYaml(const std::string& path, RigMounting* rig, std::string* error) {
-  const auto fail = [&](const std::string& why) {
-    if (error) *error = path + ": " + why;
-    return false;
-  };
-  std::ifstream in(path);
-  if (!in) return fail("cannot be read");
-  std::stringstream text;
-  text << in.rdbuf();
-  YAML::Node root;
-  try {
-    root = YAML::Load(text.str());
-  } catch (const YAML::Exception& e) {
-    return fail(std::string("not valid YAML: ") + e.what());
+  sim::YamlReader r(path);
+  if (!r.ParseFile(path, "rig file")) return r.Report(error);
+  YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
+  const std::vector<std::string> keys = {"camera_forward_m", "camera_height_m", "camera_pitch_deg"};
+  if (!r.ExpectMap(root, "", "a mapping of camera_forward_m, camera_height_m, camera_pitch_deg") ||
+      !r.CheckKeys(root, "", keys))
+    return r.Report(error);
+  RigMounting m;
+  double* values[] = {&m.forward_m, &m.height_m, &m.pitch_deg};
+  for (size_t i = 0; i < keys.size(); ++i) {
+    if (!r.Require(root, "", keys[i], "a number") ||
+        !r.ReadDouble(root[keys[i]], keys[i], values[i]))
+      return r.Report(error);
   }
-  if (!root.IsMap())
-    return fail("must be a map of camera_forward_m, camera_height_m and camera_pitch_deg");
-  RigMounting r;
-  struct Key {
-    const char* name;
-    double* value;
-  };
-  const Key keys[] = {{"camera_forward_m", &r.forward_m},
-                      {"camera_height_m", &r.height_m},
-                      {"camera_pitch_deg", &r.pitch_deg}};
-  for (const auto& entry : root) {
-    const std::string name = entry.first.as<std::string>("");
-    bool known = false;
-    for (const Key& k : keys) known = known || name == k.name;
-    if (!known) return fail("unknown key '" + name + "'");
-  }
-  for (const Key& k : keys) {
-    const YAML::Node node = root[k.name];
-    if (!node) return fail(std::string("missing ") + k.name);
-    try {
-      *k.value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      return fail(std::string(k.name) + " must be a number");
-    }
-  }
-  std::string why;
-  if (!r.IsValid(&why)) return fail(why);
-  *rig = r;
+  if (!r.Check(m.height_m > 0.0, root, "", "camera_height_m",
+               "must be > 0, got " + std::to_string(m.height_m)) ||
+      !r.Check(m.pitch_deg > -90.0 && m.pitch_deg < 90.0, root, "", "camera_pitch_deg",
+               "must be in (-90, 90), got " + std::to_string(m.pitch_deg)))
+    return r.Report(error);
+  *rig = m;
   return true;
 }
 

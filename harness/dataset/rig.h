@@ -28,9 +28,9 @@ inline constexpr const char* kRigFileName = "rig.yaml";
 // rig.yaml's text for `rig` (round-trips exactly through ReadRigYaml).
 std::string RigYaml(const RigMounting& rig);
 
-// Reads `path`. False, with an error naming the file and the problem, when it cannot be read,
-// is not a YAML map of the three keys with numbers (unknown keys are refused), or the values
-// are out of range.
+// Reads `path` with sim::YamlReader ("PATH:LINE: key 'K': ..."). False when it cannot be read,
+// is not a YAML map of the three keys with finite numbers (unknown and duplicate keys are
+// refused), or the height or pitch is out of range.
 bool ReadRigYaml(const std::string& path, RigMounting* rig, std::string* error);
 
 }  // namespace harness

@@ -434,19 +434,21 @@ TEST_F(EvalBadInputTest, MalformedRigFile) {
   const std::string rig = data + "/rig.yaml";
   const std::string ok_rest = "camera_height_m: 0.4\ncamera_pitch_deg: 0\n";
   const std::pair<std::string, std::string> cases[] = {
-      {"[1, 2]\n", "must be a map"},
-      {"camera_forward_m: [\n", "not valid YAML"},
-      {"camera_height_m: 0.4\ncamera_pitch_deg: 0\n", "missing camera_forward_m"},
-      {"camera_forward_m: ahead\n" + ok_rest, "camera_forward_m must be a number"},
-      {"camera_forward_m: 0.15\naxle_m: 0.1\n" + ok_rest, "unknown key 'axle_m'"},
-      {"camera_forward_m: .nan\n" + ok_rest, "camera_forward_m must be finite"},
+      {"[1, 2]\n", "1: expected a mapping"},
+      {"camera_forward_m: [\n", "2: malformed YAML"},
+      {"camera_height_m: 0.4\ncamera_pitch_deg: 0\n",
+       "1: key 'camera_forward_m': required: a number"},
+      {"camera_forward_m: ahead\n" + ok_rest,
+       "1: key 'camera_forward_m': expected a number, got 'ahead'"},
+      {"camera_forward_m: 0.15\naxle_m: 0.1\n" + ok_rest, "2: key 'axle_m': unknown key"},
+      {"camera_forward_m: .nan\n" + ok_rest, "1: key 'camera_forward_m': expected a finite number"},
       {"camera_forward_m: 0.15\ncamera_height_m: -0.4\ncamera_pitch_deg: 0\n",
-       "camera_height_m must be finite and > 0"},
+       "2: key 'camera_height_m': must be > 0"},
       {"camera_forward_m: 0.15\ncamera_height_m: 0.4\ncamera_pitch_deg: 95\n",
-       "camera_pitch_deg must be in (-90, 90)"}};
+       "3: key 'camera_pitch_deg': must be in (-90, 90)"}};
   for (const auto& [text, why] : cases) {
     WriteText(rig, text);
-    ExpectCliFailure("--dataset " + data + " --format kitti", rig + ": " + why);
+    ExpectCliFailure("--dataset " + data + " --format kitti", rig + ":" + why);
   }
 }
 
