@@ -155,6 +155,9 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
   if (few_point_motion && !few_point.IsValid(&part_error)) {
     return FailPart("few_point", part_error, error);
   }
+  if (ground_vehicle && vehicle_bridge_alignment && !vehicle_bridge.IsValid(&part_error)) {
+    return FailPart("vehicle_bridge", part_error, error);
+  }
   std::ostringstream msg;
   if (!(prior_radius_scale >= 0.05 && prior_radius_scale <= 20.0)) {
     msg << "prior_radius_scale must be in [0.05, 20], got " << prior_radius_scale;
@@ -375,6 +378,7 @@ void StereoOdometry::Reset() {
   vehicle_up_ = VehicleUpEstimate();
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
+  previous_frame_features_.clear();
   last_matches_.clear();
   last_inlier_mask_.clear();
   last_reference_features_.clear();
@@ -395,6 +399,7 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
                                                : Eigen::Isometry3d(T_world_prev_.inverse() * T);
   T_world_prev_ = T;
   previous_measured_ = result.motion_measured;
+  previous_frame_features_ = last_features_;
   // Next frame's disparity search range from the depths of this one (full after a loss).
   scene_num_disparities_ = 0;
   if (options_.disparity_range_from_scene && result.status != TrackingStatus::kLost) {
@@ -493,6 +498,45 @@ Eigen::Isometry3d VehicleMotionFromImageShift(const StereoCamera& camera,
 Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, OdometryResult* result,
                                               const Eigen::Isometry3d* chained) {
   if (chained != nullptr) return *chained;  // measured against the lost-frame chain
+  const Eigen::Isometry3d bridged = ShiftCorrectedPose(prior, result);
+  const RobustTrackingOptions& o = options_.tracking;
+  if (prior != nullptr || !o.ground_vehicle || !o.vehicle_bridge_alignment || !world_up_known_ ||
+      options_.matcher.prediction == PredictionMode::kNone) {
+    return bridged;
+  }
+  return AlignedBridgePose(bridged, result);
+}
+
+Eigen::Isometry3d StereoOdometry::AlignedBridgePose(const Eigen::Isometry3d& bridged,
+                                                    OdometryResult* result) {
+  const RobustTrackingOptions& o = options_.tracking;
+  const Clock::time_point t = Clock::now();
+  Eigen::Isometry3d T = T_world_prev_.inverse() * bridged;
+  int pairs = 0;
+  double t_z = 0.0;
+  if (ForwardStepFromDepth(camera_, previous_frame_features_, last_features_, T, o.vehicle_bridge,
+                           &t_z, &pairs)) {
+    T.translation().z() = t_z;
+    result->bridge_aligned = true;
+  }
+  const Eigen::Vector3d up = WorldUpInCamera(T_world_prev_);
+  const double axle = o.few_point.axle_behind_camera_m;
+  const Eigen::Vector2d yaw_forward = VehicleMotionParameters(T, up, axle);
+  double yaw = yaw_forward.x();
+  if (yaw_forward.allFinite() &&
+      AlignVehicleYaw(camera_, previous_frame_features_, last_features_, up, axle, yaw_forward.y(),
+                      o.vehicle_bridge, &yaw, &pairs)) {
+    T = VehicleMotion(up, axle, yaw, yaw_forward.y());
+    result->bridge_aligned = true;
+  }
+  result->times.predict_ms += MsSince(t);
+  if (!IsFinite(T)) return bridged;
+  if (has_velocity_) velocity_ = T;
+  return T_world_prev_ * T;
+}
+
+Eigen::Isometry3d StereoOdometry::ShiftCorrectedPose(const MotionPrior* prior,
+                                                     OdometryResult* result) {
   const Eigen::Isometry3d predicted = T_world_prev_ * BridgeMotion(prior);
   const RobustTrackingOptions& o = options_.tracking;
   if (options_.matcher.prediction == PredictionMode::kNone || !o.rotation_from_shift ||
