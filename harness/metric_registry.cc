@@ -120,6 +120,10 @@ std::vector<MetricInfo> MakeRegistry() {
       Metric("reinitialisations", "frames", Better::kLower, kRun,
              "lost frames the VO re-initialised on",
              [](const RunSummary& s) { return json(s.reinitialisations); }),
+      Metric("bridge_aligned_frames", "frames", Better::kNeither, kRun,
+             "lost frames whose bridged forward step or yaw was measured against the previous "
+             "frame's features (tracking.vehicle_bridge_alignment)",
+             [](const RunSummary& s) { return json(s.bridge_aligned_frames); }),
       Metric("vo_ms_median", "ms", Better::kLower, MetricGroup::kTiming,
              "median VO time per frame (the first frame excluded)",
              [](const RunSummary& s) { return json(s.vo_ms_median); }),

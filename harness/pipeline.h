@@ -104,6 +104,9 @@ struct RunSummary {
   TrajectoryMetrics metrics;
   int lost_frames = 0;             // frames without a measured motion (vo::IsLostFrame)
   int reinitialisations = 0;       // of those, frames the VO re-initialised on
+  int bridge_aligned_frames = 0;   // of those, frames whose bridged forward step or yaw was
+                                   // measured against the previous frame's features
+                                   // (vo::OdometryResult::bridge_aligned)
   int frames_not_initialised = 0;  // frames before the first one the VO initialised on: no
                                    // pose, not in the trajectories, metrics or lost_frames
   double vo_ms_median = 0.0;

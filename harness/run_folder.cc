@@ -63,6 +63,10 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
   }
   r << "| lost frames (no measured motion) / re-initialisations | " << s.lost_frames << " / "
     << s.reinitialisations << " |\n";
+  if (s.bridge_aligned_frames > 0) {
+    r << "| lost frames whose bridged step or yaw was measured (vehicle_bridge_alignment) | "
+      << s.bridge_aligned_frames << " |\n";
+  }
   if (s.frames_not_initialised > 0) {
     r << "| frames before the VO initialised (no pose, not evaluated) | "
       << s.frames_not_initialised << " |\n";
@@ -138,7 +142,7 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
          "translation_error_m,rotation_error_deg,motion_measured,reinitialised,prediction,"
          "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_"
          "disparities,"
-         "disparity_pixels,chained_to_frame,chain_inliers\n";
+         "disparity_pixels,chained_to_frame,chain_inliers,bridge_aligned\n";
   // One row per frame; frames before the first initialised one have no pose and no error.
   const double kNan = std::nan("");
   auto row = [&](size_t frame, double time_s, const std::string& status,
@@ -157,7 +161,7 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
         << Fmt(r.image_shift_px.x(), 2) << "," << Fmt(r.image_shift_px.y(), 2) << ","
         << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << ","
         << r.num_disparities << "," << r.disparity_pixels << "," << r.chained_to_frame << ","
-        << r.chain_inliers << "\n";
+        << r.chain_inliers << "," << (r.bridge_aligned ? 1 : 0) << "\n";
   };
   for (size_t i = 0; i < first; ++i) {
     const vo::OdometryResult& r = records.frames[i].result;

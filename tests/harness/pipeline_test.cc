@@ -93,11 +93,13 @@ RunRecords CraftedRecords() {
     res.num_inliers = 50 + i;
     if (i < 2) {
       res.status = vo::TrackingStatus::kLost;
+      res.bridge_aligned = true;  // not counted: before the first initialised frame
     } else if (i == 2) {
       res.status = vo::TrackingStatus::kInitializing;
     } else if (i == 5) {
       res.status = vo::TrackingStatus::kRecovered;
       res.reinitialised = true;
+      res.bridge_aligned = true;  // counted: a lost frame whose bridge was measured
     } else {
       res.status = vo::TrackingStatus::kTracking;
       res.motion_measured = true;
@@ -118,6 +120,7 @@ TEST(PipelineTest, SummarizeCountsAndMediansOfACraftedRunAreExact) {
   EXPECT_EQ(s.metrics.frames, 6);
   EXPECT_EQ(s.lost_frames, 1);  // frame 5: no measured motion
   EXPECT_EQ(s.reinitialisations, 1);
+  EXPECT_EQ(s.bridge_aligned_frames, 1);
   EXPECT_TRUE(s.has_ground_truth);
   EXPECT_EQ(s.ground_truth_frames, 6);
   EXPECT_DOUBLE_EQ(s.metrics.path_length_m, 5.0);
