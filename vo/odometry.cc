@@ -926,8 +926,11 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   result.num_matches = static_cast<int>(matches.size());
   result.prediction = attempt.source;
 
-  // Too few matches for a consensus, or a frame with fewer than min_features features (matched
-  // only for this): the few-point solver with the prior. Such a frame takes no RANSAC motion.
+  // No consensus (too few matches, or fewer than min_inliers of them agree), or a frame with
+  // fewer than min_features features (matched only for this): the few-point solver with the
+  // prior. Such a frame takes no RANSAC motion. (Until 2026-12-03 a frame with min_inliers
+  // matches or more but fewer inliers was left lost: texture seed 10, stride 1, frame 204, 11
+  // of 13.)
   const RobustTrackingOptions& tracking = options_.tracking;
   const bool few_features = static_cast<int>(frame.features.size()) < options_.min_features;
   bool ransac_failed = few_features || !ransac.ok() || ransac.num_inliers < options_.min_inliers ||
@@ -943,7 +946,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   if (ransac_failed && tracking.few_point_motion && T_ref_curr_prior != nullptr &&
       previous_measured_ && consecutive_lost_ == 0 &&
       options_.matcher.prediction != PredictionMode::kNone && !correspondences.empty() &&
-      (few_features || static_cast<int>(correspondences.size()) < options_.min_inliers)) {
+      (few_features || static_cast<int>(correspondences.size()) < options_.min_inliers ||
+       ransac.num_inliers < options_.min_inliers)) {
     Eigen::Isometry3d few_prior;
     const PriorMotionResult few = FewPointMotion(correspondences, *T_ref_curr_prior, &few_prior);
     const bool agrees =

@@ -218,7 +218,8 @@ struct RobustTrackingOptions {
                                    // 0.347 -> 0.152 m, but strides 2 and 3 worse on seeds 2, 5,
                                    // 10: median 0.256 -> 0.331 m at stride 2). On: when RANSAC
                                    // finds no consensus (too few features or
-                                   // matches: a plain wall in front of the camera), the motion is
+                                   // matches, or fewer than min_inliers of them agree: a plain
+                                   // wall in front of the camera), the motion is
                                    // estimated from the few matches and the motion prior
                                    // (prior_motion.h: 1-point rotation hypotheses, then a
                                    // Gauss-Newton fit regularised by the prior) instead of losing

@@ -269,6 +269,41 @@ TEST(OdometrySeamTest, FewMatchesAreTrackedWithThePrior) {
   EXPECT_TRUE(IsLostFrame(plain.ProcessFeatures(frames[5].features, few, 0.5)));
 }
 
+// Enough matches for RANSAC (14 >= min_inliers 12) but too few of them agree (4 wrong, 10
+// right): no consensus, so the few-point solver takes the frame instead of losing it.
+TEST(OdometrySeamTest, MatchesWithoutAConsensusAreTrackedWithThePrior) {
+  const StereoCamera cam = HallwayCamera();
+  OdometryOptions options;
+  options.estimate_initial_orientation = false;
+  options.tracking.few_point_motion = true;  // off by default
+  const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  std::vector<SeamFrame> frames;
+  for (int i = 0; i < 6; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
+  std::vector<Match> some = SeamMatches(frames[4], frames[5], 0);
+  some.resize(14);
+  std::swap(some[0].curr, some[1].curr);
+  std::swap(some[2].curr, some[3].curr);
+  auto run = [&](bool few_point_motion) {
+    options.tracking.few_point_motion = few_point_motion;
+    StereoOdometry vo(cam, options);
+    vo.ProcessFeatures(frames[0].features, {}, 0.0);
+    for (int i = 1; i < 5; ++i) {
+      vo.ProcessFeatures(frames[i].features, SeamMatches(frames[i - 1], frames[i], 0), 0.1 * i);
+    }
+    return vo.ProcessFeatures(frames[5].features, some, 0.5);
+  };
+  const OdometryResult r5 = run(true);
+  EXPECT_EQ(r5.status, TrackingStatus::kTracking) << r5.message;
+  EXPECT_TRUE(r5.few_point_motion);
+  EXPECT_FALSE(IsLostFrame(r5));
+  EXPECT_EQ(r5.num_inliers, 10);
+  const Eigen::Isometry3d true_motion = SeamPose(4).inverse() * SeamPose(5);
+  EXPECT_THAT(r5.T_prev_curr, IsNearPose(true_motion, 0.1 * kDeg, 0.01));
+  const OdometryResult lost = run(false);
+  EXPECT_TRUE(IsLostFrame(lost));
+  EXPECT_THAT(lost.message, ::testing::HasSubstr("10 inliers of 14"));
+}
+
 // The image shift a motion predicts at the image centre: f · tan(θ) for a pan θ (any depth),
 // and for a sideways step b at depth z, −f · b / z.
 TEST(OdometrySeamTest, PredictedCentreShiftIsExact) {
