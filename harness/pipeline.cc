@@ -179,9 +179,11 @@ bool Summarize(const RunRecords& records, RunSummary* summary, std::string* erro
   std::map<std::string, std::vector<double>> stages;
   for (size_t i = first; i < all.size(); ++i) {
     const vo::OdometryResult& r = all[i].result;
-    if (vo::IsLostFrame(r)) ++s.lost_frames;
+    if (vo::IsLostFrame(r)) {
+      ++s.lost_frames;
+      if (r.bridge_aligned) ++s.bridge_aligned_frames;
+    }
     if (r.reinitialised) ++s.reinitialisations;
-    if (vo::IsLostFrame(r) && r.bridge_aligned) ++s.bridge_aligned_frames;
     total.push_back(r.times.total_ms);
     feats.push_back(r.num_features_with_depth);
     inl.push_back(r.num_inliers);

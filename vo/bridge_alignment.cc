@@ -12,13 +12,7 @@ namespace {
 
 bool Usable(const Feature& f) { return f.has_depth() && f.p_cam0.allFinite(); }
 
-// p (camera frame) in the left image; false behind the camera.
-bool Project(const StereoCamera& camera, const Eigen::Vector3d& p, Eigen::Vector2d* uv) {
-  if (!(p.z() > 1e-3)) return false;
-  *uv = Eigen::Vector2d(camera.fx_px * p.x() / p.z() + camera.cx_px,
-                        camera.fy_px * p.y() / p.z() + camera.cy_px);
-  return true;
-}
+constexpr double kMinDepthM = 1e-3;  // a point nearer than this does not project
 
 // The feature of `features` nearest to uv within gate_px (the first of equals), or null.
 const Feature* Nearest(const std::vector<Feature>& features, const Eigen::Vector2d& uv,
@@ -68,7 +62,7 @@ bool ForwardStepFromDepth(const StereoCamera& camera, const std::vector<Feature>
   for (const Feature& q : curr) {
     if (!Usable(q)) continue;
     Eigen::Vector2d uv;
-    if (!Project(camera, T * q.p_cam0, &uv)) continue;
+    if (!camera.ProjectLeft(T * q.p_cam0, &uv, kMinDepthM)) continue;
     const Feature* p = Nearest(prev, uv, options.gate_px);
     if (p == nullptr) continue;
     const double z1 = p->p_cam0.z(), z2 = q.p_cam0.z();
@@ -119,10 +113,10 @@ bool AlignVehicleYaw(const StereoCamera& camera, const std::vector<Feature>& pre
     for (const Feature& f : prev) {
       if (!Usable(f)) continue;
       Eigen::Vector2d uv, uv_d;
-      if (!Project(camera, T_curr_prev * f.p_cam0, &uv)) continue;
+      if (!camera.ProjectLeft(T_curr_prev * f.p_cam0, &uv, kMinDepthM)) continue;
       const Feature* target = Nearest(curr, uv, options.gate_px);
       if (target == nullptr) continue;
-      if (!Project(camera, T_curr_prev_d * f.p_cam0, &uv_d)) return false;
+      if (!camera.ProjectLeft(T_curr_prev_d * f.p_cam0, &uv_d, kMinDepthM)) return false;
       ++n;
       const Eigen::Vector2d r = uv - target->uv_px;
       const Eigen::Vector2d J = (uv_d - uv) / kStep;

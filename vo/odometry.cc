@@ -399,7 +399,10 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
                                                : Eigen::Isometry3d(T_world_prev_.inverse() * T);
   T_world_prev_ = T;
   previous_measured_ = result.motion_measured;
-  previous_frame_features_ = last_features_;
+  // Only the bridge alignment reads the previous frame's features: no copy per frame otherwise.
+  if (options_.tracking.ground_vehicle && options_.tracking.vehicle_bridge_alignment) {
+    previous_frame_features_ = last_features_;
+  }
   // Next frame's disparity search range from the depths of this one (full after a loss).
   scene_num_disparities_ = 0;
   if (options_.disparity_range_from_scene && result.status != TrackingStatus::kLost) {
@@ -946,8 +949,7 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   if (ransac_failed && tracking.few_point_motion && T_ref_curr_prior != nullptr &&
       previous_measured_ && consecutive_lost_ == 0 &&
       options_.matcher.prediction != PredictionMode::kNone && !correspondences.empty() &&
-      (few_features || static_cast<int>(correspondences.size()) < options_.min_inliers ||
-       ransac.num_inliers < options_.min_inliers)) {
+      (few_features || ransac.num_inliers < options_.min_inliers)) {
     Eigen::Isometry3d few_prior;
     const PriorMotionResult few = FewPointMotion(correspondences, *T_ref_curr_prior, &few_prior);
     const bool agrees =
