@@ -349,9 +349,10 @@ BackendResult SolveWithCeres(const StereoCamera& cam, const BundleAdjustmentProb
                              bp->points[o.point_index].data());
   }
   for (const auto& [a, b] : bp->planar_links) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlanarMotionResidual, 4, 7, 7>(
-                                 new PlanarMotionResidual(input.planar)),
-                             nullptr, bp->poses[a].data(), bp->poses[b].data());
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<PlanarMotionResidual, PlanarMotionResidual::kNumResiduals,
+                                        7, 7>(new PlanarMotionResidual(input.planar)),
+        nullptr, bp->poses[a].data(), bp->poses[b].data());
   }
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (size_t i = 0; i < bp->poses.size(); ++i) {

@@ -206,6 +206,13 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
            "be finite and > 0, got "
         << vehicle_ba_tilt_sigma_deg << ", " << vehicle_ba_lift_sigma_m << ", "
         << vehicle_ba_slip_sigma_m;
+  } else if (!(vehicle_floor_tilt_sigma_deg > 0.0) ||
+             !std::isfinite(vehicle_floor_tilt_sigma_deg) ||
+             !(vehicle_floor_height_sigma_m > 0.0) ||
+             !std::isfinite(vehicle_floor_height_sigma_m)) {
+    msg << "vehicle_floor_tilt_sigma_deg and vehicle_floor_height_sigma_m must be finite and > 0, "
+           "got "
+        << vehicle_floor_tilt_sigma_deg << ", " << vehicle_floor_height_sigma_m;
   } else if (few_point_min_features < 1) {
     msg << "few_point_min_features must be >= 1, got " << few_point_min_features;
   } else if (!(few_point_prior_update >= 0.0 && few_point_prior_update <= 1.0)) {
@@ -658,6 +665,13 @@ PlanarMotionPrior StereoOdometry::WindowPlanarPrior() const {
   prior.tilt_sigma_rad = o.vehicle_ba_tilt_sigma_deg * M_PI / 180.0;
   prior.lift_sigma_m = o.vehicle_ba_lift_sigma_m;
   prior.slip_sigma_m = o.vehicle_ba_slip_sigma_m;
+  // The world's z is the first frame's floor normal (EstimateInitialOrientation) and the first
+  // camera centre its origin (Initialise).
+  prior.flat_floor = o.vehicle_flat_floor;
+  prior.floor_up_world = Eigen::Vector3d::UnitZ();
+  prior.floor_height_m = 0.0;
+  prior.floor_tilt_sigma_rad = o.vehicle_floor_tilt_sigma_deg * M_PI / 180.0;
+  prior.floor_height_sigma_m = o.vehicle_floor_height_sigma_m;
   return prior;
 }
 

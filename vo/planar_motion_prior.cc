@@ -15,6 +15,12 @@ bool PlanarMotionPrior::IsValid(std::string* error) const {
            !std::isfinite(tilt_sigma_rad) || !std::isfinite(lift_sigma_m) ||
            !std::isfinite(slip_sigma_m))
     msg << "planar motion prior: the sigmas must be finite and > 0";
+  else if (flat_floor && (!floor_up_world.allFinite() || floor_up_world.norm() < 1e-9 ||
+                          !std::isfinite(floor_height_m) || !(floor_tilt_sigma_rad > 0.0) ||
+                          !(floor_height_sigma_m > 0.0) || !std::isfinite(floor_tilt_sigma_rad) ||
+                          !std::isfinite(floor_height_sigma_m)))
+    msg << "planar motion prior: the flat floor needs a finite, non-zero floor_up_world, a "
+           "finite floor_height_m and finite sigmas > 0";
   if (msg.tellp() == 0) return true;
   if (error) *error = msg.str();
   return false;

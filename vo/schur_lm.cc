@@ -122,26 +122,41 @@ Eigen::Matrix<double, 4, 3> QuaternionPlusJacobian(const double* q) {
 // Jacobians w.r.t. the two tangents [δθ δt], by ceres::Jet over the 14 ambient parameters
 // times the manifold's Plus Jacobian (what ceres::AutoDiffCostFunction and the manifold give
 // the Ceres backend).
+constexpr int kLinkRows = PlanarMotionResidual::kNumResiduals;
+using LinkVector = Eigen::Matrix<double, kLinkRows, 1>;
+using LinkJacobian = Eigen::Matrix<double, kLinkRows, 6>;
 void PlanarResidualAndJacobians(const PlanarMotionResidual& f, const PoseBlock7& a,
-                                const PoseBlock7& b, Eigen::Vector4d* r,
-                                Eigen::Matrix<double, 4, 6>* J_a,
-                                Eigen::Matrix<double, 4, 6>* J_b) {
+                                const PoseBlock7& b, LinkVector* r, LinkJacobian* J_a,
+                                LinkJacobian* J_b) {
   using Jet = ceres::Jet<double, 14>;
-  Jet pa[7], pb[7], out[4];
+  Jet pa[7], pb[7], out[kLinkRows];
   for (int c = 0; c < 7; ++c) {
     pa[c] = Jet(a[c], c);
     pb[c] = Jet(b[c], 7 + c);
   }
   f(pa, pb, out);
-  Eigen::Matrix<double, 4, 14> J;
-  for (int k = 0; k < 4; ++k) {
+  Eigen::Matrix<double, kLinkRows, 14> J;
+  for (int k = 0; k < kLinkRows; ++k) {
     (*r)(k) = out[k].a;
     J.row(k) = out[k].v.transpose();
   }
-  J_a->leftCols<3>() = J.block<4, 4>(0, 0) * QuaternionPlusJacobian(a.data());
-  J_a->rightCols<3>() = J.block<4, 3>(0, 4);
-  J_b->leftCols<3>() = J.block<4, 4>(0, 7) * QuaternionPlusJacobian(b.data());
-  J_b->rightCols<3>() = J.block<4, 3>(0, 11);
+  J_a->leftCols<3>() = J.block<kLinkRows, 4>(0, 0) * QuaternionPlusJacobian(a.data());
+  J_a->rightCols<3>() = J.block<kLinkRows, 3>(0, 4);
+  J_b->leftCols<3>() = J.block<kLinkRows, 4>(0, 7) * QuaternionPlusJacobian(b.data());
+  J_b->rightCols<3>() = J.block<kLinkRows, 3>(0, 11);
+}
+
+// Sums over a link's rows, the relative rows (4) and the flat floor's (3) apart, so that a
+// prior without the flat floor (rows 4..6 zero) adds exactly what a 4-row block would.
+double LinkSquaredNorm(const LinkVector& v) {
+  return v.head<4>().squaredNorm() + v.tail<3>().squaredNorm();
+}
+Vector6 LinkJtr(const LinkJacobian& J, const LinkVector& r) {
+  return J.topRows<4>().transpose() * r.head<4>() + J.bottomRows<3>().transpose() * r.tail<3>();
+}
+Matrix6 LinkJtJ(const LinkJacobian& A, const LinkJacobian& B) {
+  return A.topRows<4>().transpose() * B.topRows<4>() +
+         A.bottomRows<3>().transpose() * B.bottomRows<3>();
 }
 
 // The residual block r = [u_l, v_l, u_r, v_r] − observed (rows 2, 3 zero for a left-only
@@ -237,8 +252,8 @@ class Solver {
   };
   // A planar prior block linearised: residual and Jacobians w.r.t. the two pose tangents.
   struct LinkLinearisation {
-    Eigen::Vector4d r;
-    Eigen::Matrix<double, 4, 6> J_a, J_b;
+    LinkVector r;
+    LinkJacobian J_a, J_b;
   };
   // The linearisation at one point of parameter space: per block, and per slot (6) and per
   // point (3) the gradient Jᵀr and the squared Jacobian column norms diag(JᵀJ).
@@ -437,12 +452,13 @@ bool Solver::Evaluate(const std::vector<PoseBlock7>& poses,
     LinkLinearisation& l = lin->links[k];
     PlanarResidualAndJacobians(*planar_, poses[link.pose_a], poses[link.pose_b], &l.r, &l.J_a,
                                &l.J_b);
-    total += 0.5 * l.r.squaredNorm();
+    total += 0.5 * LinkSquaredNorm(l.r);
     for (const auto& [slot, J] :
          {std::make_pair(link.slot_a, &l.J_a), std::make_pair(link.slot_b, &l.J_b)}) {
       if (slot < 0) continue;
-      lin->grad_pose[slot] += J->transpose() * l.r;
-      lin->col_sq_pose[slot] += J->colwise().squaredNorm().transpose();
+      lin->grad_pose[slot] += LinkJtr(*J, l.r);
+      lin->col_sq_pose[slot] += J->topRows<4>().colwise().squaredNorm().transpose() +
+                                J->bottomRows<3>().colwise().squaredNorm().transpose();
     }
   }
   if (!std::isfinite(total)) return false;
@@ -562,18 +578,18 @@ bool Solver::ComputeStep(double radius, bool reuse_diagonal, double* model_cost_
     const Link& link = links_[k];
     const LinkLinearisation& l = lin_.links[k];
     if (link.slot_a >= 0) {
-      S_blocks_[link.slot_a * nf + link.slot_a] += l.J_a.transpose() * l.J_a;
-      S_rhs_[link.slot_a] += l.J_a.transpose() * l.r;
+      S_blocks_[link.slot_a * nf + link.slot_a] += LinkJtJ(l.J_a, l.J_a);
+      S_rhs_[link.slot_a] += LinkJtr(l.J_a, l.r);
     }
     if (link.slot_b >= 0) {
-      S_blocks_[link.slot_b * nf + link.slot_b] += l.J_b.transpose() * l.J_b;
-      S_rhs_[link.slot_b] += l.J_b.transpose() * l.r;
+      S_blocks_[link.slot_b * nf + link.slot_b] += LinkJtJ(l.J_b, l.J_b);
+      S_rhs_[link.slot_b] += LinkJtr(l.J_b, l.r);
     }
     if (link.slot_a >= 0 && link.slot_b >= 0) {
       if (link.slot_a > link.slot_b)
-        S_blocks_[link.slot_a * nf + link.slot_b] += l.J_a.transpose() * l.J_b;
+        S_blocks_[link.slot_a * nf + link.slot_b] += LinkJtJ(l.J_a, l.J_b);
       else
-        S_blocks_[link.slot_b * nf + link.slot_a] += l.J_b.transpose() * l.J_a;
+        S_blocks_[link.slot_b * nf + link.slot_a] += LinkJtJ(l.J_b, l.J_a);
     }
   }
   // Reduced camera system by dense Cholesky (lower triangle), then the points back-substituted.
@@ -615,10 +631,11 @@ bool Solver::ComputeStep(double radius, bool reuse_diagonal, double* model_cost_
   for (size_t k = 0; k < links_.size(); ++k) {
     const Link& link = links_[k];
     const LinkLinearisation& l = lin_.links[k];
-    Eigen::Vector4d jd = Eigen::Vector4d::Zero();
+    LinkVector jd = LinkVector::Zero();
     if (link.slot_a >= 0) jd += l.J_a * step_pose_[link.slot_a];
     if (link.slot_b >= 0) jd += l.J_b * step_pose_[link.slot_b];
-    change -= jd.dot(l.r) + 0.5 * jd.squaredNorm();
+    change -= jd.head<4>().dot(l.r.head<4>()) + jd.tail<3>().dot(l.r.tail<3>()) +
+              0.5 * LinkSquaredNorm(jd);
   }
   *model_cost_change = change;
   return change > 0.0;

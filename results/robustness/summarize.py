@@ -20,7 +20,10 @@ CONFIGS = [("default", "svd_ncc_gabor, prediction: motion_prior (the library def
            ("few_point_ground_rig", "svd_ncc_gabor, tracking.few_point_motion: true, "
             "ground_vehicle: true, few_point.axle_behind_camera_m: 0.15 (the rig's camera.forward_m)"),
            ("few_point_ground_rig_planar", "svd_ncc_gabor, tracking.few_point_motion: true, "
-            "ground_vehicle: true, vehicle_planar_ba: true, few_point.axle_behind_camera_m: 0.15")]
+            "ground_vehicle: true, vehicle_planar_ba: true, few_point.axle_behind_camera_m: 0.15"),
+           ("few_point_ground_rig_planar_floor", "svd_ncc_gabor, tracking.few_point_motion: true, "
+            "ground_vehicle: true, vehicle_planar_ba: true, vehicle_flat_floor: true, "
+            "few_point.axle_behind_camera_m: 0.15")]
 KEYS = ["end_pose_error_m", "end_pose_error_pct", "ate_rmse_m", "lost_frames",
         "reinitialisations", "vo_ms_median"]
 

@@ -54,8 +54,11 @@ printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  
 # The same with the planar motion prior in the window's bundle adjustment (it needs the axle).
 printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  vehicle_planar_ba: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
   > "$WORK/few_point_ground_rig_planar.yaml"
+# And with the flat floor (every pose held to the first pose's floor tilt and camera height).
+printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  vehicle_planar_ba: true\n  vehicle_flat_floor: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
+  > "$WORK/few_point_ground_rig_planar_floor.yaml"
 runs=()
-for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual few_point few_point_ground ground few_point_ground_rig few_point_ground_rig_planar}; do
+for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual few_point few_point_ground ground few_point_ground_rig few_point_ground_rig_planar few_point_ground_rig_planar_floor}; do
   for s in 1 2 3 4 5 6 7 8 9 10; do for k in 1 2 3 5; do runs+=("seed$s $k $c"); done; done
   runs+=("seed7 8 $c" "pitch10 1 $c" "vga 1 $c")
   for k in 1 2 3 5; do runs+=("corridor $k $c"); done

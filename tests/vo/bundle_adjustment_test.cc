@@ -525,15 +525,16 @@ std::vector<Eigen::Isometry3d> VehiclePoses(double yaw_rad) {
   return poses;
 }
 
-Eigen::Vector4d PlanarResidual(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b,
-                               const PlanarMotionPrior& prior) {
+using LinkResidual = Eigen::Matrix<double, PlanarMotionResidual::kNumResiduals, 1>;
+LinkResidual PlanarResidual(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b,
+                            const PlanarMotionPrior& prior) {
   auto block = [](const Eigen::Isometry3d& T) {
     const Eigen::Quaterniond q(T.linear());
     return std::array<double, 7>{
         q.x(), q.y(), q.z(), q.w(), T.translation().x(), T.translation().y(), T.translation().z()};
   };
   const std::array<double, 7> a = block(T_a), b = block(T_b);
-  Eigen::Vector4d r;
+  LinkResidual r;
   const PlanarMotionResidual residual(prior);
   residual(a.data(), b.data(), r.data());
   return r;
@@ -555,7 +556,7 @@ TEST(PlanarMotionPriorTest, ZeroForAVehicleMotionAndTheSizeOfATiltALiftAndASlip)
       // σ in r1 resp. r0 (R u moves towards ∓e2 resp. ±e1).
       Eigen::Isometry3d tilted = T_ab;
       tilted.linear() = Eigen::AngleAxisd(0.01, e1) * T_ab.linear();
-      Eigen::Vector4d r = PlanarResidual(T_a, T_a * tilted, prior);
+      LinkResidual r = PlanarResidual(T_a, T_a * tilted, prior);
       EXPECT_NEAR(std::hypot(r(0), r(1)), std::sin(0.01) / prior.tilt_sigma_rad, 1e-6);
       // A lift of 1 cm along up.
       Eigen::Isometry3d lifted = T_ab;
@@ -574,6 +575,40 @@ TEST(PlanarMotionPriorTest, ZeroForAVehicleMotionAndTheSizeOfATiltALiftAndASlip)
   }
 }
 
+// The flat floor's rows: zero for every pose of a vehicle on the first pose's floor (any yaw,
+// anywhere), the sine of a tilt against the floor over σ, a height step over σ; zero when off.
+TEST(PlanarMotionPriorTest, FlatFloorRowsHoldEachPoseOnTheFirstPosesFloor) {
+  PlanarMotionPrior prior = Prior();
+  prior.flat_floor = true;
+  const std::vector<Eigen::Isometry3d> poses = VehiclePoses(0.2);
+  const Eigen::Vector3d u = PitchedUp();
+  const Eigen::Vector3d w = poses[0].linear() * u;  // the floor's up in the world
+  prior.floor_up_world = 3.0 * w;                   // normalised by the residual
+  prior.floor_height_m = w.dot(poses[0].translation());
+  for (int i = 1; i < kNumFrames; ++i) {
+    SCOPED_TRACE(i);
+    // The relative rows link the neighbour; the floor rows see the later pose only.
+    EXPECT_LT(PlanarResidual(poses[i - 1], poses[i], prior).norm(), 1e-10);
+    EXPECT_LT(PlanarResidual(poses[0], poses[i], prior).tail<3>().norm(), 1e-10);
+    const Eigen::Vector3d f1 = HorizontalForwardAxis(w), f2 = w.cross(f1);
+    for (const Eigen::Vector3d& tilt_axis : {f1, f2, (f1 + f2).normalized()}) {
+      Eigen::Isometry3d tilted = poses[i];
+      tilted.linear() = Eigen::AngleAxisd(0.02, tilt_axis) * poses[i].linear();
+      const LinkResidual r = PlanarResidual(poses[i - 1], tilted, prior);
+      EXPECT_NEAR(r.segment<2>(4).norm(), std::sin(0.02) / prior.floor_tilt_sigma_rad, 1e-6);
+      EXPECT_NEAR(r(6), 0.0, 1e-9);
+    }
+    Eigen::Isometry3d raised = poses[i];
+    raised.translation() += 0.03 * w + 0.5 * HorizontalForwardAxis(w);  // up 3 cm, and along
+    const LinkResidual r = PlanarResidual(poses[i - 1], raised, prior);
+    EXPECT_NEAR(r(6), 0.03 / prior.floor_height_sigma_m, 1e-9);
+    EXPECT_LT(r.segment<2>(4).norm(), 1e-10);
+    prior.flat_floor = false;
+    EXPECT_EQ(PlanarResidual(poses[i - 1], raised, prior).tail<3>().norm(), 0.0);
+    prior.flat_floor = true;
+  }
+}
+
 TEST(PlanarMotionPriorTest, InvalidPriorIsRejected) {
   Scene s = MakeScene(31, kPixelSigma, nullptr);
   for (auto spoil : std::vector<std::function<void(PlanarMotionPrior*)>>{
@@ -581,7 +616,19 @@ TEST(PlanarMotionPriorTest, InvalidPriorIsRejected) {
            [](PlanarMotionPrior* p) { p->up_cam.x() = NAN; },
            [](PlanarMotionPrior* p) { p->axle_behind_camera_m = -0.1; },
            [](PlanarMotionPrior* p) { p->tilt_sigma_rad = 0.0; },
-           [](PlanarMotionPrior* p) { p->slip_sigma_m = INFINITY; }}) {
+           [](PlanarMotionPrior* p) { p->slip_sigma_m = INFINITY; },
+           [](PlanarMotionPrior* p) {
+             p->flat_floor = true;
+             p->floor_up_world.setZero();
+           },
+           [](PlanarMotionPrior* p) {
+             p->flat_floor = true;
+             p->floor_height_sigma_m = 0.0;
+           },
+           [](PlanarMotionPrior* p) {
+             p->flat_floor = true;
+             p->floor_height_m = NAN;
+           }}) {
     s.start.planar = Prior();
     spoil(&s.start.planar);
     const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), s.start);
@@ -602,22 +649,28 @@ TEST_P(BundleAdjustmentTest, PlanarPriorKeepsTheTrueVehicleMotionOnExactData) {
     EXPECT_THAT(r.T_world_cam0[i], IsNearPose(poses[i], kExactTolRad, kExactTolM)) << i;
 }
 
-// Few, far points (a plain wall's few features at 6-10 m): the visual evidence alone lets the
-// poses tilt and lift; with the prior they stay a vehicle's.
-TEST_P(BundleAdjustmentTest, PlanarPriorKeepsAWeaklyObservedVehicleLevel) {
-  const std::vector<Eigen::Isometry3d> poses = VehiclePoses(0.02);
-  Scene s = MakeScene(33, 1.0, &poses);
-  // Keep only the points farther than 6 m, at most 15.
+// The start of a scene with only its points farther than 6 m from the first pose, at most 15
+// (a plain wall's few features at 6-10 m).
+BundleAdjustmentProblem FarPointsOnly(const Scene& s) {
   BundleAdjustmentProblem weak = s.start;
   weak.observations.clear();
   int kept = 0;
   for (size_t j = 0; j < s.truth.points_world.size() && kept < 15; ++j) {
-    if ((poses[0].inverse() * s.truth.points_world[j]).z() < 6.0) continue;
+    if ((s.truth.T_world_cam0[0].inverse() * s.truth.points_world[j]).z() < 6.0) continue;
     ++kept;
     for (const BaObservation& o : s.start.observations)
       if (o.point_index == static_cast<int>(j)) weak.observations.push_back(o);
   }
-  ASSERT_EQ(kept, 15);
+  EXPECT_EQ(kept, 15);
+  return weak;
+}
+
+// Few, far points: the visual evidence alone lets the poses tilt and lift; with the prior they
+// stay a vehicle's.
+TEST_P(BundleAdjustmentTest, PlanarPriorKeepsAWeaklyObservedVehicleLevel) {
+  const std::vector<Eigen::Isometry3d> poses = VehiclePoses(0.02);
+  Scene s = MakeScene(33, 1.0, &poses);
+  BundleAdjustmentProblem weak = FarPointsOnly(s);
   const BundleAdjustmentSummary free = RunBundleAdjustment(TestCamera(), weak, Options());
   weak.planar = Prior();
   const BundleAdjustmentSummary planar = RunBundleAdjustment(TestCamera(), weak, Options());
@@ -625,9 +678,8 @@ TEST_P(BundleAdjustmentTest, PlanarPriorKeepsAWeaklyObservedVehicleLevel) {
   ASSERT_TRUE(planar.ok()) << planar.message;
   double free_tilt = 0.0, planar_tilt = 0.0, free_lift = 0.0, planar_lift = 0.0;
   for (int i = 1; i < kNumFrames; ++i) {
-    const Eigen::Vector4d rf =
-        PlanarResidual(free.T_world_cam0[i - 1], free.T_world_cam0[i], Prior());
-    const Eigen::Vector4d rp =
+    const LinkResidual rf = PlanarResidual(free.T_world_cam0[i - 1], free.T_world_cam0[i], Prior());
+    const LinkResidual rp =
         PlanarResidual(planar.T_world_cam0[i - 1], planar.T_world_cam0[i], Prior());
     free_tilt = std::max(free_tilt, rf.head<2>().norm() * Prior().tilt_sigma_rad);
     planar_tilt = std::max(planar_tilt, rp.head<2>().norm() * Prior().tilt_sigma_rad);
@@ -645,6 +697,45 @@ TEST_P(BundleAdjustmentTest, PlanarPriorKeepsAWeaklyObservedVehicleLevel) {
   EXPECT_LT(planar_lift, Prior().lift_sigma_m);
   EXPECT_LT(planar_tilt, 0.15 * free_tilt);
   EXPECT_LT(planar_lift, 0.1 * free_lift);
+}
+
+// The neighbour links let each weakly observed pose tilt and rise a little more than the one
+// before (within σ per link, summing along the window); the flat floor holds every pose against
+// the first one's floor. The fixed first pose is the truth, the floor is the true one.
+TEST_P(BundleAdjustmentTest, FlatFloorHoldsTheTiltAndHeightOfAWeaklyObservedVehicle) {
+  const std::vector<Eigen::Isometry3d> poses = VehiclePoses(0.02);
+  const Eigen::Vector3d w = poses[0].linear() * PitchedUp();
+  double worst[2][2] = {{0, 0}, {0, 0}};  // [links only, flat floor][tilt rad, height m]
+  for (uint64_t seed : {41, 42, 43, 44}) {
+    Scene s = MakeScene(seed, 1.0, &poses);
+    BundleAdjustmentProblem weak = FarPointsOnly(s);
+    for (int floor = 0; floor < 2; ++floor) {
+      weak.planar = Prior();
+      weak.planar.tilt_sigma_rad = 0.01;  // loose links: the drift the floor is for
+      weak.planar.lift_sigma_m = 0.01;
+      weak.planar.flat_floor = floor == 1;
+      weak.planar.floor_up_world = w;
+      weak.planar.floor_height_m = w.dot(poses[0].translation());
+      const BundleAdjustmentSummary r = RunBundleAdjustment(TestCamera(), weak, Options());
+      ASSERT_TRUE(r.ok()) << r.message;
+      for (int i = 1; i < kNumFrames; ++i) {
+        const Eigen::Vector3d up = r.T_world_cam0[i].linear() * PitchedUp();
+        worst[floor][0] = std::max(worst[floor][0], std::asin(std::min(1.0, up.cross(w).norm())));
+        worst[floor][1] =
+            std::max(worst[floor][1],
+                     std::abs(w.dot(r.T_world_cam0[i].translation() - poses[0].translation())));
+      }
+    }
+  }
+  std::printf(
+      "weak vehicle, largest tilt / height against the floor: links only %.5f rad / "
+      "%.4f m, flat floor %.5f rad / %.4f m\n",
+      worst[0][0], worst[0][1], worst[1][0], worst[1][1]);
+  const PlanarMotionPrior floor = Prior();
+  EXPECT_LT(worst[1][0], 2.0 * floor.floor_tilt_sigma_rad);
+  EXPECT_LT(worst[1][1], 2.0 * floor.floor_height_sigma_m);
+  EXPECT_LT(worst[1][0], 0.5 * worst[0][0]);
+  EXPECT_LT(worst[1][1], 0.5 * worst[0][1]);
 }
 
 TEST(BundleAdjustmentBackendTest, SchurLmMatchesCeresWithThePlanarPrior) {
@@ -670,6 +761,14 @@ TEST(BundleAdjustmentBackendTest, SchurLmMatchesCeresWithThePlanarPrior) {
   const BundleAdjustmentSummary lm_gap = Solve(gap, options, BaSolver::kSchurLm);
   ExpectSameSolution(ceres_gap, lm_gap);
   EXPECT_EQ(lm_gap.num_planar_links, 2);  // (1, 2) and (2, 4)
+  // With a flat floor 0.5° and 2 cm off the true one (the prior and the images disagree).
+  s.start.planar.flat_floor = true;
+  s.start.planar.floor_up_world = Eigen::AngleAxisd(0.5 * M_PI / 180.0, Eigen::Vector3d::UnitZ()) *
+                                  (poses[0].linear() * PitchedUp());
+  s.start.planar.floor_height_m = 0.02;
+  options.num_fixed_poses = 1;
+  ExpectSameSolution(Solve(s.start, options, BaSolver::kCeres),
+                     Solve(s.start, options, BaSolver::kSchurLm));
 }
 
 TEST(BundleAdjustmentBackendTest, SolverNames) {

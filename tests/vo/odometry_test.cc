@@ -1316,6 +1316,10 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
           "vehicle_ba_tilt_sigma_deg");
   rejects([](OdometryOptions* o) { o->tracking.vehicle_ba_slip_sigma_m = NAN; },
           "vehicle_ba_slip_sigma_m");
+  rejects([](OdometryOptions* o) { o->tracking.vehicle_floor_tilt_sigma_deg = -1.0; },
+          "vehicle_floor_tilt_sigma_deg");
+  rejects([](OdometryOptions* o) { o->tracking.vehicle_floor_height_sigma_m = NAN; },
+          "vehicle_floor_height_sigma_m");
   rejects([](OdometryOptions* o) { o->prior_weight = 1.5; }, "prior_weight");
   rejects([](OdometryOptions* o) { o->min_inliers = 2; }, "min_inliers");
   rejects([](OdometryOptions* o) { o->min_features = 0; }, "min_features");
