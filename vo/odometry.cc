@@ -665,10 +665,11 @@ PlanarMotionPrior StereoOdometry::WindowPlanarPrior() const {
   prior.tilt_sigma_rad = o.vehicle_ba_tilt_sigma_deg * M_PI / 180.0;
   prior.lift_sigma_m = o.vehicle_ba_lift_sigma_m;
   prior.slip_sigma_m = o.vehicle_ba_slip_sigma_m;
-  // The world's z is the first frame's floor normal (EstimateInitialOrientation) and the first
-  // camera centre its origin (Initialise).
+  // The floor's up is the vehicle's (as refined so far) at the first pose, (R_hall_cam0_initial_,
+  // 0) (Initialise), so that a turn about the refined up keeps it; the world's z (the first
+  // floor fit) would tilt every pose by what the refinement has moved the up since.
   prior.flat_floor = o.vehicle_flat_floor;
-  prior.floor_up_world = Eigen::Vector3d::UnitZ();
+  prior.floor_up_world = R_hall_cam0_initial_ * vehicle_up_.up();
   prior.floor_height_m = 0.0;
   prior.floor_tilt_sigma_rad = o.vehicle_floor_tilt_sigma_deg * M_PI / 180.0;
   prior.floor_height_sigma_m = o.vehicle_floor_height_sigma_m;

@@ -308,20 +308,18 @@ struct RobustTrackingOptions {
   double vehicle_ba_lift_sigma_m = 0.002;
   double vehicle_ba_slip_sigma_m = 0.002;
   // With vehicle_planar_ba: the floor is flat (one plane), so every pose of the window keeps
-  // the world's up (the first frame's floor normal) as the vehicle's up (σ
-  // vehicle_floor_tilt_sigma_deg) and the first camera's height (σ vehicle_floor_height_sigma_m),
-  // both > 0 (planar_motion_prior.h, "Flat floor"; the σ are an indoor floor's and a vehicle's
-  // suspension's, not tuned). The planar prior links only neighbours, so the tilt and the height
-  // wander a little with every window. Off by default: it is only as good as the first frame's
-  // floor fit, and that is off by up to ~0.8° (texture seed 7: the vehicle's up 0.84° off in
-  // pitch at frame 20, 0.46° after the turn's refinement). Measured with few_point_motion, the
-  // axle and vehicle_planar_ba on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs):
-  // median end-pose error 0.108 -> 0.122 m, mean 0.211 -> 0.211 m, seed 7 stride 1 0.099 ->
-  // 0.133 m, plain_corridor strides 1/2/3/5 1.21/0.79/2.84/1.31 -> 3.01/2.59/3.02/2.23 %; pitch
-  // 10° 0.33 -> 0.28 %, seed 7 stride 8 0.71 -> 0.29 %. With the true first orientation (an
-  // oracle experiment) and the up not refined, seeds 7/2/4/1 at stride 1 go 0.099/0.107/0.073/
-  // 0.154 -> 0.073/0.044/0.049/0.130 m: a floor measured better (per frame, from the disparity)
-  // is what it needs.
+  // the first pose's vehicle up (as refined so far; σ vehicle_floor_tilt_sigma_deg) and the
+  // first camera's height (σ vehicle_floor_height_sigma_m), both > 0 (planar_motion_prior.h,
+  // "Flat floor"; the σ are an indoor floor's and a vehicle's suspension's, not tuned). The
+  // planar prior links only neighbours, so the tilt and the height wander a little with every
+  // window. Off by default: it is only as good as the first frame's floor fit, and that is off by
+  // up to 0.8° in pitch on l_hallway (1.5° on plain_corridor). Measured with few_point_motion,
+  // the axle and vehicle_planar_ba on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs):
+  // median end-pose error 0.108 -> 0.132 m, mean 0.211 -> 0.207 m, seed 7 stride 1 0.099 ->
+  // 0.100 m, plain_corridor strides 1/2/3/5 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 %. With
+  // the true first orientation (an oracle experiment) and the up not refined, seeds 7/2/4/1 at
+  // stride 1 go 0.099/0.107/0.073/0.154 -> 0.073/0.044/0.049/0.130 m: a floor measured better
+  // is what it needs (README, "Flat floor").
   bool vehicle_flat_floor = false;
   double vehicle_floor_tilt_sigma_deg = 0.3;
   double vehicle_floor_height_sigma_m = 0.01;

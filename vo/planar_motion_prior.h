@@ -25,7 +25,7 @@
 //   r6     = (w·t_b − floor_height_m) / floor_height_sigma_m (the camera centre's height),
 // with T_world_b = (R_b, t_b). Without it r4..r6 are 0. The relative residuals above let the
 // tilt and the height wander by a little each step of the window (a pitch drift of ~1° over 200
-// frames on l_hallway); these do not.
+// frames on l_hallway); these hold them to the floor given, so they are only as good as it.
 //
 // The residual is a template so that both backends evaluate the same function: the Ceres
 // backend through ceres::AutoDiffCostFunction, schur_lm.cc through ceres::Jet and the pose
