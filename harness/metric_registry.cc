@@ -148,10 +148,14 @@ std::vector<MetricInfo> MakeRegistry() {
       Metric("initial_orientation_error_deg", "deg", Better::kLower, kRun,
              "error of that orientation vs the ground truth (< 0: not known)",
              [](const RunSummary& s) { return json(s.initial_orientation_error_deg); }),
+      Metric("initial_floor_refined", "", kNeither, kRun,
+             "the first frame's floor was refined on the images (orientation_floor_refinement)",
+             [](const RunSummary& s) { return json(s.initial_floor_refined); }),
   };
   // Not columns of summary.csv: the flags (the suite's status says enough) and the stride.
   for (MetricInfo& m : r) {
     if (m.key == "has_ground_truth" || m.key == "initial_orientation_ok" ||
+        m.key == "initial_floor_refined" ||
         m.key == "frame_stride")  // the suite's own stride column
       m.csv = false;
     if (m.key == "end_pose_error_pct") m.label = "end-pose error (% of path)";

@@ -204,6 +204,8 @@ bool Summarize(const RunRecords& records, RunSummary* summary, std::string* erro
   s.match_stats = records.match_stats;
   s.inliers_median = Median({inl.begin() + 1, inl.end()});
   s.initial_orientation_ok = first_frame.result.initial_orientation_ok;
+  s.initial_floor_refined = first_frame.result.floor_refined;
+  s.initial_floor_message = first_frame.result.floor_refinement_message;
   if (s.has_ground_truth && first_frame.has_gt && s.initial_orientation_ok) {
     s.initial_orientation_error_deg = RotationAngle(first_frame.result.T_world_cam0.linear(),
                                                     first_frame.T_world_cam0_gt.linear()) *

@@ -116,6 +116,8 @@ struct RunSummary {
   double inliers_median = 0.0;
   bool initial_orientation_ok = false;
   double initial_orientation_error_deg = -1.0;  // vs ground truth; < 0 when not known
+  bool initial_floor_refined = false;           // its floor was refined on the images
+  std::string initial_floor_message;            // what that refinement did, or why not
   bool has_ground_truth = false;  // at least 2 frames with ground truth: the metrics are set
   int ground_truth_frames = 0;    // frames with a ground-truth pose; the metrics use these only
   VoMatchStats match_stats;       // the VO's matches against the ground truth (simulated runs and

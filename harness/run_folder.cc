@@ -59,7 +59,8 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
     if (s.initial_orientation_error_deg >= 0)
       r << "| initial orientation from planes (error vs GT) | "
         << (s.initial_orientation_ok ? "found" : "not found") << ", "
-        << Fmt(s.initial_orientation_error_deg, 2) << " deg |\n";
+        << Fmt(s.initial_orientation_error_deg, 2) << " deg"
+        << (s.initial_floor_message.empty() ? "" : "; " + s.initial_floor_message) << " |\n";
   }
   r << "| lost frames (no measured motion) / re-initialisations | " << s.lost_frames << " / "
     << s.reinitialisations << " |\n";

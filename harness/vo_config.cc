@@ -108,6 +108,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
   vo::RansacOptions& r = o->ransac;
   vo::BundleAdjustmentOptions& ba = o->ba;
   vo::PlaneOrientationOptions& po = o->orientation;
+  vo::PlaneRefinementOptions& fr = o->floor_refinement;
   vo::RobustTrackingOptions& t = o->tracking;
   using vo::BaLinearSolver;
   using vo::BaSolver;
@@ -283,6 +284,18 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"orientation.max_normal_deviation_deg", Number(&po.max_normal_deviation_deg, 0.0, 180.0)},
       {"orientation.manhattan_refinement", Bool(&po.manhattan_refinement)},
       {"orientation_sample_step_px", Number(&o->orientation_sample_step_px, 1, 1000)},
+      {"orientation_floor_refinement", Bool(&o->orientation_floor_refinement)},
+      {"floor_refinement.max_iterations", Number(&fr.max_iterations, 1, 1000)},
+      {"floor_refinement.converged_px", Number(&fr.converged_px, 1e-9, 100.0)},
+      {"floor_refinement.huber_iterations", Number(&fr.huber_iterations, 0, 999)},
+      {"floor_refinement.huber_sigmas", Number(&fr.huber_sigmas, 1e-3, 100.0)},
+      {"floor_refinement.tukey_sigmas", Number(&fr.tukey_sigmas, 1e-3, 100.0)},
+      {"floor_refinement.region_radius_px", Number(&fr.region_radius_px, 1, 50)},
+      {"floor_refinement.region_outlier_ratio", Number(&fr.region_outlier_ratio, 1.0, 1000.0)},
+      {"floor_refinement.min_sigma_grey", Number(&fr.min_sigma_grey, 1e-6, 255.0)},
+      {"floor_refinement.min_pixels", Number(&fr.min_pixels, 5, kBig)},
+      {"floor_refinement.max_tilt_change_deg", Number(&fr.max_tilt_change_deg, 1e-6, 90.0)},
+      {"floor_refinement.max_offset_change", Number(&fr.max_offset_change, 1e-6, 100.0)},
       {"orientation_requires_wall", Bool(&o->orientation_requires_wall)},
       {"adaptive_min_features", Number(&o->adaptive_min_features, 0, 100000)},
       {"adaptive_quality_level", Number(&o->adaptive_quality_level, 0.0, 0.999)},

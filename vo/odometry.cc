@@ -236,6 +236,10 @@ bool OdometryOptions::IsValid(std::string* error) const {
   if (estimate_initial_orientation && !orientation.IsValid(&part_error)) {
     return FailPart("orientation", part_error, error);
   }
+  if (estimate_initial_orientation && orientation_floor_refinement &&
+      !floor_refinement.IsValid(&part_error)) {
+    return FailPart("floor_refinement", part_error, error);
+  }
   std::ostringstream msg;
   if (matcher.type == MatcherType::kSiftRatio && detector.type != DetectorType::kSift) {
     msg << "matcher sift_ratio needs descriptors: detector.type must be kSift";
@@ -641,8 +645,73 @@ OdometryResult StereoOdometry::Lost(OdometryResult result, const std::string& me
   return Finish(std::move(result), T_world_cam0, start);
 }
 
-bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0) {
+bool StereoOdometry::RefineInitialFloor(const cv::Mat& left, const cv::Mat& right,
+                                        const cv::Mat& disparity_px, std::string* message) {
+  PlaneOrientationResult& o = orientation_result_;
+  // The floor, or without one the ceiling (its normal is then the down direction).
+  const bool has_floor = o.floor_index >= 0;
+  Plane& floor = o.planes[has_floor ? o.floor_index : o.ceiling_index];
+  const double up_sign = has_floor ? 1.0 : -1.0;
+  // The floor's pixels: those whose point of the dense map lies on the geometric fit (within
+  // the plane extraction's inlier distance).
+  std::vector<cv::Point> pixels;
+  for (int v = 0; v < disparity_px.rows; ++v) {
+    const float* row = disparity_px.ptr<float>(v);
+    for (int u = 0; u < disparity_px.cols; ++u) {
+      if (!(row[u] > 0.0f)) continue;
+      const Eigen::Vector3d p = camera_.Backproject(u, v, row[u]);
+      const double threshold = options_.orientation.distance_threshold_m +
+                               options_.orientation.distance_threshold_per_m * p.z();
+      if (std::abs(floor.normal_cam0.dot(p) + floor.offset_m) <= threshold) {
+        pixels.emplace_back(u, v);
+      }
+    }
+  }
+  const PlaneRefinementResult refined =
+      RefinePlanePhotometric(left, right, camera_, floor, pixels, options_.floor_refinement);
+  if (!refined.ok) {
+    *message = "floor not refined: " + refined.message;
+    return false;
+  }
+  const double start_offset = floor.offset_m;
+  floor = refined.plane;
+  // The floor fixes the pitch: the rotation about the hallway's y axis. With walls found, that
+  // axis (their normal) stays, so the roll and the yaw stay the walls' (a side wall seen face
+  // on measures the roll better than a floor seen at a grazing angle); the up is the refined
+  // normal without its part along y_hall. Without walls, the up is the refined normal.
+  Eigen::Vector3d up = up_sign * floor.normal_cam0;
+  if (o.ok()) {
+    const Eigen::Vector3d y_old = o.R_hall_cam0.row(1).transpose();
+    up = (up - up.dot(y_old) * y_old).normalized();
+  }
+  const Eigen::Vector3d x_old = o.R_hall_cam0.row(0).transpose();
+  const Eigen::Vector3d x_hall = (x_old - x_old.dot(up) * up).normalized();
+  o.R_hall_cam0.row(0) = x_hall.transpose();
+  o.R_hall_cam0.row(1) = up.cross(x_hall).transpose();
+  o.R_hall_cam0.row(2) = up.transpose();
+  std::ostringstream msg;
+  msg << (has_floor ? "floor" : "ceiling") << " refined on the images (" << refined.pixels
+      << " pixels, " << refined.iterations << " iterations): up moved by "
+      << std::acos(std::clamp(up.dot(o.up_cam0), -1.0, 1.0)) * 180.0 / M_PI << " deg, distance "
+      << start_offset << " -> " << floor.offset_m << " m";
+  *message = msg.str();
+  o.up_cam0 = up;
+  if (has_floor) o.camera_height_m = floor.offset_m;
+  return true;
+}
+
+bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0,
+                                                const cv::Mat& left, const cv::Mat& right,
+                                                const cv::Mat& disparity_px,
+                                                OdometryResult* result) {
   orientation_result_ = EstimateHallwayOrientation(points_cam0, options_.orientation);
+  if (options_.orientation_floor_refinement && !disparity_px.empty() &&
+      (orientation_result_.floor_index >= 0 || orientation_result_.ceiling_index >= 0) &&
+      (orientation_result_.ok() ||
+       orientation_result_.status == PlaneOrientationResult::Status::kNoWall)) {
+    result->floor_refined =
+        RefineInitialFloor(left, right, disparity_px, &result->floor_refinement_message);
+  }
   const bool ok = orientation_result_.ok() ||
                   (orientation_result_.status == PlaneOrientationResult::Status::kNoWall &&
                    !options_.orientation_requires_wall);
@@ -1246,10 +1315,12 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
           }
         }
       }
-      result.initial_orientation_ok = EstimateInitialOrientation(points);
+      result.initial_orientation_ok = EstimateInitialOrientation(points, left, right, d, &result);
       if (!result.initial_orientation_ok) {
         reason = std::string("initial orientation failed (") +
                  ToString(orientation_result_.status) + "): world = first camera frame";
+      } else {
+        reason = result.floor_refinement_message;
       }
       result.times.orientation_ms = MsSince(t);
     }
@@ -1348,7 +1419,8 @@ OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
       const Clock::time_point to = Clock::now();
       std::vector<Eigen::Vector3d> points;
       for (const Feature& f : frame.features) points.push_back(f.p_cam0);
-      result.initial_orientation_ok = EstimateInitialOrientation(points);
+      result.initial_orientation_ok =
+          EstimateInitialOrientation(points, cv::Mat(), cv::Mat(), cv::Mat(), &result);
       if (!result.initial_orientation_ok) {
         reason = std::string("initial orientation failed (") +
                  ToString(orientation_result_.status) + "): world = first camera frame";

@@ -124,6 +124,7 @@
 #include "vo/image_motion.h"
 #include "vo/matcher.h"
 #include "vo/plane_orientation.h"
+#include "vo/plane_refinement.h"
 #include "vo/prior_motion.h"
 #include "vo/ransac.h"
 #include "vo/sliding_window.h"
@@ -316,10 +317,12 @@ struct RobustTrackingOptions {
   // up to 0.8° in pitch on l_hallway (1.5° on plain_corridor). Measured with few_point_motion,
   // the axle and vehicle_planar_ba on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs):
   // median end-pose error 0.108 -> 0.132 m, mean 0.211 -> 0.207 m, seed 7 stride 1 0.099 ->
-  // 0.100 m, plain_corridor strides 1/2/3/5 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 %. With
-  // the true first orientation (an oracle experiment) and the up not refined, seeds 7/2/4/1 at
-  // stride 1 go 0.099/0.107/0.073/0.154 -> 0.073/0.044/0.049/0.130 m: a floor measured better
-  // is what it needs (README, "Flat floor").
+  // 0.100 m, plain_corridor strides 1/2/3/5 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 % (with
+  // the first floor refined on the images, orientation_floor_refinement: median 0.124 m, mean
+  // 0.217 m, seed 7 stride 1 0.49 %, corridor 2.10/1.56/2.01/1.44 %; the planar row then 0.111 /
+  // 0.194 m). With the true first orientation (an oracle experiment) and the up not refined, seeds
+  // 7/2/4/1 at stride 1 go 0.099/0.107/0.073/0.154 -> 0.073/0.044/0.049/0.130 m: a floor measured
+  // better is what it needs (README, "Flat floor").
   bool vehicle_flat_floor = false;
   double vehicle_floor_tilt_sigma_deg = 0.3;
   double vehicle_floor_height_sigma_m = 0.01;
@@ -433,9 +436,17 @@ struct OdometryOptions {
   bool estimate_initial_orientation = true;  // hallway frame from the first frame's planes
                                              // (floor/walls); false = world is the first camera
   PlaneOrientationOptions orientation;       // plane extraction for the initial orientation
-  int orientation_sample_step_px = 4;      // the first frame's dense disparity map is sampled every
-                                           // this many pixels (both axes) for the plane extraction
-                                           // (pixels), >= 1. ProcessFeatures uses the features' 3D
+  int orientation_sample_step_px = 4;  // the first frame's dense disparity map is sampled every
+                                       // this many pixels (both axes) for the plane extraction
+                                       // (pixels), >= 1. ProcessFeatures uses the features' 3D
+  // The first frame's floor (when the plane extraction found one) refined on the images
+  // themselves (plane_refinement.h) over the dense map's pixels on the geometric fit: the up and
+  // the camera's height then come from it (the yaw stays the walls'). The block matcher's map
+  // at a grazing floor is biased: the fit's pitch was off by +0.2..+0.8° on l_hallway texture
+  // seeds 1-10 and +1.5° on plain_corridor. Needs the dense map (the first frame of Process;
+  // ProcessFeatures has none and skips it).
+  bool orientation_floor_refinement = true;
+  PlaneRefinementOptions floor_refinement;
   bool orientation_requires_wall = false;  // true: kNoWall (up known, yaw not) also counts as a
                                            // failure (world = first camera); false: the yaw is
                                            // then the camera's heading (zero)
@@ -545,8 +556,11 @@ struct OdometryResult {
                                    // with disparity_mode dense; left + right-view pixels
                                    // with at_features)
   StageTimes times;
-  bool initial_orientation_ok = false;  // first frame only: the hallway orientation was found
-                                        // and defines the world frame
+  bool initial_orientation_ok = false;   // first frame only: the hallway orientation was found
+  bool floor_refined = false;            // first frame only: its floor was refined on the images
+                                         // (orientation_floor_refinement)
+  std::string floor_refinement_message;  // first frame: what the refinement did, or why not
+                                         // and defines the world frame
 };
 
 // Where each reference feature's 3D point (p_cam0, from its disparity) appears in the current
@@ -772,8 +786,17 @@ class StereoOdometry {
   // Sets the output pose (finite), T_prev_curr and the total time.
   OdometryResult Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
                         TimePoint start);
-  // Plane-based orientation of the first frame; true when it defines the world frame.
-  bool EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0);
+  // Refines orientation_result_'s floor on the images over the dense map's pixels on it and
+  // rebuilds its up, height and R_hall_cam0 from it; false (unchanged) when refusing. *message
+  // says what it did or why not.
+  bool RefineInitialFloor(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity_px,
+                          std::string* message);
+  // Plane-based orientation of the first frame; true when it defines the world frame. With the
+  // images and the dense disparity map (Process; empty in ProcessFeatures) and
+  // orientation_floor_refinement, the floor is refined photometrically (result->floor_refined).
+  bool EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0,
+                                  const cv::Mat& left, const cv::Mat& right,
+                                  const cv::Mat& disparity_px, OdometryResult* result);
 
   StereoCamera camera_;
   OdometryOptions options_;

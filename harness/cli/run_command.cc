@@ -93,8 +93,11 @@ void PrintRunTable(const RunSummary& s, const std::string& out) {
                 m.ate_rmse_unaligned_m);
     std::printf("drift           %.3f %%, %.4f deg/m\n", m.drift_pct, m.drift_deg_per_m);
     if (s.initial_orientation_error_deg >= 0)
-      std::printf("initial orient. %.2f deg from ground truth (plane-based)\n",
-                  s.initial_orientation_error_deg);
+      std::printf("initial orient. %.2f deg from ground truth (plane-based%s)\n",
+                  s.initial_orientation_error_deg,
+                  s.initial_floor_refined ? ", floor or ceiling refined on the images" : "");
+    if (!s.initial_floor_message.empty() && !s.initial_floor_refined)
+      std::printf("                %s\n", s.initial_floor_message.c_str());
   }
   std::printf("VO time/frame   median %.2f ms, p95 %.2f ms |", s.vo_ms_median, s.vo_ms_p95);
   for (const auto& [k, v] : s.stage_ms_median) std::printf(" %s %.2f", k.c_str(), v);
