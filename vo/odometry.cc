@@ -22,6 +22,11 @@ using Clock = std::chrono::steady_clock;
 // straight approach. A 4 cm step then gives its direction to ~14°, a 3° turn its axis to ~6°:
 // the motions move the floor fit over tens of frames (seed 7: 0.77° -> 0.35° off).
 constexpr double kVehicleUpPriorSigmaDeg = 1.0;
+// ... when the floor was refined on the images (orientation_floor_refinement): its pitch error
+// on l_hallway texture seeds 1-10 was within 0.17° (rms 0.10°). With 1° the reliable motions
+// that refine the up carry its slow pitch drift into it (texture seed 5, stride 1: 1.2° off by
+// the end, and the flat floor with it).
+constexpr double kVehicleUpRefinedFloorSigmaDeg = 0.15;
 constexpr double kVehicleUpTranslationSigmaM = 1e-2;
 constexpr double kVehicleUpRotationSigmaDeg = 0.3;
 
@@ -387,6 +392,7 @@ void StereoOdometry::Reset() {
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   world_up_known_ = false;
   vehicle_up_ = VehicleUpEstimate();
+  first_floor_found_ = false;
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
   previous_frame_features_.clear();
@@ -718,8 +724,14 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
   R_hall_cam0_initial_ = ok ? orientation_result_.R_hall_cam0 : Eigen::Matrix3d::Identity();
   world_up_known_ = ok;
   if (ok) {
+    // A refined ceiling is not as good (plain_corridor: 1.05° off): the floor's σ only for a
+    // floor.
+    first_floor_found_ = orientation_result_.floor_index >= 0;
+    const double sigma_deg = result->floor_refined && first_floor_found_
+                                 ? kVehicleUpRefinedFloorSigmaDeg
+                                 : kVehicleUpPriorSigmaDeg;
     vehicle_up_ = VehicleUpEstimate(R_hall_cam0_initial_.transpose() * Eigen::Vector3d::UnitZ(),
-                                    kVehicleUpPriorSigmaDeg * M_PI / 180.0);
+                                    sigma_deg * M_PI / 180.0);
   }
   return ok;
 }
@@ -737,7 +749,10 @@ PlanarMotionPrior StereoOdometry::WindowPlanarPrior() const {
   // The floor's up is the vehicle's (as refined so far) at the first pose, (R_hall_cam0_initial_,
   // 0) (Initialise), so that a turn about the refined up keeps it; the world's z (the first
   // floor fit) would tilt every pose by what the refinement has moved the up since.
-  prior.flat_floor = o.vehicle_flat_floor;
+  // Only when the first frame found a floor: an up from the ceiling is off by 1-1.5°
+  // (plain_corridor, where no floor is found: strides 1/2/3/5 0.72/0.52/2.75/1.04 % without the
+  // flat floor, 2.10/1.56/2.01/1.44 % with it on the refined ceiling's up).
+  prior.flat_floor = o.vehicle_flat_floor && first_floor_found_;
   prior.floor_up_world = R_hall_cam0_initial_ * vehicle_up_.up();
   prior.floor_height_m = 0.0;
   prior.floor_tilt_sigma_rad = o.vehicle_floor_tilt_sigma_deg * M_PI / 180.0;

@@ -313,16 +313,16 @@ struct RobustTrackingOptions {
   // first camera's height (σ vehicle_floor_height_sigma_m), both > 0 (planar_motion_prior.h,
   // "Flat floor"; the σ are an indoor floor's and a vehicle's suspension's, not tuned). The
   // planar prior links only neighbours, so the tilt and the height wander a little with every
-  // window. Off by default: it is only as good as the first frame's floor fit, and that is off by
-  // up to 0.8° in pitch on l_hallway (1.5° on plain_corridor). Measured with few_point_motion,
-  // the axle and vehicle_planar_ba on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs):
-  // median end-pose error 0.108 -> 0.132 m, mean 0.211 -> 0.207 m, seed 7 stride 1 0.099 ->
-  // 0.100 m, plain_corridor strides 1/2/3/5 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 % (with
-  // the first floor refined on the images, orientation_floor_refinement: median 0.124 m, mean
-  // 0.217 m, seed 7 stride 1 0.49 %, corridor 2.10/1.56/2.01/1.44 %; the planar row then 0.111 /
-  // 0.194 m). With the true first orientation (an oracle experiment) and the up not refined, seeds
-  // 7/2/4/1 at stride 1 go 0.099/0.107/0.073/0.154 -> 0.073/0.044/0.049/0.130 m: a floor measured
-  // better is what it needs (README, "Flat floor").
+  // window. Only when the first frame found a floor (an up from a ceiling is 1-1.5° off). Off by
+  // default (a library cannot assume a flat floor). Measured with few_point_motion, the axle and
+  // vehicle_planar_ba on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs), against
+  // vehicle_planar_ba alone: with the first frame's floor refined on the images
+  // (orientation_floor_refinement) and the vehicle's up starting from it at σ 0.15°, median
+  // end-pose error 0.108 -> 0.097 m, stride 1 median 0.108 -> 0.079 m, seed 7 stride 1 0.60 ->
+  // 0.46 %, mean 0.211 -> 0.211 m, plain_corridor (no floor found: off) unchanged. Before that
+  // refinement, on the block matcher's floor fit (up to 0.8° off in pitch), it was worse: median
+  // 0.108 -> 0.132 m, corridor 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 % (README, "Flat floor"
+  // and "The first frame's floor refined").
   bool vehicle_flat_floor = false;
   double vehicle_floor_tilt_sigma_deg = 0.3;
   double vehicle_floor_height_sigma_m = 0.01;
@@ -557,7 +557,8 @@ struct OdometryResult {
                                    // with at_features)
   StageTimes times;
   bool initial_orientation_ok = false;   // first frame only: the hallway orientation was found
-  bool floor_refined = false;            // first frame only: its floor was refined on the images
+  bool floor_refined = false;            // first frame only: its floor (without one, its
+                                         // ceiling) was refined on the images
                                          // (orientation_floor_refinement)
   std::string floor_refinement_message;  // first frame: what the refinement did, or why not
                                          // and defines the world frame
@@ -806,10 +807,12 @@ class StereoOdometry {
   std::unique_ptr<FrameMatcher> matcher_;
   SlidingWindow window_;  // tracks, window poses and the bundle adjustment (sliding_window.h)
 
-  int64_t frame_index_ = 0;      // index of the next call
-  bool initialised_ = false;     // a reference was set at least once since Reset
-  bool world_up_known_ = false;  // the world's z is up (the first frame's orientation found
-                                 // the floor or a ceiling)
+  int64_t frame_index_ = 0;         // index of the next call
+  bool initialised_ = false;        // a reference was set at least once since Reset
+  bool first_floor_found_ = false;  // the first frame's orientation found a floor (not only a
+                                    // ceiling): the flat floor needs one
+  bool world_up_known_ = false;     // the world's z is up (the first frame's orientation found
+                                    // the floor or a ceiling)
   // The vehicle's up in the camera frame (tracking.vehicle_planar_ba): the floor fit refined
   // by the reliable tracked motions.
   VehicleUpEstimate vehicle_up_;
