@@ -392,7 +392,6 @@ void StereoOdometry::Reset() {
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   world_up_known_ = false;
   vehicle_up_ = VehicleUpEstimate();
-  first_floor_found_ = false;
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
   previous_frame_features_.clear();
@@ -666,9 +665,8 @@ bool StereoOdometry::RefineInitialFloor(const cv::Mat& left, const cv::Mat& righ
     for (int u = 0; u < disparity_px.cols; ++u) {
       if (!(row[u] > 0.0f)) continue;
       const Eigen::Vector3d p = camera_.Backproject(u, v, row[u]);
-      const double threshold = options_.orientation.distance_threshold_m +
-                               options_.orientation.distance_threshold_per_m * p.z();
-      if (std::abs(floor.normal_cam0.dot(p) + floor.offset_m) <= threshold) {
+      if (std::abs(floor.normal_cam0.dot(p) + floor.offset_m) <=
+          PlaneInlierDistance(p, options_.orientation)) {
         pixels.emplace_back(u, v);
       }
     }
@@ -726,8 +724,7 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
   if (ok) {
     // A refined ceiling is not as good (plain_corridor: 1.05° off): the floor's σ only for a
     // floor.
-    first_floor_found_ = orientation_result_.floor_index >= 0;
-    const double sigma_deg = result->floor_refined && first_floor_found_
+    const double sigma_deg = result->floor_refined && orientation_result_.floor_index >= 0
                                  ? kVehicleUpRefinedFloorSigmaDeg
                                  : kVehicleUpPriorSigmaDeg;
     vehicle_up_ = VehicleUpEstimate(R_hall_cam0_initial_.transpose() * Eigen::Vector3d::UnitZ(),
@@ -752,7 +749,7 @@ PlanarMotionPrior StereoOdometry::WindowPlanarPrior() const {
   // Only when the first frame found a floor: an up from the ceiling is off by 1-1.5°
   // (plain_corridor, where no floor is found: strides 1/2/3/5 0.72/0.52/2.75/1.04 % without the
   // flat floor, 2.10/1.56/2.01/1.44 % with it on the refined ceiling's up).
-  prior.flat_floor = o.vehicle_flat_floor && first_floor_found_;
+  prior.flat_floor = o.vehicle_flat_floor && orientation_result_.floor_index >= 0;
   prior.floor_up_world = R_hall_cam0_initial_ * vehicle_up_.up();
   prior.floor_height_m = 0.0;
   prior.floor_tilt_sigma_rad = o.vehicle_floor_tilt_sigma_deg * M_PI / 180.0;

@@ -807,12 +807,10 @@ class StereoOdometry {
   std::unique_ptr<FrameMatcher> matcher_;
   SlidingWindow window_;  // tracks, window poses and the bundle adjustment (sliding_window.h)
 
-  int64_t frame_index_ = 0;         // index of the next call
-  bool initialised_ = false;        // a reference was set at least once since Reset
-  bool first_floor_found_ = false;  // the first frame's orientation found a floor (not only a
-                                    // ceiling): the flat floor needs one
-  bool world_up_known_ = false;     // the world's z is up (the first frame's orientation found
-                                    // the floor or a ceiling)
+  int64_t frame_index_ = 0;      // index of the next call
+  bool initialised_ = false;     // a reference was set at least once since Reset
+  bool world_up_known_ = false;  // the world's z is up (the first frame's orientation found
+                                 // the floor or a ceiling)
   // The vehicle's up in the camera frame (tracking.vehicle_planar_ba): the floor fit refined
   // by the reliable tracked motions.
   VehicleUpEstimate vehicle_up_;

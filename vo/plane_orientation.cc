@@ -60,11 +60,15 @@ bool PlaneOrientationOptions::IsValid(std::string* error) const {
   return false;
 }
 
+double PlaneInlierDistance(const Eigen::Vector3d& p, const PlaneOrientationOptions& options) {
+  return options.distance_threshold_m + options.distance_threshold_per_m * std::max(p.z(), 0.0);
+}
+
 namespace {
 
 // Inlier distance of a point: grows with depth (stereo depth error grows with z).
 double Threshold(const Eigen::Vector3d& p, const PlaneOrientationOptions& options) {
-  return options.distance_threshold_m + options.distance_threshold_per_m * std::max(p.z(), 0.0);
+  return PlaneInlierDistance(p, options);
 }
 
 // Weighted least-squares plane through the points (smallest eigenvector of the weighted,

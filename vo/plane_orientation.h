@@ -106,6 +106,10 @@ struct PlaneOrientationResult {
 
 const char* ToString(PlaneOrientationResult::Status status);
 
+// The inlier distance of a point p_cam0 from a plane (metres): distance_threshold_m +
+// distance_threshold_per_m · z (header, step 1).
+double PlaneInlierDistance(const Eigen::Vector3d& p_cam0, const PlaneOrientationOptions& options);
+
 // Orientation of cam0 relative to the hallway from 3D points in cam0 (metres), e.g. the first
 // frame's features or a subsampled dense disparity map. Never throws.
 PlaneOrientationResult EstimateHallwayOrientation(

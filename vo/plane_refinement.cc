@@ -177,13 +177,14 @@ PlaneRefinementResult RefinePlanePhotometric(const cv::Mat& left, const cv::Mat&
       const cv::Size window(2 * options.region_radius_px + 1, 2 * options.region_radius_px + 1);
       cv::boxFilter(abs_r, abs_r, -1, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
       cv::boxFilter(count, count, -1, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-      residuals.clear();
+      std::vector<double> local_mean;
+      local_mean.reserve(samples.size());
       for (const Sample& s : samples) {
-        residuals.push_back(abs_r.at<float>(s.y, s.x) / count.at<float>(s.y, s.x));
+        local_mean.push_back(abs_r.at<float>(s.y, s.x) / count.at<float>(s.y, s.x));
       }
-      std::vector<double> local = residuals;
-      const double limit = options.region_outlier_ratio * Median(&local);
-      for (size_t i = 0; i < samples.size(); ++i) samples[i].outlier = residuals[i] > limit;
+      std::vector<double> sorted = local_mean;  // Median reorders
+      const double limit = options.region_outlier_ratio * Median(&sorted);
+      for (size_t i = 0; i < samples.size(); ++i) samples[i].outlier = local_mean[i] > limit;
     }
     residuals.clear();
     for (const Sample& s : samples) {

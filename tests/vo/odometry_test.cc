@@ -958,6 +958,16 @@ std::vector<SeamFrame> NoisyVehicleDrive(const StereoCamera& cam, uint64_t seed,
   return frames;
 }
 
+// The ground-vehicle configuration for that drive: planar BA, the axle, the flat floor or not.
+OdometryOptions DriveOptions(bool flat_floor) {
+  OdometryOptions options;
+  options.tracking.ground_vehicle = true;
+  options.tracking.vehicle_planar_ba = true;
+  options.tracking.vehicle_flat_floor = flat_floor;
+  options.tracking.few_point.axle_behind_camera_m = kDriveAxleM;
+  return options;
+}
+
 // A ground vehicle drives down a hallway (floor, two walls, the end wall), features with
 // 0.3 px of noise (the first frame's exact, so its floor fit is the true floor): with
 // vehicle_planar_ba the window's poses are linked to their neighbours only, so the tilt wanders;
@@ -969,7 +979,6 @@ std::vector<SeamFrame> NoisyVehicleDrive(const StereoCamera& cam, uint64_t seed,
 // frame noisy too, the floor fit's own error makes the flat floor no better.)
 TEST(OdometryVehicleTest, FlatFloorHoldsTheTiltOfANoisyDrive) {
   const StereoCamera cam = HallwayCamera();
-  constexpr double kAxleM = kDriveAxleM;
   constexpr int kFrames = 40;
   const Eigen::Vector3d up_cam = R_hall_cam(0.0).transpose() * Eigen::Vector3d::UnitZ();
   std::vector<double> tilt_links, tilt_floor;
@@ -977,12 +986,7 @@ TEST(OdometryVehicleTest, FlatFloorHoldsTheTiltOfANoisyDrive) {
     const std::vector<SeamFrame> frames = NoisyVehicleDrive(cam, seed, kFrames, false);
     // The largest tilt (rad) and height change (m) against the first pose, over the run.
     auto run = [&](bool flat_floor) {
-      OdometryOptions options;
-      options.tracking.ground_vehicle = true;
-      options.tracking.vehicle_planar_ba = true;
-      options.tracking.vehicle_flat_floor = flat_floor;
-      options.tracking.few_point.axle_behind_camera_m = kAxleM;
-      StereoOdometry vo(cam, options);
+      StereoOdometry vo(cam, DriveOptions(flat_floor));
       const OdometryResult first = vo.ProcessFeatures(frames[0].features, {}, 0.0);
       EXPECT_TRUE(first.initial_orientation_ok);
       const Eigen::Vector3d w = first.T_world_cam0.linear() * up_cam;
@@ -1023,12 +1027,7 @@ TEST(OdometryVehicleTest, FlatFloorNeedsAFloorNotACeiling) {
   constexpr int kFrames = 12;
   const std::vector<SeamFrame> frames = NoisyVehicleDrive(cam, 11, kFrames, true);
   auto run = [&](bool flat_floor) {
-    OdometryOptions options;
-    options.tracking.ground_vehicle = true;
-    options.tracking.vehicle_planar_ba = true;
-    options.tracking.vehicle_flat_floor = flat_floor;
-    options.tracking.few_point.axle_behind_camera_m = kDriveAxleM;
-    StereoOdometry vo(cam, options);
+    StereoOdometry vo(cam, DriveOptions(flat_floor));
     const OdometryResult first = vo.ProcessFeatures(frames[0].features, {}, 0.0);
     EXPECT_TRUE(first.initial_orientation_ok) << first.message;
     EXPECT_GE(vo.initial_orientation().ceiling_index, 0);
