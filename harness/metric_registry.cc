@@ -151,11 +151,14 @@ std::vector<MetricInfo> MakeRegistry() {
       Metric("initial_floor_refined", "", kNeither, kRun,
              "the first frame's floor was refined on the images (orientation_floor_refinement)",
              [](const RunSummary& s) { return json(s.initial_floor_refined); }),
+      Metric("platform", "", kNeither, kRun,
+             "what the VO ran as: free (6-DoF) or ground_vehicle (platform auto on a known rig)",
+             [](const RunSummary& s) { return json(s.platform); }),
   };
   // Not columns of summary.csv: the flags (the suite's status says enough) and the stride.
   for (MetricInfo& m : r) {
     if (m.key == "has_ground_truth" || m.key == "initial_orientation_ok" ||
-        m.key == "initial_floor_refined" ||
+        m.key == "initial_floor_refined" || m.key == "platform" ||
         m.key == "frame_stride")  // the suite's own stride column
       m.csv = false;
     if (m.key == "end_pose_error_pct") m.label = "end-pose error (% of path)";

@@ -30,12 +30,8 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
   return true;
 }
 
-vo::OdometryOptions WithRigAxle(const vo::OdometryOptions& options, double axle_behind_camera_m) {
-  vo::OdometryOptions o = options;
-  if (o.tracking.ground_vehicle && o.tracking.few_point.axle_behind_camera_m == 0.0 &&
-      axle_behind_camera_m >= 0.0)
-    o.tracking.few_point.axle_behind_camera_m = axle_behind_camera_m;
-  return o;
+vo::OdometryOptions ForRig(const vo::OdometryOptions& options, double axle_behind_camera_m) {
+  return vo::ResolvePlatform(options, axle_behind_camera_m);
 }
 
 bool ReadAllFrames(const FrameSource& source, int max_frames, int expected_frames,

@@ -40,11 +40,12 @@ struct StereoSequence {
                                        // camera.forward_m); < 0 = unknown
 };
 
-// The VO options a run of `sequence` uses: `options`, except that a ground vehicle
-// (tracking.ground_vehicle) whose axle is left at 0 (few_point.axle_behind_camera_m, the
-// library default) takes the rig's axle when the sequence knows it. The run folder's
-// vo_options.yaml records the value used.
-vo::OdometryOptions WithRigAxle(const vo::OdometryOptions& options, double axle_behind_camera_m);
+// The VO options a run of `sequence` uses: `options` with its platform resolved on the
+// sequence's rig (vo::ResolvePlatform): `platform: auto` (the default) is a ground vehicle when
+// the sequence knows the rig's axle (a simulated robot; a dataset folder with rig.yaml), and a
+// ground vehicle whose axle is left at 0 takes the rig's. The run folder's vo_options.yaml
+// records the resolved platform and the values used.
+vo::OdometryOptions ForRig(const vo::OdometryOptions& options, double axle_behind_camera_m);
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
@@ -123,6 +124,8 @@ struct RunSummary {
   VoMatchStats match_stats;       // the VO's matches against the ground truth (simulated runs and
                                   // datasets with depth); matches == 0 when not available
   int frame_stride = 1;           // RunFramesOptions::frame_stride of the run
+  std::string platform;           // the VO's resolved platform ("free", "ground_vehicle"; set by
+                                  // RunOdometry, "" when not known)
 };
 
 // The summary of a run: trajectory metrics over the frames with ground truth from the first

@@ -27,6 +27,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   if (!RunFrames(name, source, *odometry, frames_options, &records, error) ||
       !Summarize(records, summary, error))
     return false;
+  summary->platform = vo::ToString(odometry->options().platform);
   RunFolderContents contents;
   contents.options_yaml = VoConfigToYaml(odometry->options());
   contents.scenario_yaml = scenario_yaml;
@@ -40,8 +41,8 @@ bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_o
   RunOptions o = options;
   if (o.outline_scene.empty()) o.outline_scene = sequence.outline_scene;
   return RunOdometry(sequence.name, sequence.camera, sequence.next, sequence.expected_frames,
-                     WithRigAxle(vo_options, sequence.axle_behind_camera_m), o,
-                     sequence.scenario_yaml, summary, error);
+                     ForRig(vo_options, sequence.axle_behind_camera_m), o, sequence.scenario_yaml,
+                     summary, error);
 }
 
 bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_options,

@@ -154,6 +154,8 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"disparity.sgbm_p1", Number(&disp.sgbm_p1, 0, kBig)},
       {"disparity.sgbm_p2", Number(&disp.sgbm_p2, 0, kBig)},
       {"disparity.sgbm_full_dp", Bool(&disp.sgbm_full_dp)},
+      {"platform", Enum(&o->platform,
+                        {vo::Platform::kAuto, vo::Platform::kFree, vo::Platform::kGroundVehicle})},
       {"disparity_mode",
        Enum(&o->disparity_mode, {vo::DisparityMode::kDense, vo::DisparityMode::kAtFeatures})},
       {"disparity_range_from_scene", Bool(&o->disparity_range_from_scene)},

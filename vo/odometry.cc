@@ -90,7 +90,7 @@ int DerivedNumDisparities(const StereoCamera& camera, const OdometryOptions& opt
 
 // Options as the pipeline uses them: derived disparity range, RANSAC min_inliers raised.
 OdometryOptions EffectiveOptions(const StereoCamera& camera, const OdometryOptions& options) {
-  OdometryOptions effective = options;
+  OdometryOptions effective = ResolvePlatform(options, -1.0);  // no rig known here
   if (options.derive_num_disparities) {
     effective.disparity.num_disparities = DerivedNumDisparities(camera, options);
   }
@@ -301,6 +301,34 @@ const char* ToString(DisparityMode mode) {
       return "at_features";
   }
   return "unknown";
+}
+
+const char* ToString(Platform platform) {
+  switch (platform) {
+    case Platform::kAuto:
+      return "auto";
+    case Platform::kFree:
+      return "free";
+    case Platform::kGroundVehicle:
+      return "ground_vehicle";
+  }
+  return "unknown";
+}
+
+OdometryOptions ResolvePlatform(const OdometryOptions& options, double rig_axle_behind_camera_m) {
+  OdometryOptions o = options;
+  if (o.platform == Platform::kAuto)
+    o.platform = rig_axle_behind_camera_m >= 0.0 ? Platform::kGroundVehicle : Platform::kFree;
+  if (o.platform == Platform::kGroundVehicle) {
+    o.tracking.few_point_motion = true;
+    o.tracking.ground_vehicle = true;
+    o.tracking.vehicle_planar_ba = true;
+    o.tracking.vehicle_flat_floor = true;
+  }
+  if (o.tracking.ground_vehicle && o.tracking.few_point.axle_behind_camera_m == 0.0 &&
+      rig_axle_behind_camera_m >= 0.0)
+    o.tracking.few_point.axle_behind_camera_m = rig_axle_behind_camera_m;
+  return o;
 }
 
 const char* ToString(PredictionSource source) {

@@ -79,7 +79,8 @@
 // re-initialised ones) are what IsLostFrame() counts. The frame after a kRecovered frame is
 // kTracking again.
 //
-// Few points (tracking.few_point_motion, beyond the paper; off by default, see the option).
+// Few points (tracking.few_point_motion, beyond the paper; off on the free platform, on for a
+// ground vehicle: OdometryOptions::platform, see the option).
 // While tracking normally (the
 // previous frame's motion measured, no loss since), a frame with too few matches for RANSAC
 // (fewer correspondences than min_inliers), or with fewer than min_features features with
@@ -94,7 +95,8 @@
 // neither matching pass reaches a RANSAC consensus, the pass whose matches support more of the
 // few-point motion is kept (a prior that lags a turn would otherwise win the tie).
 //
-// Ground vehicle (tracking.ground_vehicle, off by default, see the option): where the images
+// Ground vehicle (tracking.ground_vehicle; off on the free platform, on for a ground vehicle, see
+// the option and Platform): where the images
 // cannot measure the motion (few-point frames, lost frames) it is a wheeled vehicle's, planar
 // about the world's up, and in the few-point fit without sideways slip. A lost frame's forward
 // step and yaw are then measured against the previous frame's features without matching them
@@ -214,26 +216,26 @@ struct RobustTrackingOptions {
                                            // end-pose error 0.442 / 0.419 / 0.398 / 0.393 m,
                                            // median 0.182 / 0.157 / 0.141 / 0.143 m; 3 took
                                            // camera.pitch_deg 10 to 1.40 % (2: 0.73 %)
-  bool few_point_motion = false;   // OFF by default (measured, l_hallway texture seeds 1-10:
-                                   // stride 1 lost frames 113 -> 38, median end-pose error
-                                   // 0.347 -> 0.152 m, but strides 2 and 3 worse on seeds 2, 5,
-                                   // 10: median 0.256 -> 0.331 m at stride 2). On: when RANSAC
-                                   // finds no consensus (too few features or
-                                   // matches, or fewer than min_inliers of them agree: a plain
-                                   // wall in front of the camera), the motion is
-                                   // estimated from the few matches and the motion prior
-                                   // (prior_motion.h: 1-point rotation hypotheses, then a
-                                   // Gauss-Newton fit regularised by the prior) instead of losing
-                                   // the frame; needs a prior (not on the first tracked frame)
+  bool few_point_motion = false;  // off unless platform ground_vehicle (measured, l_hallway texture
+                                  // seeds 1-10: stride 1 lost frames 113 -> 38, median end-pose
+                                  // error 0.347 -> 0.152 m, but strides 2 and 3 worse on seeds 2,
+                                  // 5, 10: median 0.256 -> 0.331 m at stride 2). On: when RANSAC
+                                  // finds no consensus (too few features or
+                                  // matches, or fewer than min_inliers of them agree: a plain
+                                  // wall in front of the camera), the motion is
+                                  // estimated from the few matches and the motion prior
+                                  // (prior_motion.h: 1-point rotation hypotheses, then a
+                                  // Gauss-Newton fit regularised by the prior) instead of losing
+                                  // the frame; needs a prior (not on the first tracked frame)
   int few_point_min_features = 3;  // a frame with fewer than min_features features with depth,
                                    // but at least this many, is still matched against the
                                    // reference (few_point_motion), >= 1
-  // OFF by default (measured below). The camera rides a wheeled ground vehicle: where the images
-  // cannot measure the motion, it is a wheeled vehicle's. The few-point motion is a yaw about
-  // the world's up and a forward distance of the axle, without sideways slip (prior_motion.h,
-  // "Ground vehicle"; few_point.no_sideways_slip, few_point.axle_behind_camera_m); its prior,
-  // the constant-velocity bridge of a lost frame, loses roll, pitch and lift; a lost frame's
-  // rotation from the image shift is a yaw only (the shift's vertical part is zoom and
+  // Off unless platform ground_vehicle (measured below). The camera rides a wheeled ground vehicle:
+  // where the images cannot measure the motion, it is a wheeled vehicle's. The few-point motion is
+  // a yaw about the world's up and a forward distance of the axle, without sideways slip
+  // (prior_motion.h, "Ground vehicle"; few_point.no_sideways_slip, few_point.axle_behind_camera_m);
+  // its prior, the constant-velocity bridge of a lost frame, loses roll, pitch and lift; a lost
+  // frame's rotation from the image shift is a yaw only (the shift's vertical part is zoom and
   // parallax). Needs the up direction from the first frame's orientation (the floor found);
   // without it, 6-DoF. Measured on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs,
   // results/robustness/, with the lost-frame chain, prior_update_exponent 2 and the vehicle_*
@@ -313,16 +315,16 @@ struct RobustTrackingOptions {
   // first camera's height (σ vehicle_floor_height_sigma_m), both > 0 (planar_motion_prior.h,
   // "Flat floor"; the σ are an indoor floor's and a vehicle's suspension's, not tuned). The
   // planar prior links only neighbours, so the tilt and the height wander a little with every
-  // window. Only when the first frame found a floor (an up from a ceiling is 1-1.5° off). Off by
-  // default (a library cannot assume a flat floor). Measured with few_point_motion, the axle and
-  // vehicle_planar_ba on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs), against
-  // vehicle_planar_ba alone: with the first frame's floor refined on the images
-  // (orientation_floor_refinement) and the vehicle's up starting from it at σ 0.15°, median
-  // end-pose error 0.108 -> 0.097 m, stride 1 median 0.108 -> 0.079 m, seed 7 stride 1 0.60 ->
-  // 0.46 %, mean 0.211 -> 0.211 m, plain_corridor (no floor found: off) unchanged. Before that
-  // refinement, on the block matcher's floor fit (up to 0.8° off in pitch), it was worse: median
-  // 0.108 -> 0.132 m, corridor 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 % (README, "Flat floor"
-  // and "The first frame's floor refined").
+  // window. Only when the first frame found a floor (an up from a ceiling is 1-1.5° off). Off on
+  // the free platform (a library cannot assume a flat floor); platform ground_vehicle says so.
+  // Measured with few_point_motion, the axle and vehicle_planar_ba on l_hallway texture seeds 1-10
+  // x strides 1/2/3/5 (40 runs), against vehicle_planar_ba alone: with the first frame's floor
+  // refined on the images (orientation_floor_refinement) and the vehicle's up starting from it at σ
+  // 0.15°, median end-pose error 0.108 -> 0.097 m, stride 1 median 0.108 -> 0.079 m, seed 7 stride
+  // 1 0.60 -> 0.46 %, mean 0.211 -> 0.211 m, plain_corridor (no floor found: off) unchanged. Before
+  // that refinement, on the block matcher's floor fit (up to 0.8° off in pitch), it was worse:
+  // median 0.108 -> 0.132 m, corridor 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 % (README, "Flat
+  // floor" and "The first frame's floor refined").
   bool vehicle_flat_floor = false;
   double vehicle_floor_tilt_sigma_deg = 0.3;
   double vehicle_floor_height_sigma_m = 0.01;
@@ -381,7 +383,26 @@ enum class DisparityMode {
 // "dense", "at_features".
 const char* ToString(DisparityMode mode);
 
+// What the camera is mounted on (OdometryOptions::platform).
+enum class Platform {
+  kAuto,           // the caller's rig decides (ResolvePlatform): a rig known to be a ground
+                   // vehicle (a wheeled robot on a floor, its axle known) is kGroundVehicle,
+                   // anything else kFree. StereoOdometry alone knows no rig: kFree
+  kFree,           // 6-DoF: the options as given (the paper's form; a drone, a hand-held rig)
+  kGroundVehicle,  // a wheeled robot on one flat floor: the ground-vehicle options on
+                   // (tracking.few_point_motion, ground_vehicle, vehicle_planar_ba,
+                   // vehicle_flat_floor; the axle from the rig when the options leave it at 0)
+};
+// "auto", "free", "ground_vehicle".
+const char* ToString(Platform platform);
+
 struct OdometryOptions {
+  Platform platform = Platform::kAuto;  // see Platform and ResolvePlatform. Measured on the
+                                        // simulated differential-drive robot (l_hallway texture
+                                        // seeds 1-10 x strides 1/2/3/5, 40 runs): the ground
+                                        // vehicle's median / mean end-pose error 0.097 / 0.211 m
+                                        // against free's 0.136 / 0.375 m, stride 1 lost frames 31
+                                        // against 113 (results/robustness/summary.md)
   DetectorOptions detector = DefaultOdometryDetectorOptions();  // feature detection (left)
   DisparityOptions disparity =
       DefaultOdometryDisparityOptions();  // the block matcher and its post-filters;
@@ -473,6 +494,15 @@ struct OdometryOptions {
 
   bool IsValid(std::string* error) const;
 };
+
+// The options a run on a rig uses: `platform` resolved (never kAuto in the result). kAuto is
+// kGroundVehicle when rig_axle_behind_camera_m >= 0 (the caller knows the rig is a ground
+// vehicle and where its wheel axle is: a simulated robot, a dataset with the rig's
+// description), kFree otherwise. kGroundVehicle switches tracking.few_point_motion,
+// ground_vehicle, vehicle_planar_ba and vehicle_flat_floor on (so on that platform they cannot
+// be switched off one by one: use kFree and set them). With ground_vehicle on (either way),
+// tracking.few_point.axle_behind_camera_m left at 0 takes the rig's axle when it is known.
+OdometryOptions ResolvePlatform(const OdometryOptions& options, double rig_axle_behind_camera_m);
 
 enum class TrackingStatus {
   kInitializing,  // first frame (or a frame before the first usable one): pose = initial

@@ -85,6 +85,11 @@ void PrintRunTable(const RunSummary& s, const std::string& out) {
   std::printf("run             %s -> %s\n", s.name.c_str(), out.c_str());
   std::printf("frames          %d (lost %d, re-initialised %d)\n", m.frames, s.lost_frames,
               s.reinitialisations);
+  if (!s.platform.empty())
+    std::printf("platform        %s%s\n", s.platform.c_str(),
+                s.platform == "ground_vehicle"
+                    ? " (the rig's wheel axle known; platform: free in --config for 6-DoF)"
+                    : "");
   if (s.has_ground_truth) {
     std::printf("path length     %.3f m\n", m.path_length_m);
     std::printf("end-pose error  %.4f m (%.2f %% of the path), rotation %.3f deg\n",

@@ -9,21 +9,27 @@ import os
 import statistics
 import sys
 
-CONFIGS = [("default", "svd_ncc_gabor, prediction: motion_prior (the library default)"),
-           ("paper", "svd_ncc_gabor, prediction: none (the paper as published)"),
-           ("lucas_kanade", "lucas_kanade, prediction: motion_prior"),
-           ("ncc_mutual", "ncc_mutual, prediction: motion_prior"),
-           ("few_point", "svd_ncc_gabor, tracking.few_point_motion: true"),
-           ("few_point_ground", "svd_ncc_gabor, tracking.few_point_motion: true, "
+CONFIGS = [("default", "svd_ncc_gabor, prediction: motion_prior, platform: auto (the library "
+            "default; the simulated robot runs as a ground vehicle)"),
+           ("free", "svd_ncc_gabor, prediction: motion_prior, platform: free (6-DoF; the default "
+            "before 2026-12-03)"),
+           ("paper", "svd_ncc_gabor, prediction: none, platform: free (the paper as published)"),
+           ("lucas_kanade", "lucas_kanade, prediction: motion_prior, platform: auto"),
+           ("ncc_mutual", "ncc_mutual, prediction: motion_prior, platform: auto"),
+           ("few_point", "svd_ncc_gabor, platform: free, tracking.few_point_motion: true"),
+           ("few_point_ground", "svd_ncc_gabor, platform: free, tracking.few_point_motion: true, "
             "ground_vehicle: true"),
-           ("ground", "svd_ncc_gabor, tracking.ground_vehicle: true"),
-           ("few_point_ground_rig", "svd_ncc_gabor, tracking.few_point_motion: true, "
-            "ground_vehicle: true, few_point.axle_behind_camera_m: 0.15 (the rig's camera.forward_m)"),
-           ("few_point_ground_rig_planar", "svd_ncc_gabor, tracking.few_point_motion: true, "
-            "ground_vehicle: true, vehicle_planar_ba: true, few_point.axle_behind_camera_m: 0.15"),
-           ("few_point_ground_rig_planar_floor", "svd_ncc_gabor, tracking.few_point_motion: true, "
-            "ground_vehicle: true, vehicle_planar_ba: true, vehicle_flat_floor: true, "
-            "few_point.axle_behind_camera_m: 0.15")]
+           ("ground", "svd_ncc_gabor, platform: free, tracking.ground_vehicle: true"),
+           ("few_point_ground_rig", "svd_ncc_gabor, platform: free, tracking.few_point_motion: "
+            "true, ground_vehicle: true, few_point.axle_behind_camera_m: 0.15 (the rig's "
+            "camera.forward_m)"),
+           ("few_point_ground_rig_planar", "svd_ncc_gabor, platform: free, "
+            "tracking.few_point_motion: true, ground_vehicle: true, vehicle_planar_ba: true, "
+            "few_point.axle_behind_camera_m: 0.15"),
+           ("few_point_ground_rig_planar_floor", "svd_ncc_gabor, platform: free, "
+            "tracking.few_point_motion: true, ground_vehicle: true, vehicle_planar_ba: true, "
+            "vehicle_flat_floor: true, few_point.axle_behind_camera_m: 0.15 (what platform "
+            "ground_vehicle switches on)")]
 KEYS = ["end_pose_error_m", "end_pose_error_pct", "ate_rmse_m", "lost_frames",
         "reinitialisations", "vo_ms_median"]
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Robustness sweep of issue #9, the figures in results/robustness/summary.md: l_hallway with
 # texture seeds 1-10 (only textures.seed changed) x frame strides 1, 2, 3, 5 (and 8 on seed 7)
-# x eight VO configurations, plus camera.pitch_deg 10, a 640x480 camera (same field of view) and
+# x eleven VO configurations, plus camera.pitch_deg 10, a 640x480 camera (same field of view) and
 # the low-texture plain_corridor scene at strides 1, 2, 3, 5.
 # Each hallway is rendered once (vobench render, KITTI layout) and every run reads the same
 # frames (vobench run --dataset --stride), which gives the same trajectories as simulating each
@@ -31,38 +31,48 @@ sed -e "s|^scene: corridor_plain.xml|scene: $ROOT/scenes/corridor_plain.xml|" sc
   > "$WORK/corridor.yaml"; datasets+=(corridor)  # the low-texture corridor, a scene of its own
 printf '%s\n' "${datasets[@]}" | xargs -P "$JOBS" -I{} bash -c \
   '[ -d "'"$WORK"'/ds_{}" ] || "'"$BIN"'" render "'"$WORK"'/{}.yaml" --out "'"$WORK"'/ds_{}" -q > /dev/null'
-# `render` writes the camera's mounting (rig.yaml), from which a ground-vehicle run with the axle
-# left at 0 takes the rig's axle. The configurations below give the axle themselves (the `_rig`
-# ones 0.15 m, the others 0, as their rows were measured), so the sweep leaves it out.
-for d in "${datasets[@]}"; do rm -f "$WORK/ds_$d/rig.yaml"; done
+# `render` writes the camera's mounting (rig.yaml): `vobench run --dataset` then knows the rig's
+# axle, so `platform: auto` (the default) runs the simulated robot as a ground vehicle with that
+# axle, as `vobench run l_hallway` does. The `platform: free` configurations below read the same
+# frames without rig.yaml (ds_<name>_norig, links to the files): they give the axle themselves
+# (the `_rig` ones 0.15 m, the others 0, as their rows were measured).
+for d in "${datasets[@]}"; do
+  v="$WORK/ds_${d}_norig"
+  [ -d "$v" ] && continue
+  mkdir "$v"
+  for f in "$WORK/ds_$d"/*; do [ "$(basename "$f")" = rig.yaml ] || ln -s "$f" "$v/"; done
+done
 
 # VO configurations (partial VO YAMLs over the defaults).
 printf 'matcher:\n  type: svd_ncc_gabor\n' > "$WORK/default.yaml"
-printf 'matcher:\n  type: svd_ncc_gabor\n  prediction: none\nreinit_after_lost_frames: 1\n' > "$WORK/paper.yaml"
+printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\n' > "$WORK/free.yaml"
+printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\n  prediction: none\nreinit_after_lost_frames: 1\n' > "$WORK/paper.yaml"
 printf 'matcher:\n  type: lucas_kanade\n' > "$WORK/lucas_kanade.yaml"
 printf 'matcher:\n  type: ncc_mutual\n' > "$WORK/ncc_mutual.yaml"
-# The plain-wall options (off by default; README, "Robust tracking"): few-point motion, alone and
-# with the ground-vehicle (planar) constraint.
-printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n' > "$WORK/few_point.yaml"
-printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n' \
+# The ground vehicle's options one by one on the free platform (README, "Robust tracking"):
+# few-point motion, alone and with the ground-vehicle (planar) constraint; the last one is what
+# platform ground_vehicle switches on.
+printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n' > "$WORK/few_point.yaml"
+printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n' \
   > "$WORK/few_point_ground.yaml"
-printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  ground_vehicle: true\n' > "$WORK/ground.yaml"
+printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  ground_vehicle: true\n' > "$WORK/ground.yaml"
 # Both, with the rig's calibration: the camera 0.15 m ahead of the wheel axle (camera.forward_m, set in
-# scenes/l_hallway.yaml, the default for plain_corridor; rig.yaml of a rendered dataset, removed above).
-printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
+# scenes/l_hallway.yaml, the default for plain_corridor; given here as on the free platform).
+printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
   > "$WORK/few_point_ground_rig.yaml"
 # The same with the planar motion prior in the window's bundle adjustment (it needs the axle).
-printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  vehicle_planar_ba: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
+printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  vehicle_planar_ba: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
   > "$WORK/few_point_ground_rig_planar.yaml"
 # And with the flat floor (every pose held to the first pose's floor tilt and camera height).
-printf 'matcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  vehicle_planar_ba: true\n  vehicle_flat_floor: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
+printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  vehicle_planar_ba: true\n  vehicle_flat_floor: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
   > "$WORK/few_point_ground_rig_planar_floor.yaml"
 runs=()
-for c in ${CONFIGS:-default paper lucas_kanade ncc_mutual few_point few_point_ground ground few_point_ground_rig few_point_ground_rig_planar few_point_ground_rig_planar_floor}; do
+for c in ${CONFIGS:-default free paper lucas_kanade ncc_mutual few_point few_point_ground ground few_point_ground_rig few_point_ground_rig_planar few_point_ground_rig_planar_floor}; do
   for s in 1 2 3 4 5 6 7 8 9 10; do for k in 1 2 3 5; do runs+=("seed$s $k $c"); done; done
   runs+=("seed7 8 $c" "pitch10 1 $c" "vga 1 $c")
   for k in 1 2 3 5; do runs+=("corridor $k $c"); done
 done
 printf '%s\n' "${runs[@]}" | xargs -P "$JOBS" -L1 bash -c \
-  'out="'"$WORK"'/runs/$0_s$1_$2"; [ -f "$out/metrics.json" ] || "'"$BIN"'" run --dataset "'"$WORK"'/ds_$0" --stride $1 --config "'"$WORK"'/$2.yaml" --out "$out" --no-plots -q > /dev/null'
+  'out="'"$WORK"'/runs/$0_s$1_$2"; ds="'"$WORK"'/ds_$0"; grep -q "^platform: free" "'"$WORK"'/$2.yaml" && ds="${ds}_norig"
+   [ -f "$out/metrics.json" ] || "'"$BIN"'" run --dataset "$ds" --stride $1 --config "'"$WORK"'/$2.yaml" --out "$out" --no-plots -q > /dev/null'
 /usr/bin/python3 results/robustness/summarize.py "$WORK/runs" results/robustness

@@ -85,6 +85,10 @@ class EvalTest : public ::testing::Test {
       options.format = format;
       options.T_body_cam0 = simulator->calibration().T_body_cam0;
       options.rate_hz = scenario_->rate_hz;
+      options.write_rig = true;  // the mounting, so a run on the export knows the ground vehicle
+      options.rig.forward_m = scenario_->camera.forward_m;
+      options.rig.height_m = scenario_->camera.height_m;
+      options.rig.pitch_deg = scenario_->camera.pitch_deg;
       DatasetWriter writer(options);
       ASSERT_TRUE(writer.Open(Export(format), camera, &error)) << error;
       for (const DatasetFrame& frame : frames) ASSERT_TRUE(writer.Add(frame, &error)) << error;
@@ -97,8 +101,10 @@ class EvalTest : public ::testing::Test {
       *frame = frames[next++];
       return true;
     };
+    // As `vobench run` resolves the platform on the simulated rig (a ground vehicle).
     ASSERT_TRUE(RunOdometry(scenario_->name, camera, source, static_cast<int>(frames.size()),
-                            vo::OdometryOptions(), QuietRun(RunDir()), "", run_, &error))
+                            ForRig(vo::OdometryOptions(), scenario_->camera.forward_m),
+                            QuietRun(RunDir()), "", run_, &error))
         << error;
   }
   static void TearDownTestSuite() {
@@ -386,7 +392,7 @@ TEST_F(EvalBadInputTest, WellFormedDatasetsRun) {
 }
 
 // rig.yaml beside a dataset (vobench render writes it): its forward distance becomes the
-// sequence's axle (a ground-vehicle run takes it, WithRigAxle); without it the rig is unknown.
+// sequence's axle (a ground-vehicle run takes it, ForRig); without it the rig is unknown.
 // RigYaml's text reads back exactly.
 TEST_F(EvalBadInputTest, RigFileGivesTheAxle) {
   EvalOptions options;
@@ -425,6 +431,38 @@ TEST_F(EvalBadInputTest, GroundVehicleRunTakesTheRigFilesAxle) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_THAT(ReadAll(Out() + "/vo_options.yaml"),
                 HasSubstr(std::string("axle_behind_camera_m: ") + (*axle ? "0.05" : "0.2")));
+  }
+}
+
+// End to end: platform auto (no configuration) runs a dataset with rig.yaml as a ground vehicle
+// with the rig's axle, one without it free; `platform: free` keeps the 6-DoF VO on a rig.
+// metrics.json, vo_options.yaml and the printed table say which.
+TEST_F(EvalBadInputTest, PlatformAutoFollowsTheRigFile) {
+  const std::string data = Data(DatasetFormat::kTum);
+  const std::string free_config = (dir_ / "free.yaml").string();
+  WriteText(free_config, "platform: free\n");
+  const struct {
+    bool rig;
+    std::string config;
+    std::string platform;
+  } cases[] = {{false, "", "free"}, {true, "", "ground_vehicle"}, {true, free_config, "free"}};
+  for (const auto& c : cases) {
+    if (c.rig)
+      WriteText(data + "/rig.yaml",
+                "camera_forward_m: 0.2\ncamera_height_m: 0.4\ncamera_pitch_deg: 0\n");
+    const CommandResult r = RunVobench("eval --dataset " + data + " --format kitti" +
+                                       (c.config.empty() ? "" : " --config " + c.config) +
+                                       " --out " + Out() + " -q --no-plots");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("platform        " + c.platform)) << c.platform;
+    EXPECT_EQ(ReadJson(Out() + "/metrics.json")["platform"], c.platform);
+    const std::string options = ReadAll(Out() + "/vo_options.yaml");
+    EXPECT_THAT(options, HasSubstr("platform: " + c.platform));
+    const bool vehicle = c.platform == "ground_vehicle";
+    EXPECT_THAT(options,
+                HasSubstr(std::string("vehicle_flat_floor: ") + (vehicle ? "true" : "false")));
+    EXPECT_THAT(options,
+                HasSubstr(std::string("axle_behind_camera_m: ") + (vehicle ? "0.2" : "0")));
   }
 }
 
