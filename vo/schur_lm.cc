@@ -151,6 +151,14 @@ void PlanarResidualAndJacobians(const PlanarMotionResidual& f, const PoseBlock7&
 double LinkSquaredNorm(const LinkVector& v) {
   return v.head<4>().squaredNorm() + v.tail<3>().squaredNorm();
 }
+double LinkDot(const LinkVector& a, const LinkVector& b) {
+  return a.head<4>().dot(b.head<4>()) + a.tail<3>().dot(b.tail<3>());
+}
+// The squared norms of the columns of J (the Jacobi scaling's diagonal).
+Vector6 LinkColumnSquaredNorms(const LinkJacobian& J) {
+  return J.topRows<4>().colwise().squaredNorm().transpose() +
+         J.bottomRows<3>().colwise().squaredNorm().transpose();
+}
 Vector6 LinkJtr(const LinkJacobian& J, const LinkVector& r) {
   return J.topRows<4>().transpose() * r.head<4>() + J.bottomRows<3>().transpose() * r.tail<3>();
 }
@@ -457,8 +465,7 @@ bool Solver::Evaluate(const std::vector<PoseBlock7>& poses,
          {std::make_pair(link.slot_a, &l.J_a), std::make_pair(link.slot_b, &l.J_b)}) {
       if (slot < 0) continue;
       lin->grad_pose[slot] += LinkJtr(*J, l.r);
-      lin->col_sq_pose[slot] += J->topRows<4>().colwise().squaredNorm().transpose() +
-                                J->bottomRows<3>().colwise().squaredNorm().transpose();
+      lin->col_sq_pose[slot] += LinkColumnSquaredNorms(*J);
     }
   }
   if (!std::isfinite(total)) return false;
@@ -634,8 +641,7 @@ bool Solver::ComputeStep(double radius, bool reuse_diagonal, double* model_cost_
     LinkVector jd = LinkVector::Zero();
     if (link.slot_a >= 0) jd += l.J_a * step_pose_[link.slot_a];
     if (link.slot_b >= 0) jd += l.J_b * step_pose_[link.slot_b];
-    change -= jd.head<4>().dot(l.r.head<4>()) + jd.tail<3>().dot(l.r.tail<3>()) +
-              0.5 * LinkSquaredNorm(jd);
+    change -= LinkDot(jd, l.r) + 0.5 * LinkSquaredNorm(jd);
   }
   *model_cost_change = change;
   return change > 0.0;
