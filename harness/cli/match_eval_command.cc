@@ -15,6 +15,7 @@
 #include "harness/progress.h"
 #include "harness/render.h"
 #include "harness/trajectory_io.h"
+#include "harness/vo_config.h"
 
 namespace harness {
 namespace {
@@ -24,7 +25,8 @@ struct MatchEvalArgs {
   std::string strides = "1,2,3,5,8";
   std::string matchers;  // "" = all
   std::string prediction = "motion_prior";
-  std::string out;  // "" = out/match_eval/<scenario>
+  std::string config;  // VO config whose matcher options are evaluated ("" = the defaults)
+  std::string out;     // "" = out/match_eval/<scenario>
   int max_frames = 0;
   bool quiet = false;
 };
@@ -49,7 +51,7 @@ bool ParseIntList(const std::string& text, std::vector<int>* out) {
 
 int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg,
                  const std::string& matchers_arg, const std::string& prediction_arg,
-                 std::string out, int max_frames, bool quiet) {
+                 const std::string& config, std::string out, int max_frames, bool quiet) {
   std::string error;
   sim::Scenario scenario;
   if (!ResolveScenario(scenario_arg, &scenario, &error)) {
@@ -57,6 +59,15 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
     return 2;
   }
   MatchEvalOptions options;
+  if (!config.empty()) {  // the matcher's options and its gate scale; the rest stays as it is
+    vo::OdometryOptions vo_options;
+    if (!LoadVoConfig(config, &vo_options, &error)) {
+      std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
+      return 2;
+    }
+    options.matcher = vo_options.matcher;
+    options.prediction_radius_scale = vo_options.tracking.prior_radius_scale;
+  }
   if (!ParseIntList(strides_arg, &options.strides)) {
     std::fprintf(stderr,
                  "vobench match-eval: --strides: expected comma-separated integers, got '%s'\n",
@@ -170,13 +181,16 @@ Command AddMatchEvalCommand(CLI::App& app) {
                    "Search centre of every matcher: motion_prior (constant velocity from the "
                    "previous pair's ground truth, as the VO predicts) or none (the paper's form)")
       ->capture_default_str();
+  match_eval->add_option("--config", a->config,
+                         "VO options (YAML): its matcher.* options (the type is set by "
+                         "--matchers) and tracking.prior_radius_scale are evaluated");
   match_eval->add_option("--out,-o", a->out, "Output folder (default out/match_eval/<scenario>)");
   match_eval->add_option("--max-frames", a->max_frames, "Use only the first N frames (0 = all)")
       ->check(AtLeast(0));
   match_eval->add_flag("-q,--quiet", a->quiet, "No progress display");
   return {match_eval, [a] {
-            return RunMatchEval(a->scenario, a->strides, a->matchers, a->prediction, a->out,
-                                a->max_frames, a->quiet);
+            return RunMatchEval(a->scenario, a->strides, a->matchers, a->prediction, a->config,
+                                a->out, a->max_frames, a->quiet);
           }};
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -63,8 +64,8 @@ TEST(CliTest, ArgumentErrorsExitTwoWithOneReadableLine) {
 TEST(CliTest, ConfigThatIsAFolderOrMissingIsAnErrorNamingIt) {
   TempDir dir("cli_config");
   fs::create_directories(dir / "conf.d");
-  for (const std::string& command :
-       std::vector<std::string>{"run", "eval --dataset " + dir.str() + " --format kitti"}) {
+  for (const std::string& command : std::vector<std::string>{
+           "run", "eval --dataset " + dir.str() + " --format kitti", "match-eval"}) {
     const CommandResult folder =
         RunVobench(command + " --config " + (dir / "conf.d") + " -q --out " + (dir / "out"));
     EXPECT_EQ(folder.exit_code, 2) << folder.output;
@@ -78,6 +79,37 @@ TEST(CliTest, ConfigThatIsAFolderOrMissingIsAnErrorNamingIt) {
         << missing.output;
     EXPECT_FALSE(fs::exists(dir / "out"));
   }
+}
+
+// match-eval --config evaluates the config's matcher options: gabor_min_ncc 0.99 (only near-perfect
+// patches pair) leaves fewer matches than the default 0.6 on the same frames; keys outside the
+// matcher do not matter there, and a bad key is refused naming the file.
+TEST(CliTest, MatchEvalTakesTheMatcherOptionsOfAVoConfig) {
+  TempDir dir("cli_match_eval_config");
+  WriteText(dir / "strict.yaml", "platform: free\nmatcher:\n  svd:\n    gabor_min_ncc: 0.99\n");
+  WriteText(dir / "bad.yaml", "matcher:\n  svd:\n    min_ncc: 2\n");
+  const std::string common =
+      " --strides 1 --matchers svd_ncc_gabor --max-frames 4 -q --out " + (dir / "out");
+  auto matches = [&](const std::string& config) {
+    const CommandResult r = RunVobench("match-eval" + common + config);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const std::string csv = vobench_test::ReadAll(dir / "out/match_eval.csv");
+    const size_t row = csv.find("\nsvd_ncc_gabor,1,");
+    EXPECT_NE(row, std::string::npos) << csv;
+    std::stringstream fields(csv.substr(row + 1));
+    std::string field;
+    for (int i = 0; i < 4; ++i)
+      std::getline(fields, field, ',');  // matcher, stride, pairs, matches
+    return std::stol(field);
+  };
+  const long plain = matches("");
+  const long strict = matches(" --config " + (dir / "strict.yaml"));
+  EXPECT_GT(plain, 0);
+  EXPECT_LT(strict, plain);
+  const CommandResult bad = RunVobench("match-eval" + common + " --config " + (dir / "bad.yaml"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find(dir / "bad.yaml" + ":3: key 'matcher.svd.min_ncc'"), std::string::npos)
+      << bad.output;
 }
 
 // Without --out, `run` wrote to out/run/<name>: a scenario named ../../../escaped_run wrote
