@@ -181,7 +181,7 @@ bool OpenDataset(const std::string& dir, const EvalOptions& options, StereoSeque
   };
   if (!open()) return false;
   // The camera's mounting, when the folder says (vobench render writes it): a ground vehicle
-  // then takes the rig's axle (ForRig).
+  // then takes the rig's axle (vo::ResolvePlatform).
   const fs::path rig_path = fs::path(dir) / kRigFileName;
   std::error_code ec;
   if (fs::exists(rig_path, ec)) {

@@ -30,10 +30,6 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
   return true;
 }
 
-vo::OdometryOptions ForRig(const vo::OdometryOptions& options, double axle_behind_camera_m) {
-  return vo::ResolvePlatform(options, axle_behind_camera_m);
-}
-
 bool ReadAllFrames(const FrameSource& source, int max_frames, int expected_frames,
                    const std::string& label, bool progress, const std::string& out,
                    std::vector<DatasetFrame>* frames, std::string* error) {

@@ -37,15 +37,12 @@ struct StereoSequence {
   std::string outline_scene;  // MJCF scene whose walls outline the trajectory plot ("" = none)
   double axle_behind_camera_m = -1.0;  // the rig's wheel axle behind the camera (metres) when
                                        // the source knows it (a simulated scenario's
-                                       // camera.forward_m); < 0 = unknown
+                                       // camera.forward_m, a dataset's rig.yaml); < 0 = unknown.
+                                       // A run resolves the VO's platform on it
+                                       // (vo::ResolvePlatform: auto is a ground vehicle with
+                                       // this axle when it is known); vo_options.yaml records
+                                       // the resolved platform and the values used
 };
-
-// The VO options a run of `sequence` uses: `options` with its platform resolved on the
-// sequence's rig (vo::ResolvePlatform): `platform: auto` (the default) is a ground vehicle when
-// the sequence knows the rig's axle (a simulated robot; a dataset folder with rig.yaml), and a
-// ground vehicle whose axle is left at 0 takes the rig's. The run folder's vo_options.yaml
-// records the resolved platform and the values used.
-vo::OdometryOptions ForRig(const vo::OdometryOptions& options, double axle_behind_camera_m);
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,

@@ -607,8 +607,8 @@ constexpr double kUnusableScore = 1e9;
 bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& options,
                    const TuneObjective& objective, SequenceScore* score, std::string* error) {
   std::string why;
-  auto odometry = vo::StereoOdometry::Create(sequence.camera,
-                                             ForRig(options, sequence.axle_behind_camera_m), &why);
+  auto odometry = vo::StereoOdometry::Create(
+      sequence.camera, vo::ResolvePlatform(options, sequence.axle_behind_camera_m), &why);
   if (!odometry) {
     *error = sequence.name + ": invalid VO options or camera: " + why;
     return false;

@@ -60,20 +60,16 @@ bool PlaneOrientationOptions::IsValid(std::string* error) const {
   return false;
 }
 
+// Grows with depth (stereo depth error grows with z).
 double PlaneInlierDistance(const Eigen::Vector3d& p, const PlaneOrientationOptions& options) {
   return options.distance_threshold_m + options.distance_threshold_per_m * std::max(p.z(), 0.0);
 }
 
 namespace {
 
-// Inlier distance of a point: grows with depth (stereo depth error grows with z).
-double Threshold(const Eigen::Vector3d& p, const PlaneOrientationOptions& options) {
-  return PlaneInlierDistance(p, options);
-}
-
 // Weighted least-squares plane through the points (smallest eigenvector of the weighted,
-// centred scatter). Weights 1 / Threshold(p)²: the threshold models the point's noise, which
-// grows with depth, so far (noisy) points count less.
+// centred scatter). Weights 1 / PlaneInlierDistance(p)²: the threshold models the point's noise,
+// which grows with depth, so far (noisy) points count less.
 bool FitPlaneLeastSquares(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& idx,
                           const PlaneOrientationOptions& options, Eigen::Vector3d* normal,
                           double* offset) {
@@ -81,14 +77,14 @@ bool FitPlaneLeastSquares(const std::vector<Eigen::Vector3d>& points, const std:
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   double weight_sum = 0.0;
   for (int i : idx) {
-    const double w = 1.0 / std::pow(Threshold(points[i], options), 2);
+    const double w = 1.0 / std::pow(PlaneInlierDistance(points[i], options), 2);
     mean += w * points[i];
     weight_sum += w;
   }
   mean /= weight_sum;
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (int i : idx) {
-    const double w = 1.0 / std::pow(Threshold(points[i], options), 2);
+    const double w = 1.0 / std::pow(PlaneInlierDistance(points[i], options), 2);
     const Eigen::Vector3d q = points[i] - mean;
     scatter.noalias() += w * (q * q.transpose());
   }
@@ -104,7 +100,7 @@ std::vector<int> Inliers(const std::vector<Eigen::Vector3d>& points,
                          const PlaneOrientationOptions& options) {
   std::vector<int> in;
   for (int i : candidates)
-    if (std::abs(n.dot(points[i]) + d) <= Threshold(points[i], options)) in.push_back(i);
+    if (std::abs(n.dot(points[i]) + d) <= PlaneInlierDistance(points[i], options)) in.push_back(i);
   return in;
 }
 
@@ -142,7 +138,7 @@ std::vector<Plane> ExtractPlanes(const std::vector<Eigen::Vector3d>& points,
       int count = 0;
       double cost = 0.0;
       for (int i : remaining) {
-        const double r = std::abs(n.dot(points[i]) + d) / Threshold(points[i], options);
+        const double r = std::abs(n.dot(points[i]) + d) / PlaneInlierDistance(points[i], options);
         if (r <= 1.0) {
           ++count;
           cost += r * r;
@@ -200,7 +196,7 @@ std::vector<Plane> ExtractPlanes(const std::vector<Eigen::Vector3d>& points,
   for (int pass = 0; pass < 2 && planes.size() > 1; ++pass) {
     std::vector<std::vector<int>> exclusive(planes.size());
     for (size_t i = 0; i < points.size(); ++i) {
-      const double thr = Threshold(points[i], options);
+      const double thr = PlaneInlierDistance(points[i], options);
       int owner = -1, count = 0;
       for (size_t k = 0; k < planes.size(); ++k) {
         if (std::abs(planes[k].normal_cam0.dot(points[i]) + planes[k].offset_m) <= thr) {

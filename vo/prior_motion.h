@@ -66,7 +66,7 @@ struct PriorMotionOptions {
                                       // calibration, not a tuning knob; vobench's simulated
                                       // runs and tune put the rig's camera.forward_m here when
                                       // ground_vehicle is on and this is left at 0
-                                      // (harness::ForRig)
+                                      // (vo::ResolvePlatform)
 
   bool IsValid(std::string* error) const;
 };

@@ -1,7 +1,7 @@
 // The stereo camera's mounting on a ground vehicle, written beside a dataset as rig.yaml by
 // `vobench render` and read by `vobench run --dataset` / `eval` when present: a KITTI, EuRoC or
 // TUM folder otherwise carries no rig, and a tracking.ground_vehicle run needs the wheel
-// axle's distance behind the camera (tracking.few_point.axle_behind_camera_m, ForRig).
+// axle's distance behind the camera (tracking.few_point.axle_behind_camera_m, vo::ResolvePlatform).
 //
 //   # rig.yaml (metres, degrees)
 //   camera_forward_m: 0.15   # optical centre ahead of the wheel axle
@@ -15,7 +15,7 @@ namespace harness {
 
 struct RigMounting {
   double forward_m = 0.0;  // optical centre ahead of the wheel axle (m), finite; a camera
-                           // behind the axle (< 0) is recorded, not applied (ForRig)
+                           // behind the axle (< 0) is recorded, not applied (vo::ResolvePlatform)
   double height_m = 0.0;   // optical centre above the floor (m), > 0
   double pitch_deg = 0.0;  // downward tilt of the optical axis (degrees), (-90, 90)
 

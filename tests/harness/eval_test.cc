@@ -103,7 +103,7 @@ class EvalTest : public ::testing::Test {
     };
     // As `vobench run` resolves the platform on the simulated rig (a ground vehicle).
     ASSERT_TRUE(RunOdometry(scenario_->name, camera, source, static_cast<int>(frames.size()),
-                            ForRig(vo::OdometryOptions(), scenario_->camera.forward_m),
+                            vo::ResolvePlatform(vo::OdometryOptions(), scenario_->camera.forward_m),
                             QuietRun(RunDir()), "", run_, &error))
         << error;
   }
@@ -392,8 +392,8 @@ TEST_F(EvalBadInputTest, WellFormedDatasetsRun) {
 }
 
 // rig.yaml beside a dataset (vobench render writes it): its forward distance becomes the
-// sequence's axle (a ground-vehicle run takes it, ForRig); without it the rig is unknown.
-// RigYaml's text reads back exactly.
+// sequence's axle (a ground-vehicle run takes it, vo::ResolvePlatform); without it the rig is
+// unknown. RigYaml's text reads back exactly.
 TEST_F(EvalBadInputTest, RigFileGivesTheAxle) {
   EvalOptions options;
   options.format = DatasetFormat::kKitti;
