@@ -29,6 +29,16 @@ std::string Fmt(double v, int prec = 4) {
   return s.str();
 }
 
+// A CSV field (RFC 4180): in double quotes, a quote doubled, a line break as a space.
+std::string CsvQuoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += (c == '\n' || c == '\r') ? ' ' : c;
+  }
+  return out + "\"";
+}
+
 std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml) {
   const TrajectoryMetrics& m = s.metrics;
   std::ostringstream r;
@@ -143,7 +153,8 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
          "translation_error_m,rotation_error_deg,motion_measured,reinitialised,prediction,"
          "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_"
          "disparities,"
-         "disparity_pixels,chained_to_frame,chain_inliers,bridge_aligned\n";
+         "disparity_pixels,chained_to_frame,chain_inliers,bridge_aligned,few_point_motion,"
+         "message\n";
   // One row per frame; frames before the first initialised one have no pose and no error.
   const double kNan = std::nan("");
   auto row = [&](size_t frame, double time_s, const std::string& status,
@@ -162,7 +173,8 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
         << Fmt(r.image_shift_px.x(), 2) << "," << Fmt(r.image_shift_px.y(), 2) << ","
         << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << ","
         << r.num_disparities << "," << r.disparity_pixels << "," << r.chained_to_frame << ","
-        << r.chain_inliers << "," << (r.bridge_aligned ? 1 : 0) << "\n";
+        << r.chain_inliers << "," << (r.bridge_aligned ? 1 : 0) << ","
+        << (r.few_point_motion ? 1 : 0) << "," << CsvQuoted(r.message) << "\n";
   };
   for (size_t i = 0; i < first; ++i) {
     const vo::OdometryResult& r = records.frames[i].result;

@@ -83,9 +83,11 @@
 // ground vehicle: OdometryOptions::platform, see the option).
 // While tracking normally (the
 // previous frame's motion measured, no loss since), a frame with too few matches for RANSAC
-// (fewer correspondences than min_inliers), or with fewer than min_features features with
+// (fewer correspondences than min_inliers), with fewer than min_features features with
 // depth (down to tracking.few_point_min_features; such a frame takes no RANSAC motion, only
-// this one), takes the few-point motion of prior_motion.h:
+// this one), or — a ground vehicle — whose weak RANSAC motion tilts or lifts the vehicle
+// (tracking.vehicle_max_weak_tilt_deg), takes the few-point motion of prior_motion.h on the same
+// matches:
 // the prior corrected by the few matches (inliers >= few_point.min_inliers and >=
 // few_point.min_inlier_fraction of them), unless the frame's coarse-to-fine image shift
 // contradicts it (few_point_max_shift_disagreement_px). That frame is not bundle-adjusted

@@ -91,7 +91,10 @@ def main(runs_dir, out_dir):
                     label, r["end_pose_error_m"], r["end_pose_error_pct"], r["ate_rmse_m"],
                     r["lost_frames"], r["reinitialisations"], r["vo_ms_median"]))
         md.append("")
-    md.append("VO ms/frame: median per frame of one run, two runs in parallel on a 2-core machine.")
+    md.append("VO ms/frame: median per frame of one run, two runs in parallel on a 2-core machine, "
+              "as loaded as it was while the sweep ran (the runs of a re-made section may have "
+              "shared it with other work): a rough cost, not a speed measurement "
+              "(results/speed has the pinned ones).")
     open(os.path.join(out_dir, "summary.md"), "w").write("\n".join(md) + "\n")
 
 

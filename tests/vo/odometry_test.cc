@@ -407,6 +407,59 @@ TEST(OdometrySeamTest, GroundVehicleRefusesAWeakMotionThatTilts) {
   EXPECT_THAT(strong.T_prev_curr, IsNearPose(true_motion, 1e-3, 1e-3));
 }
 
+// A refused weak motion goes to the few-point solver with the vehicle's model (yaw and forward
+// step from the prior) on the same matches, as a frame with too few matches does: frame 5 lifted
+// by 3.5 cm (more than vehicle_max_weak_lift_m) and matched by 20 exact matches. Few of them are
+// near enough to show the lift by more than the solver's 2 px: the frame is tracked with the
+// vehicle's motion, which leaves the lift out and keeps the rotation. A 5° tilt no vehicle motion
+// explains: refused by RANSAC's gate and by the solver, the frame is lost.
+TEST(OdometrySeamTest, GroundVehicleMeasuresARefusedWeakMotionWithTheFewPointSolver) {
+  const StereoCamera cam = HallwayCamera();
+  std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  for (double x = -3.0; x <= 3.0; x += 0.5) {
+    for (double z = 2.5; z <= 9.0; z += 0.5) points.emplace_back(x, 1.0, z);
+  }
+  std::vector<SeamFrame> frames;
+  for (int i = 0; i < 5; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
+  auto run = [&](const Eigen::Isometry3d& T_world_5) {
+    const SeamFrame f5 = MakeSeamFrameAt(cam, points, T_world_5, 5);
+    std::vector<Match> weak = SeamMatches(frames[4], f5, 0);
+    EXPECT_GE(weak.size(), 60u);
+    weak.resize(20);
+    OdometryOptions options;
+    options.tracking.ground_vehicle = true;
+    options.tracking.few_point_motion = true;
+    StereoOdometry vo(cam, options);
+    EXPECT_TRUE(vo.ProcessFeatures(frames[0].features, {}, 0.0).initial_orientation_ok);
+    for (int i = 1; i < 5; ++i) {
+      const OdometryResult r =
+          vo.ProcessFeatures(frames[i].features, SeamMatches(frames[i - 1], frames[i], 0), 0.1 * i);
+      EXPECT_EQ(r.status, TrackingStatus::kTracking) << r.message;
+    }
+    return vo.ProcessFeatures(f5.features, weak, 0.5);
+  };
+  // cv axes: y down, so the lift is along −y.
+  const Eigen::Isometry3d T_world_lifted =
+      SeamPose(5) * MakePose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.0, -0.035, 0.0));
+  const OdometryResult lifted = run(T_world_lifted);
+  EXPECT_EQ(lifted.status, TrackingStatus::kTracking) << lifted.message;
+  EXPECT_TRUE(lifted.few_point_motion);
+  EXPECT_TRUE(lifted.motion_measured);
+  EXPECT_GE(lifted.num_inliers, 10);
+  const Eigen::Isometry3d true_motion = SeamPose(4).inverse() * T_world_lifted;
+  EXPECT_LT(RotationAngleRad(lifted.T_prev_curr.linear(), true_motion.linear()), 0.2 * kDeg);
+  EXPECT_LT((lifted.T_prev_curr.translation() - true_motion.translation()).norm(), 0.045);
+  const Eigen::Vector3d up(0.0, -1.0, 0.0);  // the first camera's, the world's (no pitch)
+  EXPECT_TRUE(IsVehicleLike(lifted.T_prev_curr, SeamPose(4).linear().transpose() * up, 2.0, 0.03));
+  const OdometryResult tilted =
+      run(SeamPose(5) *
+          MakePose(Eigen::AngleAxisd(5.0 * kDeg, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+                   Eigen::Vector3d::Zero()));
+  EXPECT_TRUE(IsLostFrame(tilted)) << tilted.message;
+  EXPECT_NE(tilted.message.find("tilts or lifts the ground vehicle"), std::string::npos)
+      << tilted.message;
+}
+
 TEST(OdometrySeamTest, TooFewMatchesIsLostThenReinitialises) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
