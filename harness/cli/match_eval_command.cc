@@ -1,5 +1,6 @@
 #include "harness/cli/match_eval_command.h"
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -28,6 +29,7 @@ struct MatchEvalArgs {
   std::string config;  // VO config whose matcher options are evaluated ("" = the defaults)
   std::string out;     // "" = out/match_eval/<scenario>
   int max_frames = 0;
+  double correct_px = 2.0;  // a match is correct within this of the ground-truth position
   bool quiet = false;
 };
 
@@ -49,9 +51,15 @@ bool ParseIntList(const std::string& text, std::vector<int>* out) {
   return !out->empty();
 }
 
-int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg,
-                 const std::string& matchers_arg, const std::string& prediction_arg,
-                 const std::string& config, std::string out, int max_frames, bool quiet) {
+int RunMatchEval(const MatchEvalArgs& args) {
+  const std::string& scenario_arg = args.scenario;
+  const std::string& strides_arg = args.strides;
+  const std::string& matchers_arg = args.matchers;
+  const std::string& prediction_arg = args.prediction;
+  const std::string& config = args.config;
+  std::string out = args.out;
+  const int max_frames = args.max_frames;
+  const bool quiet = args.quiet;
   std::string error;
   sim::Scenario scenario;
   if (!ResolveScenario(scenario_arg, &scenario, &error)) {
@@ -96,6 +104,13 @@ int RunMatchEval(const std::string& scenario_arg, const std::string& strides_arg
                  prediction_arg.c_str());
     return 2;
   }
+  if (!(args.correct_px > 0.0) || !std::isfinite(args.correct_px)) {
+    std::fprintf(stderr,
+                 "vobench match-eval: --correct-px: expected a finite distance > 0, got %g\n",
+                 args.correct_px);
+    return 2;
+  }
+  options.correct_px = args.correct_px;
   if (!options.IsValid(&error)) {
     std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
     return 2;
@@ -187,11 +202,13 @@ Command AddMatchEvalCommand(CLI::App& app) {
   match_eval->add_option("--out,-o", a->out, "Output folder (default out/match_eval/<scenario>)");
   match_eval->add_option("--max-frames", a->max_frames, "Use only the first N frames (0 = all)")
       ->check(AtLeast(0));
+  match_eval
+      ->add_option("--correct-px", a->correct_px,
+                   "A match is correct when its current feature lies within this distance of "
+                   "the ground-truth position (pixels, > 0); 1 asks for better placed matches")
+      ->capture_default_str();
   match_eval->add_flag("-q,--quiet", a->quiet, "No progress display");
-  return {match_eval, [a] {
-            return RunMatchEval(a->scenario, a->strides, a->matchers, a->prediction, a->config,
-                                a->out, a->max_frames, a->quiet);
-          }};
+  return {match_eval, [a] { return RunMatchEval(*a); }};
 }
 
 }  // namespace harness

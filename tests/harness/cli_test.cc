@@ -112,6 +112,45 @@ TEST(CliTest, MatchEvalTakesTheMatcherOptionsOfAVoConfig) {
       << bad.output;
 }
 
+// --correct-px sets how close to the ground truth a match must land to count: a tighter
+// distance counts fewer matches correct (and fewer possible), the same matches are made; a
+// distance that is not a finite number > 0 is refused before anything is simulated or written.
+TEST(CliTest, MatchEvalCorrectDistanceIsAnOption) {
+  TempDir dir("cli_match_eval_correct_px");
+  const std::string common = " --strides 1 --matchers svd_ncc_gabor --max-frames 4 -q --out ";
+  auto row = [&](const std::string& out, const std::string& extra) {
+    const CommandResult r = RunVobench("match-eval" + common + (dir / out) + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const std::string csv = vobench_test::ReadAll(dir / (out + "/match_eval.csv"));
+    const size_t at = csv.find("\nsvd_ncc_gabor,1,");
+    EXPECT_NE(at, std::string::npos) << csv;
+    std::stringstream fields(csv.substr(at + 1));
+    std::vector<long> v;  // pairs, matches, correct, possible
+    std::string field;
+    for (int i = 0; i < 6; ++i) {
+      std::getline(fields, field, ',');
+      if (i >= 2) v.push_back(std::stol(field));
+    }
+    return v;
+  };
+  const std::vector<long> loose = row("loose", "");
+  const std::vector<long> tight = row("tight", " --correct-px 0.5");
+  ASSERT_EQ(loose.size(), 4u);
+  ASSERT_EQ(tight.size(), 4u);
+  EXPECT_EQ(tight[1], loose[1]);  // the same matches
+  EXPECT_GT(loose[2], 0);
+  EXPECT_LT(tight[2], loose[2]);
+  EXPECT_LE(tight[3], loose[3]);
+  for (const char* bad : {"0", "-1", "nan", "inf"}) {
+    const CommandResult r =
+        RunVobench("match-eval" + common + (dir / "bad") + " --correct-px " + bad);
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+    EXPECT_NE(r.output.find("--correct-px: expected a finite distance > 0"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir / "bad")) << bad;
+  }
+}
+
 // Without --out, `run` wrote to out/run/<name>: a scenario named ../../../escaped_run wrote
 // beside the working folder.
 TEST(CliTest, ScenarioNamesThatCannotNameAFolderAreRefusedWithoutOut) {
