@@ -181,13 +181,14 @@ bool OpenDataset(const std::string& dir, const EvalOptions& options, StereoSeque
   };
   if (!open()) return false;
   // The camera's mounting, when the folder says (vobench render writes it): a ground vehicle
-  // then takes the rig's axle (vo::ResolvePlatform).
+  // then takes the rig's axle and pitch (vo::ResolvePlatform).
   const fs::path rig_path = fs::path(dir) / kRigFileName;
   std::error_code ec;
   if (fs::exists(rig_path, ec)) {
     RigMounting rig;
     if (!ReadRigYaml(rig_path.string(), &rig, error)) return false;
     sequence->axle_behind_camera_m = rig.forward_m;
+    sequence->camera_pitch_deg = rig.pitch_deg;
   }
   return true;
 }

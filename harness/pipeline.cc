@@ -21,6 +21,7 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
   sequence->scenario_yaml = sim::ScenarioToYaml(scenario);
   sequence->outline_scene = scenario.scene_path;
   sequence->axle_behind_camera_m = scenario.camera.forward_m;
+  sequence->camera_pitch_deg = scenario.camera.pitch_deg;
   sequence->next = [simulator, f = sim::StereoFrame()](DatasetFrame* frame,
                                                        std::string* err) mutable {
     if (!simulator->Next(&f, err)) return false;

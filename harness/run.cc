@@ -40,9 +40,10 @@ bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_o
                  const RunOptions& options, RunSummary* summary, std::string* error) {
   RunOptions o = options;
   if (o.outline_scene.empty()) o.outline_scene = sequence.outline_scene;
-  return RunOdometry(sequence.name, sequence.camera, sequence.next, sequence.expected_frames,
-                     vo::ResolvePlatform(vo_options, sequence.axle_behind_camera_m), o,
-                     sequence.scenario_yaml, summary, error);
+  return RunOdometry(
+      sequence.name, sequence.camera, sequence.next, sequence.expected_frames,
+      vo::ResolvePlatform(vo_options, sequence.axle_behind_camera_m, sequence.camera_pitch_deg), o,
+      sequence.scenario_yaml, summary, error);
 }
 
 bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_options,

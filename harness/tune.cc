@@ -584,6 +584,7 @@ bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSeque
   sequence->name = scenario.name;
   sequence->camera = simulated.camera;
   sequence->axle_behind_camera_m = simulated.axle_behind_camera_m;
+  sequence->camera_pitch_deg = simulated.camera_pitch_deg;
   const FrameSource without_depth = [&](DatasetFrame* frame, std::string* err) {
     if (!simulated.next(frame, err)) return false;
     frame->depth_m = cv::Mat();  // not needed: the score uses the poses only
@@ -608,7 +609,8 @@ bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& opti
                    const TuneObjective& objective, SequenceScore* score, std::string* error) {
   std::string why;
   auto odometry = vo::StereoOdometry::Create(
-      sequence.camera, vo::ResolvePlatform(options, sequence.axle_behind_camera_m), &why);
+      sequence.camera,
+      vo::ResolvePlatform(options, sequence.axle_behind_camera_m, sequence.camera_pitch_deg), &why);
   if (!odometry) {
     *error = sequence.name + ": invalid VO options or camera: " + why;
     return false;

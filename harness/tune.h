@@ -63,6 +63,7 @@
 //   tune.yaml         a copy of the tune file
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -119,6 +120,7 @@ struct TuneSequence {
   vo::StereoCamera camera;
   std::vector<DatasetFrame> frames;
   double axle_behind_camera_m = -1.0;  // the rig's (StereoSequence), < 0 = unknown
+  double camera_pitch_deg = std::numeric_limits<double>::quiet_NaN();  // the rig's, NaN = unknown
 };
 bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSequence* sequence,
                           std::string* error);

@@ -299,6 +299,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"floor_refinement.max_tilt_change_deg", Number(&fr.max_tilt_change_deg, 1e-6, 90.0)},
       {"floor_refinement.max_offset_change", Number(&fr.max_offset_change, 1e-6, 100.0)},
       {"orientation_requires_wall", Bool(&o->orientation_requires_wall)},
+      {"orientation_up_from_mounting", Bool(&o->orientation_up_from_mounting)},
       {"adaptive_min_features", Number(&o->adaptive_min_features, 0, 100000)},
       {"adaptive_quality_level", Number(&o->adaptive_quality_level, 0.0, 0.999)},
       {"min_features", Number(&o->min_features, 0, 100000)},

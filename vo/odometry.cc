@@ -315,7 +315,8 @@ const char* ToString(Platform platform) {
   return "unknown";
 }
 
-OdometryOptions ResolvePlatform(const OdometryOptions& options, double rig_axle_behind_camera_m) {
+OdometryOptions ResolvePlatform(const OdometryOptions& options, double rig_axle_behind_camera_m,
+                                double rig_pitch_deg) {
   OdometryOptions o = options;
   if (o.platform == Platform::kAuto)
     o.platform = rig_axle_behind_camera_m >= 0.0 ? Platform::kGroundVehicle : Platform::kFree;
@@ -328,6 +329,14 @@ OdometryOptions ResolvePlatform(const OdometryOptions& options, double rig_axle_
   if (o.tracking.ground_vehicle && o.tracking.few_point.axle_behind_camera_m == 0.0 &&
       rig_axle_behind_camera_m >= 0.0)
     o.tracking.few_point.axle_behind_camera_m = rig_axle_behind_camera_m;
+  if (o.platform == Platform::kGroundVehicle && std::isfinite(rig_pitch_deg)) {
+    o.orientation_up_from_mounting = true;
+    if (o.orientation.expected_up_cam0 == PlaneOrientationOptions().expected_up_cam0) {
+      const double p = rig_pitch_deg * M_PI / 180.0;
+      // (0 − sin p: a level camera writes 0, not −0, into vo_options.yaml)
+      o.orientation.expected_up_cam0 = Eigen::Vector3d(0.0, -std::cos(p), 0.0 - std::sin(p));
+    }
+  }
   return o;
 }
 
@@ -744,9 +753,23 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
     result->floor_refined =
         RefineInitialFloor(left, right, disparity_px, &result->floor_refinement_message);
   }
-  const bool ok = orientation_result_.ok() ||
-                  (orientation_result_.status == PlaneOrientationResult::Status::kNoWall &&
-                   !options_.orientation_requires_wall);
+  bool ok = orientation_result_.ok() ||
+            (orientation_result_.status == PlaneOrientationResult::Status::kNoWall &&
+             !options_.orientation_requires_wall);
+  if (!ok && options_.orientation_up_from_mounting &&
+      orientation_result_.status == PlaneOrientationResult::Status::kNoFloor) {
+    // The mounting's up; x_hall the camera's forward axis made horizontal (zero yaw).
+    const Eigen::Vector3d up = options_.orientation.expected_up_cam0.normalized();
+    const Eigen::Vector3d x_hall = (Eigen::Vector3d::UnitZ() - up.z() * up).normalized();
+    orientation_result_.R_hall_cam0.row(0) = x_hall.transpose();
+    orientation_result_.R_hall_cam0.row(1) = up.cross(x_hall).transpose();
+    orientation_result_.R_hall_cam0.row(2) = up.transpose();
+    orientation_result_.up_cam0 = up;
+    result->floor_refinement_message =
+        "no floor or ceiling in the first frame: the up from the camera's mounting "
+        "(orientation.expected_up_cam0)";
+    ok = x_hall.allFinite();
+  }
   R_hall_cam0_initial_ = ok ? orientation_result_.R_hall_cam0 : Eigen::Matrix3d::Identity();
   world_up_known_ = ok;
   if (ok) {
@@ -1466,6 +1489,8 @@ OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
       if (!result.initial_orientation_ok) {
         reason = std::string("initial orientation failed (") +
                  ToString(orientation_result_.status) + "): world = first camera frame";
+      } else {
+        reason = result.floor_refinement_message;
       }
       result.times.orientation_ms = MsSince(to);
     } else if (initialised_) {

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -394,7 +395,7 @@ TEST_F(EvalBadInputTest, WellFormedDatasetsRun) {
 // rig.yaml beside a dataset (vobench render writes it): its forward distance becomes the
 // sequence's axle (a ground-vehicle run takes it, vo::ResolvePlatform); without it the rig is
 // unknown. RigYaml's text reads back exactly.
-TEST_F(EvalBadInputTest, RigFileGivesTheAxle) {
+TEST_F(EvalBadInputTest, RigFileGivesTheAxleAndThePitch) {
   EvalOptions options;
   options.format = DatasetFormat::kKitti;
   const std::string data = Data(DatasetFormat::kTum);
@@ -403,6 +404,7 @@ TEST_F(EvalBadInputTest, RigFileGivesTheAxle) {
   std::string error;
   ASSERT_TRUE(OpenDataset(data, options, &sequence, &info, &error)) << error;
   EXPECT_EQ(sequence.axle_behind_camera_m, -1.0);
+  EXPECT_TRUE(std::isnan(sequence.camera_pitch_deg));
   RigMounting rig;
   rig.forward_m = 0.1234567890123;
   rig.height_m = 0.4;
@@ -410,6 +412,7 @@ TEST_F(EvalBadInputTest, RigFileGivesTheAxle) {
   WriteText(data + "/rig.yaml", RigYaml(rig));
   ASSERT_TRUE(OpenDataset(data, options, &sequence, &info, &error)) << error;
   EXPECT_EQ(sequence.axle_behind_camera_m, rig.forward_m);
+  EXPECT_EQ(sequence.camera_pitch_deg, rig.pitch_deg);
   RigMounting back;
   ASSERT_TRUE(ReadRigYaml(data + "/rig.yaml", &back, &error)) << error;
   EXPECT_EQ(back.forward_m, rig.forward_m);

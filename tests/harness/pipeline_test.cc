@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "harness/run_folder.h"
@@ -212,6 +213,34 @@ TEST(PipelineTest, PlatformAutoIsAGroundVehicleOnAKnownRig) {
   const vo::OdometryOptions forced = vo::ResolvePlatform(g, -1.0);
   EXPECT_TRUE(forced.tracking.vehicle_flat_floor && forced.tracking.few_point_motion);
   EXPECT_EQ(forced.tracking.few_point.axle_behind_camera_m, 0.0);
+}
+
+// A ground vehicle whose rig's camera pitch is known takes its up from the mounting when the
+// first frame shows no floor: orientation_up_from_mounting on, expected_up_cam0 the up of that
+// pitch (cv axes: y down; a camera tilted down by p sees the up as (0, −cos p, −sin p)). An
+// unknown pitch, the free platform or an up given in the options change nothing of it.
+TEST(PipelineTest, AGroundVehicleTakesItsUpFromTheRigsPitch) {
+  vo::OdometryOptions o;
+  const Eigen::Vector3d level(0.0, -1.0, 0.0);
+  ASSERT_FALSE(o.orientation_up_from_mounting);
+  ASSERT_EQ(o.orientation.expected_up_cam0, level);
+  const vo::OdometryOptions no_pitch = vo::ResolvePlatform(o, 0.15);
+  EXPECT_FALSE(no_pitch.orientation_up_from_mounting);
+  EXPECT_EQ(no_pitch.orientation.expected_up_cam0, level);
+  const vo::OdometryOptions flat = vo::ResolvePlatform(o, 0.15, 0.0);
+  EXPECT_TRUE(flat.orientation_up_from_mounting);
+  EXPECT_EQ(flat.orientation.expected_up_cam0, level);
+  const vo::OdometryOptions pitched = vo::ResolvePlatform(o, 0.15, 30.0);
+  EXPECT_TRUE(pitched.orientation_up_from_mounting);
+  EXPECT_NEAR(
+      (pitched.orientation.expected_up_cam0 - Eigen::Vector3d(0.0, -std::sqrt(3.0) / 2, -0.5))
+          .norm(),
+      0.0, 1e-12);
+  EXPECT_FALSE(vo::ResolvePlatform(o, -1.0, 30.0).orientation_up_from_mounting);  // free
+  vo::OdometryOptions given = o;
+  given.orientation.expected_up_cam0 = Eigen::Vector3d(0.0, -1.0, -0.1);
+  EXPECT_EQ(vo::ResolvePlatform(given, 0.15, 30.0).orientation.expected_up_cam0,
+            given.orientation.expected_up_cam0);
 }
 
 }  // namespace

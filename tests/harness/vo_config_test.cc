@@ -45,7 +45,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
   std::map<std::string, int> counts;
   CountLeaves(yaml, "", &counts);
   const Covered covered[] = {
-      {"", "OdometryOptions", sizeof(vo::OdometryOptions), 1568, 24},
+      {"", "OdometryOptions", sizeof(vo::OdometryOptions), 1568, 25},
       {"detector", "DetectorOptions", sizeof(vo::DetectorOptions), 128, 6},
       {"detector.harris", "HarrisOptions", sizeof(vo::HarrisOptions), 64, 10},
       {"detector.sift", "SiftOptions", sizeof(vo::SiftOptions), 40, 5},

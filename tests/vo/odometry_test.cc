@@ -407,6 +407,35 @@ TEST(OdometrySeamTest, GroundVehicleRefusesAWeakMotionThatTilts) {
   EXPECT_THAT(strong.T_prev_curr, IsNearPose(true_motion, 1e-3, 1e-3));
 }
 
+// With no floor or ceiling in the first frame (the seam's cloud of points) the first camera is
+// the world, unless orientation_up_from_mounting takes the mounting's up
+// (orientation.expected_up_cam0, here a camera pitched down by 10°): the world's z is then that
+// up and its x the camera's forward axis made horizontal.
+TEST(OdometrySeamTest, NoFloorTakesTheUpFromTheMounting) {
+  const StereoCamera cam = HallwayCamera();
+  const SeamFrame f0 = MakeSeamFrame(cam, SeamWorldPoints(), 0);
+  OdometryOptions options;
+  StereoOdometry plain(cam, options);
+  const OdometryResult r_plain = plain.ProcessFeatures(f0.features, {}, 0.0);
+  EXPECT_FALSE(r_plain.initial_orientation_ok);
+  EXPECT_THAT(r_plain.message, ::testing::HasSubstr("no_floor"));
+  EXPECT_THAT(r_plain.T_world_cam0, IsNearPose(Eigen::Isometry3d::Identity(), 1e-12, 1e-12));
+
+  const double p = 10.0 * kDeg;
+  const Eigen::Vector3d up(0.0, -std::cos(p), -std::sin(p));
+  options.orientation_up_from_mounting = true;
+  options.orientation.expected_up_cam0 = up;
+  StereoOdometry vo(cam, options);
+  const OdometryResult r = vo.ProcessFeatures(f0.features, {}, 0.0);
+  EXPECT_TRUE(r.initial_orientation_ok) << r.message;
+  EXPECT_THAT(r.message, ::testing::HasSubstr("the up from the camera's mounting"));
+  EXPECT_NEAR((r.T_world_cam0.linear() * up - Eigen::Vector3d::UnitZ()).norm(), 0.0, 1e-12);
+  const Eigen::Vector3d forward = r.T_world_cam0.linear() * Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR(forward.y(), 0.0, 1e-12);
+  EXPECT_NEAR(forward.x(), std::cos(p), 1e-12);
+  EXPECT_NEAR(forward.z(), -std::sin(p), 1e-12);  // looking down
+}
+
 // A refused weak motion goes to the few-point solver with the vehicle's model (yaw and forward
 // step from the prior) on the same matches, as a frame with too few matches does: frame 5 lifted
 // by 3.5 cm (more than vehicle_max_weak_lift_m) and matched by 20 exact matches. Few of them are
