@@ -356,15 +356,22 @@ TEST(OdometrySeamTest, VehicleLikeMotionIsAYawAndAStepInThePlane) {
   }
 }
 
+// The seam's points with a floor 1 m below the first camera (a grid 2.5–9 m ahead), so that
+// the first frame finds the up.
+std::vector<Eigen::Vector3d> SeamWorldWithFloor() {
+  std::vector<Eigen::Vector3d> points = SeamWorldPoints();
+  for (double x = -3.0; x <= 3.0; x += 0.5) {
+    for (double z = 2.5; z <= 9.0; z += 0.5) points.emplace_back(x, 1.0, z);
+  }
+  return points;
+}
+
 // tracking.ground_vehicle refuses a weak motion that tilts the vehicle. The seam's world with a
 // floor 1 m below the first camera (so the first frame finds up); frame 5 is seen from its pose
 // pitched by 5° and matched by 20 exact matches only (weak: fewer than reliable_min_inliers).
 TEST(OdometrySeamTest, GroundVehicleRefusesAWeakMotionThatTilts) {
   const StereoCamera cam = HallwayCamera();
-  std::vector<Eigen::Vector3d> points = SeamWorldPoints();
-  for (double x = -3.0; x <= 3.0; x += 0.5) {
-    for (double z = 2.5; z <= 9.0; z += 0.5) points.emplace_back(x, 1.0, z);
-  }
+  const std::vector<Eigen::Vector3d> points = SeamWorldWithFloor();
   std::vector<SeamFrame> frames;
   for (int i = 0; i < 5; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
   const Eigen::Isometry3d T_world_tilted =
@@ -444,10 +451,7 @@ TEST(OdometrySeamTest, NoFloorTakesTheUpFromTheMounting) {
 // explains: refused by RANSAC's gate and by the solver, the frame is lost.
 TEST(OdometrySeamTest, GroundVehicleMeasuresARefusedWeakMotionWithTheFewPointSolver) {
   const StereoCamera cam = HallwayCamera();
-  std::vector<Eigen::Vector3d> points = SeamWorldPoints();
-  for (double x = -3.0; x <= 3.0; x += 0.5) {
-    for (double z = 2.5; z <= 9.0; z += 0.5) points.emplace_back(x, 1.0, z);
-  }
+  const std::vector<Eigen::Vector3d> points = SeamWorldWithFloor();
   std::vector<SeamFrame> frames;
   for (int i = 0; i < 5; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
   auto run = [&](const Eigen::Isometry3d& T_world_5) {
