@@ -43,13 +43,10 @@ struct StereoSequence {
                                        // (vo::ResolvePlatform: auto is a ground vehicle with
                                        // this axle when it is known); vo_options.yaml records
                                        // the resolved platform and the values used
-  double camera_pitch_deg =
-      std::numeric_limits<double>::quiet_NaN();  // the rig's camera
-                                                 // pitch (downward tilt, degrees) when the source
-                                                 // knows it (scenario camera.pitch_deg, rig.yaml);
-                                                 // NaN = unknown. A ground vehicle takes its up
-                                                 // from it when the first frame shows no floor
-                                                 // (ResolvePlatform)
+  // The rig's camera pitch (downward tilt, degrees) when the source knows it (a scenario's
+  // camera.pitch_deg, rig.yaml); NaN = unknown. A ground vehicle takes its up from it when the
+  // first frame shows no floor or ceiling (vo::ResolvePlatform).
+  double camera_pitch_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).

@@ -760,9 +760,10 @@ bool StereoOdometry::EstimateInitialOrientation(const std::vector<Eigen::Vector3
       orientation_result_.status == PlaneOrientationResult::Status::kNoFloor) {
     // The mounting's up; x_hall the camera's forward axis made horizontal (zero yaw).
     const Eigen::Vector3d up = options_.orientation.expected_up_cam0.normalized();
-    const Eigen::Vector3d x_hall = (Eigen::Vector3d::UnitZ() - up.z() * up).normalized();
+    Eigen::Vector3d x_hall, y_hall;
+    HorizontalBasis(up, &x_hall, &y_hall);
     orientation_result_.R_hall_cam0.row(0) = x_hall.transpose();
-    orientation_result_.R_hall_cam0.row(1) = up.cross(x_hall).transpose();
+    orientation_result_.R_hall_cam0.row(1) = y_hall.transpose();
     orientation_result_.R_hall_cam0.row(2) = up.transpose();
     orientation_result_.up_cam0 = up;
     result->floor_refinement_message =

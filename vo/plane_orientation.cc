@@ -65,6 +65,14 @@ double PlaneInlierDistance(const Eigen::Vector3d& p, const PlaneOrientationOptio
   return options.distance_threshold_m + options.distance_threshold_per_m * std::max(p.z(), 0.0);
 }
 
+void HorizontalBasis(const Eigen::Vector3d& up, Eigen::Vector3d* e1, Eigen::Vector3d* e2) {
+  Eigen::Vector3d forward = Eigen::Vector3d::UnitZ() - up.z() * up;
+  constexpr double kMinProjectedNorm = 1e-6;  // forward (almost) parallel to up
+  if (forward.norm() < kMinProjectedNorm) forward = Eigen::Vector3d::UnitX() - up.x() * up;
+  *e1 = forward.normalized();
+  *e2 = up.cross(*e1);
+}
+
 namespace {
 
 // Weighted least-squares plane through the points (smallest eigenvector of the weighted,
@@ -283,13 +291,9 @@ PlaneOrientationResult EstimateHallwayOrientation(const std::vector<Eigen::Vecto
   }
   const Eigen::Vector3d up = result.up_cam0;
 
-  // Horizontal reference basis: e1 = camera forward projected on the horizontal plane,
-  // e2 = up × e1 (left). Fall back to the camera's x axis when looking straight up/down.
-  Eigen::Vector3d forward = Eigen::Vector3d::UnitZ() - up.z() * up;
-  constexpr double kMinProjectedNorm = 1e-6;  // forward (almost) parallel to up
-  if (forward.norm() < kMinProjectedNorm) forward = Eigen::Vector3d::UnitX() - up.x() * up;
-  const Eigen::Vector3d e1 = forward.normalized();
-  const Eigen::Vector3d e2 = up.cross(e1);
+  // Horizontal reference basis (HorizontalBasis).
+  Eigen::Vector3d e1, e2;
+  HorizontalBasis(up, &e1, &e2);
 
   // Step 3: walls vote for the Manhattan frame: circular mean of 4θ (inlier-weighted).
   double sum_sin = 0.0, sum_cos = 0.0;

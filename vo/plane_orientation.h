@@ -110,6 +110,11 @@ const char* ToString(PlaneOrientationResult::Status status);
 // distance_threshold_per_m · z (header, step 1).
 double PlaneInlierDistance(const Eigen::Vector3d& p_cam0, const PlaneOrientationOptions& options);
 
+// The horizontal basis of a camera whose up is `up` (unit, cam0 frame): e1 = the camera's forward
+// axis projected on the horizontal plane (its x axis when it looks straight up or down), e2 = up
+// × e1 (left). With zero yaw e1 is the hallway's x.
+void HorizontalBasis(const Eigen::Vector3d& up, Eigen::Vector3d* e1, Eigen::Vector3d* e2);
+
 // Orientation of cam0 relative to the hallway from 3D points in cam0 (metres), e.g. the first
 // frame's features or a subsampled dense disparity map. Never throws.
 PlaneOrientationResult EstimateHallwayOrientation(

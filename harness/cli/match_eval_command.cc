@@ -52,39 +52,32 @@ bool ParseIntList(const std::string& text, std::vector<int>* out) {
 }
 
 int RunMatchEval(const MatchEvalArgs& args) {
-  const std::string& scenario_arg = args.scenario;
-  const std::string& strides_arg = args.strides;
-  const std::string& matchers_arg = args.matchers;
-  const std::string& prediction_arg = args.prediction;
-  const std::string& config = args.config;
   std::string out = args.out;
-  const int max_frames = args.max_frames;
-  const bool quiet = args.quiet;
   std::string error;
   sim::Scenario scenario;
-  if (!ResolveScenario(scenario_arg, &scenario, &error)) {
+  if (!ResolveScenario(args.scenario, &scenario, &error)) {
     std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
     return 2;
   }
   MatchEvalOptions options;
-  if (!config.empty()) {  // the matcher's options and its gate scale; the rest stays as it is
+  if (!args.config.empty()) {  // the matcher's options and its gate scale; the rest stays as it is
     vo::OdometryOptions vo_options;
-    if (!LoadVoConfig(config, &vo_options, &error)) {
+    if (!LoadVoConfig(args.config, &vo_options, &error)) {
       std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
       return 2;
     }
     options.matcher = vo_options.matcher;
     options.prediction_radius_scale = vo_options.tracking.prior_radius_scale;
   }
-  if (!ParseIntList(strides_arg, &options.strides)) {
+  if (!ParseIntList(args.strides, &options.strides)) {
     std::fprintf(stderr,
                  "vobench match-eval: --strides: expected comma-separated integers, got '%s'\n",
-                 strides_arg.c_str());
+                 args.strides.c_str());
     return 2;
   }
-  if (!matchers_arg.empty()) {
+  if (!args.matchers.empty()) {
     options.matchers.clear();
-    std::stringstream ss(matchers_arg);
+    std::stringstream ss(args.matchers);
     std::string name;
     while (std::getline(ss, name, ',')) {
       vo::MatcherType t;
@@ -98,10 +91,10 @@ int RunMatchEval(const MatchEvalArgs& args) {
       options.matchers.push_back(t);
     }
   }
-  if (!vo::ParsePredictionMode(prediction_arg, &options.prediction)) {
+  if (!vo::ParsePredictionMode(args.prediction, &options.prediction)) {
     std::fprintf(stderr,
                  "vobench match-eval: --prediction: expected none or motion_prior, got '%s'\n",
-                 prediction_arg.c_str());
+                 args.prediction.c_str());
     return 2;
   }
   if (!(args.correct_px > 0.0) || !std::isfinite(args.correct_px)) {
@@ -132,8 +125,8 @@ int RunMatchEval(const MatchEvalArgs& args) {
   StereoSequence sequence;
   std::vector<DatasetFrame> simulated;
   if (!OpenScenarioSequence(scenario, &sequence, &error) ||
-      !ReadAllFrames(sequence.next, max_frames, sequence.expected_frames,
-                     "simulate " + scenario.name, !quiet, out, &simulated, &error)) {
+      !ReadAllFrames(sequence.next, args.max_frames, sequence.expected_frames,
+                     "simulate " + scenario.name, !args.quiet, out, &simulated, &error)) {
     std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
     return 1;
   }
@@ -142,7 +135,7 @@ int RunMatchEval(const MatchEvalArgs& args) {
     frames.push_back({f.left, f.right, f.depth_m, f.T_world_cam0});
   simulated.clear();
   std::vector<MatchEvalRow> rows;
-  Progress progress("match-eval", 1, !quiet);
+  Progress progress("match-eval", 1, !args.quiet);
   if (!EvaluateMatchers(frames, sequence.camera, options, &rows, &error, [&](int done, int total) {
         progress.set_total(total);
         progress.Update(done);
