@@ -137,6 +137,19 @@ std::string ShardTag(const Shard& shard) {
   return "shard" + std::to_string(shard.index) + "of" + std::to_string(shard.count);
 }
 
+bool MakeWorkDir(const fs::path& work, std::string* error) {
+  // Another shard's RemoveLeftovers removes tmp/ when it finds it empty, which may fall between
+  // create_directories making tmp/ and making tmp/<tag> in it: try again (tmp/<tag> is never
+  // removed by another process, so once it stands it stays).
+  std::error_code ec;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    fs::create_directories(work, ec);
+    if (!ec && fs::is_directory(work, ec)) return true;
+  }
+  *error = work.string() + ": cannot create: " + (ec ? ec.message() : "it keeps disappearing");
+  return false;
+}
+
 void RemoveLeftovers(const fs::path& out, const fs::path& work) {
   std::error_code ec;
   fs::remove_all(work, ec);

@@ -64,6 +64,8 @@ bool IsFinished(const std::filesystem::path& run_dir, const std::string& spec_ha
 std::filesystem::path WorkDir(const std::filesystem::path& out, const std::string& tag);
 // "shard<i>of<N>": names the shard's work folder and lock.
 std::string ShardTag(const Shard& shard);
+// Creates `work` (and tmp/), also while a shard sharing the folder removes an empty tmp/.
+bool MakeWorkDir(const std::filesystem::path& work, std::string* error);
 // Removes `work` (this process's folder under tmp/, and tmp/ when it is then empty) and every
 // *.partial* entry in runs/: leftovers of interrupted runs.
 void RemoveLeftovers(const std::filesystem::path& out, const std::filesystem::path& work);

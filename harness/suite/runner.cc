@@ -31,6 +31,7 @@ using suite_internal::CommandLine;
 using suite_internal::ExitText;
 using suite_internal::IsFinished;
 using suite_internal::MakeDirs;
+using suite_internal::MakeWorkDir;
 using suite_internal::Manifest;
 using suite_internal::ReadJsonFile;
 using suite_internal::ReadManifest;
@@ -136,7 +137,6 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
     return false;
   const std::vector<SuiteRun> runs = ExpandSuite(suite);
   // The manifest first: a folder with suite.json is recognised as this suite's on resume.
-  std::error_code ec;
   // A marked suite folder (created with its marker, or an earlier one of this suite), and the
   // lock of this shard in it: a second `suite` on the same folder and shard fails at once.
   FolderLock shard_lock;
@@ -151,11 +151,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
     return false;
   const fs::path work = WorkDir(out, shard_tag);
   RemoveLeftovers(out, work);
-  fs::create_directories(work, ec);
-  if (ec) {
-    *error = work.string() + ": cannot create: " + ec.message();
-    return false;
-  }
+  if (!MakeWorkDir(work, error)) return false;
 
   // What to run: this shard's runs that are not finished for their spec.
   std::deque<Job> queue;

@@ -6,13 +6,16 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
+#include <thread>
 
+#include "harness/suite/folder.h"
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
 
@@ -247,6 +250,29 @@ TEST(ShardTest, ParsesAndPartitionsTheRuns) {
       for (int i = 1; i <= n; ++i) holders += harness::Shard{i, n}.Contains(run);
       EXPECT_EQ(holders, 1) << run << " in " << n << " shards";
     }
+}
+
+TEST(ShardTest, AWorkFolderIsMadeWhileAnotherShardRemovesAnEmptyTmp) {
+  // Shards sharing an output folder: one removes tmp/ when it finds it empty (RemoveLeftovers)
+  // while another creates tmp/<its tag> in it.
+  TempDir dir("suite_workdir");
+  const fs::path out = dir.str();
+  const fs::path work = harness::suite_internal::WorkDir(out, "shard2of2");
+  std::atomic<bool> stop{false};
+  std::thread remover([&] {
+    std::error_code ec;
+    while (!stop) fs::remove(out / "tmp", ec);  // only if empty, as RemoveLeftovers does
+  });
+  int failed = 0;
+  std::string error;
+  for (int i = 0; i < 2000; ++i) {
+    if (!harness::suite_internal::MakeWorkDir(work, &error)) ++failed;
+    std::error_code ec;
+    fs::remove_all(work, ec);
+  }
+  stop = true;
+  remover.join();
+  EXPECT_EQ(failed, 0) << error;
 }
 
 // --------------------------------------------------------------------------------------------
