@@ -1,6 +1,7 @@
 #include "vo/prior_motion.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -115,6 +116,44 @@ Eigen::VectorXd Residuals(const StereoCamera& camera, const std::vector<StereoCo
   r.segment<3>(p) = x.head<3>() / sigma_rot;
   r.segment<3>(p + 3) = x.tail<3>() / o.prior_translation_sigma_m;
   return r;
+}
+
+// A wheeled vehicle's yaw and forward distance (x = B · y, from y0) that fit correspondence c
+// alone: its left image position and its right image column (three residuals, two unknowns; no
+// prior). One stereo point tells both, the bearing the yaw and the depth change the forward
+// distance. False when the fit leaves the camera's view or does not stay finite.
+bool FitVehicleToOnePoint(const StereoCamera& camera, const StereoCorrespondence& c,
+                          const Model& model, const Eigen::Vector2d& y0,
+                          const PriorMotionOptions& o, Vector6d* x) {
+  const Basis& B = model.B;
+  auto residual = [&](const Eigen::Vector2d& y, Eigen::Vector3d* r) {
+    Eigen::Vector2d el, er;
+    if (!StereoReprojectionErrors(camera, model.At(B * y).inverse(), c, o.min_depth_m, &el, &er))
+      return false;
+    *r << el.x(), el.y(), er.x();
+    return true;
+  };
+  Eigen::Vector2d y = y0;
+  Eigen::Vector3d r;
+  if (!residual(y, &r)) return false;
+  for (int it = 0; it < o.max_iterations; ++it) {
+    Eigen::Matrix<double, 3, 2> J;
+    for (int j = 0; j < 2; ++j) {
+      Eigen::Vector2d yp = y, ym = y;
+      yp(j) += kNumericStep;
+      ym(j) -= kNumericStep;
+      Eigen::Vector3d rp, rm;
+      if (!residual(yp, &rp) || !residual(ym, &rm)) return false;
+      J.col(j) = (rp - rm) / (2.0 * kNumericStep);
+    }
+    const Eigen::Vector2d delta = -(J.transpose() * J).ldlt().solve(J.transpose() * r);
+    if (!delta.allFinite()) return false;
+    y += delta;
+    if (!residual(y, &r)) return false;
+    if (delta.squaredNorm() < kConvergedStep) break;
+  }
+  *x = B * y;
+  return x->allFinite();
 }
 
 // Gauss-Newton on y (x = B · y) from y0 over the given inliers (a step that raises the cost is
@@ -244,7 +283,23 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
   std::vector<bool> best_mask;
   double best_sq = 0.0;
   int best_n = Classify(camera, corr, model.At(Vector6d::Zero()), o, &best_mask, &best_sq);
+  // A hypothesis x is kept when more correspondences agree with it (ties: the smaller sum of
+  // squared errors; the earlier one).
+  auto consider = [&](const Vector6d& x) {
+    if (!x.allFinite()) return;
+    std::vector<bool> mask;
+    double sq = 0.0;
+    const int n = Classify(camera, corr, model.At(x), o, &mask, &sq);
+    if (n > best_n || (n == best_n && sq < best_sq)) {
+      best_n = n;
+      best_sq = sq;
+      best_x = x;
+      best_mask = std::move(mask);
+    }
+  };
   const Eigen::Matrix3d R_prior = T_prior.linear();
+  // A vehicle's 1-point yaw correction per correspondence (NaN: none).
+  std::vector<double> point_yaw(corr.size(), std::numeric_limits<double>::quiet_NaN());
   for (size_t i = 0; i < corr.size(); ++i) {
     // The observed bearing b in the current camera; the point's direction a' seen from the
     // prior's camera centre, in the prior's rotated frame. Q b = a' (smallest rotation).
@@ -274,6 +329,7 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
       }
       if (!settled) continue;
       x.head<3>() = yaw * u;
+      point_yaw[i] = yaw;
     } else if (up_curr != nullptr) {
       // Planar: the rotation about up that turns b's horizontal direction onto a's.
       const Eigen::Vector3d u = B.block<3, 1>(0, 0);
@@ -283,15 +339,22 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
       const Eigen::AngleAxisd Q(Eigen::Quaterniond::FromTwoVectors(b, a));
       x.head<3>() = Q.angle() * Q.axis();
     }
-    if (!x.allFinite()) continue;
-    std::vector<bool> mask;
-    double sq = 0.0;
-    const int n = Classify(camera, corr, model.At(x), o, &mask, &sq);
-    if (n > best_n || (n == best_n && sq < best_sq)) {
-      best_n = n;
-      best_sq = sq;
-      best_x = x;
-      best_mask = std::move(mask);
+    consider(x);
+  }
+  // A vehicle whose prior's forward distance is far off (a robot that brakes and then turns in
+  // place: l_hallway with the camera pitched 20°, stride 3, the first frame of the turn, where
+  // the prior kept 8.6 cm of the braking steps and no yaw alone put any of 10 correct matches
+  // within 2 px): when no hypothesis above has the support the result needs, each point's own
+  // forward distance as well (FitVehicleToOnePoint, from its yaw).
+  const double needed =
+      std::max(static_cast<double>(o.min_inliers), o.min_inlier_fraction * corr.size());
+  if (model.vehicle && best_n < needed) {
+    for (size_t i = 0; i < corr.size(); ++i) {
+      Vector6d x_fit;
+      if (std::isfinite(point_yaw[i]) &&
+          FitVehicleToOnePoint(camera, corr[i], model, Eigen::Vector2d(point_yaw[i], 0.0), o,
+                               &x_fit))
+        consider(x_fit);
     }
   }
   if (best_n == 0) {

@@ -323,5 +323,32 @@ TEST(PriorMotionTest, NoSideWaysSlipRecoversAnInPlaceTurn) {
   EXPECT_GT(yaw, -4.44 * kDeg * (1.0 + 0.15 / 0.85));
 }
 
+// A robot that brakes and then turns in place, its camera pitched 20° down: the constant-velocity
+// prior keeps the last frame's 8.6 cm step and no yaw (truth: 5° and 2 mm). A yaw alone cannot
+// put any point of the wall near its observation (off-centre points are 5-15 px off in height);
+// the 1-point hypotheses also fit the forward distance to the point's depth, and every point is
+// an inlier of the motion found (l_hallway, pitch 20°, stride 3: 10 of 11 matches were correct
+// and the frame was lost).
+TEST(PriorMotionTest, APriorThatStillDrivesOnIsCorrectedByOnePointsDepth) {
+  const StereoCamera cam = TestCamera();
+  const double pitch = 20.0 * kDeg;
+  const Eigen::Vector3d up(0.0, -std::cos(pitch), -std::sin(pitch));
+  const Eigen::Isometry3d T_true = VehicleMotion(up, 0.15, 5.0 * kDeg, 0.002);
+  const Eigen::Isometry3d T_prior = VehicleMotion(up, 0.15, 0.0, 0.086);
+  std::vector<StereoCorrespondence> corr;
+  for (int k = 0; k < 10; ++k) {
+    const double x = -0.4 + 0.08 * k, y = (k % 2 == 0 ? 0.05 : 0.3) - 0.02 * k;
+    corr.push_back(Exact(cam, T_true, Eigen::Vector3d(x, y, 0.95 + 0.01 * k)));
+  }
+  PriorMotionOptions vehicle;
+  vehicle.axle_behind_camera_m = 0.15;
+  const PriorMotionResult r = EstimateMotionWithPrior(cam, corr, T_prior, vehicle, &up);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.num_inliers, 10);
+  // The defaults' prior (σ 2°, 1 cm, 8.4 cm off) pulls a little against ten exact points.
+  EXPECT_LT(RotationErrorRad(r.T_prev_curr, T_true), 0.05 * kDeg);
+  EXPECT_LT((r.T_prev_curr.translation() - T_true.translation()).norm(), 0.005);
+}
+
 }  // namespace
 }  // namespace vo
