@@ -306,6 +306,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"min_inliers", Number(&o->min_inliers, 3, 100000)},
       {"reinit_after_lost_frames", Number(&o->reinit_after_lost_frames, 1, 100000)},
       {"tracking.coarse_to_fine", Bool(&t.coarse_to_fine)},
+      {"tracking.last_motion_pass", Bool(&t.last_motion_pass)},
       {"tracking.image_shift.coarsest_max_width_px",
        Number(&t.image_shift.coarsest_max_width_px, 8, 100000)},
       {"tracking.image_shift.max_shift_fraction_x",

@@ -350,6 +350,8 @@ const char* ToString(PredictionSource source) {
       return "image_shift";
     case PredictionSource::kGuided:
       return "guided";
+    case PredictionSource::kLastMotion:
+      return "last_motion";
   }
   return "unknown";
 }
@@ -425,6 +427,7 @@ void StereoOdometry::Reset() {
   T_world_prev_ = Eigen::Isometry3d::Identity();
   velocity_ = Eigen::Isometry3d::Identity();
   has_velocity_ = false;
+  last_motion_frame_ = -1;
   scene_num_disparities_ = 0;
   R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   world_up_known_ = false;
@@ -977,6 +980,33 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
     }
   }
 
+  // 2b. Still not confident, and the previous frame (the reference) measured its own motion: a
+  //     pass around that motion as measured. The prior took a weak motion in only in part, so
+  //     where a turn starts it lags (l_hallway, camera pitched 20°, stride 2: 12 px behind at the
+  //     radiator whose fins repeat every 12 px, where the image shift, 65 px, was ambiguous too).
+  //     Skipped when both predict the same (within a pixel at the image centre).
+  const bool confident_now =
+      best.inliers() >= std::max(options_.min_inliers, o.confident_min_inliers) &&
+      best.inliers() >= o.confident_inlier_fraction * smaller;
+  if (o.last_motion_pass && !confident_now && T_ref_curr_prior != nullptr &&
+      last_motion_frame_ >= 0 && ref.frame_id == last_motion_frame_ &&
+      frame.frame_id == ref.frame_id + 1 &&
+      (PredictedCentreShift(camera_, last_motion_, -1.0) -
+       PredictedCentreShift(camera_, *T_ref_curr_prior, -1.0))
+              .norm() > 1.0) {
+    t = Clock::now();
+    MatchPrediction measured;
+    measured.uv_px = PredictPositions(ref.features, last_motion_);
+    measured.radius_scale = o.prior_radius_scale;
+    times.predict_ms += MsSince(t);
+    MotionAttempt attempt;
+    if (!pass(measured, PredictionSource::kLastMotion, &times.match_ms, &times.motion_ms,
+              &attempt)) {
+      return best;
+    }
+    if (attempt.inliers() > best.inliers()) best = std::move(attempt);
+  }
+
   // 3. Guided second pass: every reference feature predicted with the estimated motion, matched
   //    in a tight window, so more correct matches reach the bundle adjustment.
   if (o.guided_rematch && best.ransac.ok() && IsFinite(best.ransac.T_prev_curr)) {
@@ -1235,6 +1265,10 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
                         : result.few_point_motion ? tracking.few_point_prior_update
                                                   : PriorUpdateWeight(ransac.num_inliers);
   MoveVelocity(per_frame, weight);
+  if (IsFinite(per_frame) && !ba_rejected) {
+    last_motion_ = per_frame;
+    last_motion_frame_ = result.frame_index;
+  }
   result.motion_measured = true;
   // A reliable measured motion refines the vehicle's up (not a few-point or bundle-adjusted
   // one: both are made planar about the current estimate).

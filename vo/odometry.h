@@ -48,6 +48,10 @@
 //      to this frame on an image pyramid (image_motion.h, the paper's "multi-scale analysis"),
 //      matching around uv + shift with gates widened by shift_radius_scale, then RANSAC; the
 //      pass with more inliers is kept.
+//   2b. last-motion pass, when still not confident and the reference (the previous frame)
+//      measured its own motion: matching around that motion as measured
+//      (tracking.last_motion_pass). The prior takes a weak motion in only in part, so it lags
+//      a turn that starts; the pass with more inliers is kept.
 //   3. guided pass: every reference feature predicted with the motion just estimated, matched
 //      in a tight window (guided_radius_scale), RANSAC; kept when it has at least as many
 //      inliers, so more correct matches reach the bundle adjustment.
@@ -168,6 +172,11 @@ struct RobustTrackingOptions {
                                // (image_motion.h) and match again around it
   ImageShiftOptions image_shift = DefaultTrackingImageShiftOptions();  // the coarse-to-fine
                                                                        // estimate
+  bool last_motion_pass = true;     // still not confident after that: when the reference (the
+                                    // previous frame) measured its own motion and it predicts
+                                    // otherwise than the prior (which blends a weak motion in only
+                                    // in part), match again around that motion; the pass with more
+                                    // inliers wins
   double prior_radius_scale = 0.5;  // the matcher's position gates around the motion prior's
                                     // prediction are scaled by this, in [0.05, 20]: the
                                     // prediction leaves a few pixels (SVD σ 10 → 5 px), and
@@ -553,8 +562,9 @@ enum class PredictionSource {
   kMotionPrior,  // the motion prior (constant velocity or the caller's MotionPrior)
   kImageShift,   // previous positions + the coarse-to-fine image shift
   kGuided,       // the estimated motion of this frame (guided second pass)
+  kLastMotion,   // the previous frame's own measured motion (not blended into the prior)
 };
-// "none", "motion_prior", "image_shift", "guided".
+// "none", "motion_prior", "image_shift", "guided", "last_motion".
 const char* ToString(PredictionSource source);
 
 struct OdometryResult {
@@ -873,6 +883,11 @@ class StereoOdometry {
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // constant-velocity model: last
                                                                 // estimated per-frame T_prev_curr
   bool has_velocity_ = false;
+  // The last measured motion as it was measured, per frame (T_prev_curr), and its frame (-1:
+  // none). The prior blends a weak motion in only in part; where the motion changes fast (a
+  // turn that starts) this one is nearer the next frame's.
+  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
+  int64_t last_motion_frame_ = -1;
   int scene_num_disparities_ = 0;  // next frame's search range from the scene; 0 = full
 
   Eigen::Matrix3d R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
