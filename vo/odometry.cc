@@ -941,10 +941,11 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
   //    shift, coarse-to-fine, and a wider search around it; the pass with more inliers wins.
   const double smaller = static_cast<double>(std::min(ref.features.size(), frame.features.size()));
   const bool weak = T_ref_curr_prior == nullptr || consecutive_lost_ > 0;
-  const bool confident =
-      best.inliers() >= std::max(options_.min_inliers, o.confident_min_inliers) &&
-      best.inliers() >= o.confident_inlier_fraction * smaller;
-  if (o.coarse_to_fine && (weak || !confident)) {
+  auto confident = [&](const MotionAttempt& a) {
+    return a.inliers() >= std::max(options_.min_inliers, o.confident_min_inliers) &&
+           a.inliers() >= o.confident_inlier_fraction * smaller;
+  };
+  if (o.coarse_to_fine && (weak || !confident(best))) {
     t = Clock::now();
     const ImageShiftResult shift = EstimateImageShift(ref.image, frame.image, o.image_shift);
     result->image_shift_ok = shift.ok;
@@ -985,10 +986,7 @@ StereoOdometry::MotionAttempt StereoOdometry::MatchAndEstimate(
   //     where a turn starts it lags (l_hallway, camera pitched 20°, stride 2: 12 px behind at the
   //     radiator whose fins repeat every 12 px, where the image shift, 65 px, was ambiguous too).
   //     Skipped when both predict the same (within a pixel at the image centre).
-  const bool confident_now =
-      best.inliers() >= std::max(options_.min_inliers, o.confident_min_inliers) &&
-      best.inliers() >= o.confident_inlier_fraction * smaller;
-  if (o.last_motion_pass && !confident_now && T_ref_curr_prior != nullptr &&
+  if (o.last_motion_pass && !confident(best) && T_ref_curr_prior != nullptr &&
       last_motion_frame_ >= 0 && ref.frame_id == last_motion_frame_ &&
       frame.frame_id == ref.frame_id + 1 &&
       (PredictedCentreShift(camera_, last_motion_, -1.0) -

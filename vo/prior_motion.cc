@@ -341,13 +341,14 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
     }
     consider(x);
   }
+  // The support an ok result needs (checked at the end): min_inliers and min_inlier_fraction.
+  const double needed =
+      std::max(static_cast<double>(o.min_inliers), o.min_inlier_fraction * corr.size());
   // A vehicle whose prior's forward distance is far off (a robot that brakes and then turns in
   // place: l_hallway with the camera pitched 20°, stride 3, the first frame of the turn, where
   // the prior kept 8.6 cm of the braking steps and no yaw alone put any of 10 correct matches
   // within 2 px): when no hypothesis above has the support the result needs, each point's own
   // forward distance as well (FitVehicleToOnePoint, from its yaw).
-  const double needed =
-      std::max(static_cast<double>(o.min_inliers), o.min_inlier_fraction * corr.size());
   if (model.vehicle && best_n < needed) {
     for (size_t i = 0; i < corr.size(); ++i) {
       Vector6d x_fit;
@@ -386,7 +387,7 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
   result.inlier_mask = mask;
   result.num_inliers = n;
   result.rms_reprojection_px = n > 0 ? std::sqrt(sq / (2.0 * n)) : 0.0;
-  if (n < o.min_inliers || n < o.min_inlier_fraction * static_cast<double>(corr.size())) {
+  if (n < needed) {
     std::ostringstream msg;
     msg << "too few inliers (" << n << " of " << corr.size() << "; need " << o.min_inliers
         << " and a fraction " << o.min_inlier_fraction << ")";
