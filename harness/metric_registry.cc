@@ -124,6 +124,10 @@ std::vector<MetricInfo> MakeRegistry() {
              "lost frames whose bridged forward step or yaw was measured against the previous "
              "frame's features (tracking.vehicle_bridge_alignment)",
              [](const RunSummary& s) { return json(s.bridge_aligned_frames); }),
+      Metric("direct_motion_frames", "frames", Better::kNeither, kRun,
+             "frames too poor in features for the matchers whose motion was measured by "
+             "direct image alignment (tracking.vehicle_direct_alignment; not lost frames)",
+             [](const RunSummary& s) { return json(s.direct_motion_frames); }),
       Metric("vo_ms_median", "ms", Better::kLower, MetricGroup::kTiming,
              "median VO time per frame (the first frame excluded)",
              [](const RunSummary& s) { return json(s.vo_ms_median); }),
@@ -137,7 +141,9 @@ std::vector<MetricInfo> MakeRegistry() {
       StageMedian("guided", "guided re-matching"),
       StageMedian("match", "matching"),
       StageMedian("motion", "RANSAC motion"),
-      StageMedian("predict", "prediction (coarse-to-fine image shift)"),
+      StageMedian("predict",
+                  "prediction (coarse-to-fine image shift; a lost frame's bridge alignment and "
+                  "direct image alignment)"),
       Metric("features_median", "", kNeither, kRun, "median number of features with depth",
              [](const RunSummary& s) { return json(s.features_median); }),
       Metric("inliers_median", "", kNeither, kRun, "median number of RANSAC inliers",

@@ -176,6 +176,7 @@ bool Summarize(const RunRecords& records, RunSummary* summary, std::string* erro
       ++s.lost_frames;
       if (r.bridge_aligned) ++s.bridge_aligned_frames;
     }
+    if (r.direct_motion) ++s.direct_motion_frames;
     if (r.reinitialised) ++s.reinitialisations;
     total.push_back(r.times.total_ms);
     feats.push_back(r.num_features_with_depth);

@@ -110,6 +110,8 @@ struct RunSummary {
   int bridge_aligned_frames = 0;   // of those, frames whose bridged forward step or yaw was
                                    // measured against the previous frame's features
                                    // (vo::OdometryResult::bridge_aligned)
+  int direct_motion_frames = 0;    // frames (not lost) whose motion was measured by direct image
+                                   // alignment (vo::OdometryResult::direct_motion)
   int frames_not_initialised = 0;  // frames before the first one the VO initialised on: no
                                    // pose, not in the trajectories, metrics or lost_frames
   double vo_ms_median = 0.0;

@@ -78,6 +78,11 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
     r << "| lost frames whose bridged step or yaw was measured (vehicle_bridge_alignment) | "
       << s.bridge_aligned_frames << " |\n";
   }
+  if (s.direct_motion_frames > 0) {
+    r << "| frames without features enough, measured by direct image alignment "
+         "(vehicle_direct_alignment) | "
+      << s.direct_motion_frames << " |\n";
+  }
   if (s.frames_not_initialised > 0) {
     r << "| frames before the VO initialised (no pose, not evaluated) | "
       << s.frames_not_initialised << " |\n";
@@ -154,7 +159,7 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
          "first_pass_inliers,image_shift_x_px,image_shift_y_px,predict_ms,guided_ms,num_"
          "disparities,"
          "disparity_pixels,chained_to_frame,chain_inliers,bridge_aligned,few_point_motion,"
-         "message\n";
+         "direct_motion,message\n";
   // One row per frame; frames before the first initialised one have no pose and no error.
   const double kNan = std::nan("");
   auto row = [&](size_t frame, double time_s, const std::string& status,
@@ -174,7 +179,8 @@ std::string PerFrameCsv(const RunRecords& records, const RunSummary& summary,
         << Fmt(r.times.predict_ms, 3) << "," << Fmt(r.times.guided_ms, 3) << ","
         << r.num_disparities << "," << r.disparity_pixels << "," << r.chained_to_frame << ","
         << r.chain_inliers << "," << (r.bridge_aligned ? 1 : 0) << ","
-        << (r.few_point_motion ? 1 : 0) << "," << CsvQuoted(r.message) << "\n";
+        << (r.few_point_motion ? 1 : 0) << "," << (r.direct_motion ? 1 : 0) << ","
+        << CsvQuoted(r.message) << "\n";
   };
   for (size_t i = 0; i < first; ++i) {
     const vo::OdometryResult& r = records.frames[i].result;

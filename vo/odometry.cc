@@ -29,6 +29,17 @@ constexpr double kVehicleUpPriorSigmaDeg = 1.0;
 constexpr double kVehicleUpRefinedFloorSigmaDeg = 0.15;
 constexpr double kVehicleUpTranslationSigmaM = 1e-2;
 constexpr double kVehicleUpRotationSigmaDeg = 0.3;
+// The planes of a frame's features for the direct alignment of the next lost frame
+// (tracking.vehicle_direct_alignment): up to 3 (a wall, the floor, a side wall); a feature is on
+// one within 1 px of disparity; each with at least 6 features spread at least 5 cm across (not
+// all along one edge), 60 % of the features on them. Without such planes a frame carries the
+// previous ones by its motion, for at most 30 frames.
+constexpr double kScenePlaneTolerancePx = 1.0;
+constexpr int kScenePlaneMinInliers = 6;
+constexpr double kScenePlaneMinFraction = 0.6;
+constexpr double kScenePlaneMinSpreadM = 0.05;
+constexpr int kMaxScenePlanes = 3;
+constexpr int kMaxScenePlaneAge = 30;
 
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -162,6 +173,10 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
   }
   if (ground_vehicle && vehicle_bridge_alignment && !vehicle_bridge.IsValid(&part_error)) {
     return FailPart("vehicle_bridge", part_error, error);
+  }
+  if (ground_vehicle && vehicle_bridge_alignment && vehicle_direct_alignment &&
+      !vehicle_direct.IsValid(&part_error)) {
+    return FailPart("vehicle_direct", part_error, error);
   }
   std::ostringstream msg;
   if (!(prior_radius_scale >= 0.05 && prior_radius_scale <= 20.0)) {
@@ -435,6 +450,8 @@ void StereoOdometry::Reset() {
   orientation_result_ = PlaneOrientationResult();
   last_features_.clear();
   previous_frame_features_.clear();
+  scene_planes_.clear();
+  scene_planes_age_ = 0;
   last_matches_.clear();
   last_inlier_mask_.clear();
   last_reference_features_.clear();
@@ -458,6 +475,7 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
   // Only the bridge alignment reads the previous frame's features: no copy per frame otherwise.
   if (options_.tracking.ground_vehicle && options_.tracking.vehicle_bridge_alignment) {
     previous_frame_features_ = last_features_;
+    if (options_.tracking.vehicle_direct_alignment) UpdateScenePlanes(result.T_prev_curr);
   }
   // Next frame's disparity search range from the depths of this one (full after a loss).
   scene_num_disparities_ = 0;
@@ -563,7 +581,50 @@ Eigen::Isometry3d StereoOdometry::BridgedPose(const MotionPrior* prior, Odometry
       options_.matcher.prediction == PredictionMode::kNone) {
     return bridged;
   }
-  return AlignedBridgePose(bridged, result);
+  const Eigen::Isometry3d aligned = AlignedBridgePose(bridged, result);
+  return o.vehicle_direct_alignment ? DirectAlignedPose(aligned, result) : aligned;
+}
+
+Eigen::Isometry3d StereoOdometry::DirectAlignedPose(const Eigen::Isometry3d& bridged,
+                                                    OdometryResult* result) {
+  if (scene_planes_.empty() || previous_left_.empty() || current_left_.empty()) return bridged;
+  const RobustTrackingOptions& o = options_.tracking;
+  const Clock::time_point t = Clock::now();
+  const Eigen::Vector3d up = WorldUpInCamera(T_world_prev_);
+  const double axle = o.few_point.axle_behind_camera_m;
+  const Eigen::Vector2d start =
+      VehicleMotionParameters(T_world_prev_.inverse() * bridged, up, axle);
+  if (!start.allFinite()) return bridged;
+  const DirectAlignmentResult direct =
+      AlignVehicleDirect(camera_, previous_left_, current_left_, scene_planes_, up, axle, start.x(),
+                         start.y(), o.vehicle_direct);
+  result->times.predict_ms += MsSince(t);
+  if (!direct.ok) return bridged;
+  const Eigen::Isometry3d T = VehicleMotion(up, axle, direct.yaw_rad, direct.forward_m);
+  if (!IsFinite(T)) return bridged;
+  if (has_velocity_) velocity_ = T;
+  result->direct_motion = true;
+  result->motion_measured = true;
+  return T_world_prev_ * T;
+}
+
+void StereoOdometry::UpdateScenePlanes(const Eigen::Isometry3d& T_prev_curr) {
+  std::vector<ScenePlane> fitted;
+  if (FitScenePlanes(camera_, last_features_, kScenePlaneTolerancePx, kScenePlaneMinInliers,
+                     kScenePlaneMinFraction, kScenePlaneMinSpreadM, kMaxScenePlanes, &fitted)) {
+    scene_planes_ = fitted;
+    scene_planes_age_ = 0;
+  } else if (!scene_planes_.empty() && IsFinite(T_prev_curr) &&
+             ++scene_planes_age_ <= kMaxScenePlaneAge) {
+    std::vector<ScenePlane> moved;
+    for (const ScenePlane& plane : scene_planes_) {
+      const ScenePlane m = TransformPlane(plane, T_prev_curr);
+      if (m.distance_m > 0.0) moved.push_back(m);  // the camera is still in front of it
+    }
+    scene_planes_.swap(moved);
+  } else {
+    scene_planes_.clear();
+  }
 }
 
 Eigen::Isometry3d StereoOdometry::AlignedBridgePose(const Eigen::Isometry3d& bridged,
@@ -687,6 +748,7 @@ OdometryResult StereoOdometry::Lost(OdometryResult result, const std::string& me
   matcher_->Reset();
   const Eigen::Isometry3d T_world_cam0 = BridgedPose(prior, &result, chained);
   if (result.rotation_from_shift) result.message += "; pose: prior + rotation from the image shift";
+  if (result.direct_motion) result.message += "; motion measured by direct image alignment";
   return Finish(std::move(result), T_world_cam0, start);
 }
 
@@ -829,6 +891,7 @@ OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame fram
     result.status = TrackingStatus::kRecovered;
     result.reinitialised = true;
     result.message = reason.empty() ? "re-initialised at the predicted pose" : reason;
+    if (result.direct_motion) result.message += "; motion measured by direct image alignment";
   }
   matcher_->Reset();
   const TrackUpdateResult update = window_.Start(result.frame_index, &frame.features, T_world_cam0);

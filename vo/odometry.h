@@ -80,7 +80,8 @@
 // prior in proportion to its support (tracking.reliable_min_inliers; not at all when the BA was
 // rejected), so one weak estimate just before a loss is not extrapolated over the gap, while a
 // long weakly textured stretch still updates it. Frames without a measured motion (lost and
-// re-initialised ones) are what IsLostFrame() counts. The frame after a kRecovered frame is
+// re-initialised ones, unless the direct image alignment measured them: "Ground vehicle") are
+// what IsLostFrame() counts. The frame after a kRecovered frame is
 // kTracking again.
 //
 // Few points (tracking.few_point_motion, beyond the paper; off on the free platform, on for a
@@ -106,7 +107,9 @@
 // cannot measure the motion (few-point frames, lost frames) it is a wheeled vehicle's, planar
 // about the world's up, and in the few-point fit without sideways slip. A lost frame's forward
 // step and yaw are then measured against the previous frame's features without matching them
-// (tracking.vehicle_bridge_alignment, bridge_alignment.h).
+// (tracking.vehicle_bridge_alignment, bridge_alignment.h), and then by aligning the previous
+// left image with this one on the planes of the last features (tracking.vehicle_direct_alignment,
+// direct_alignment.h): when that converges the frame's motion is measured (not a lost frame).
 //
 // Determinism: every random choice is seeded (RANSAC, plane extraction), the bundle
 // adjustment is single-threaded; the same inputs give bit-identical outputs. Global OpenCV
@@ -128,6 +131,7 @@
 #include "vo/bridge_alignment.h"
 #include "vo/bundle_adjustment.h"
 #include "vo/camera.h"
+#include "vo/direct_alignment.h"
 #include "vo/disparity.h"
 #include "vo/features.h"
 #include "vo/image_motion.h"
@@ -302,6 +306,18 @@ struct RobustTrackingOptions {
   // the axle's swing in the model a near wall's sideways flow reads as yaw (mean 0.375 -> 0.405 m).
   bool vehicle_bridge_alignment = true;
   BridgeAlignmentOptions vehicle_bridge;
+  // With vehicle_bridge_alignment, a lost (or re-initialised) frame's bridged motion is then
+  // measured by aligning the previous left image with this one directly (direct_alignment.h):
+  // the previous image's pixels with a gradient on the planes of the features (fitted in each
+  // frame with enough of them, carried by the measured or bridged motion through at most 30
+  // frames without), the vehicle's yaw and forward step by robust
+  // Gauss-Newton on the grey levels, coarse to fine. When it converges with enough pixels and a
+  // small enough covariance (vehicle_direct), the frame's motion counts as measured
+  // (motion_measured, direct_motion; it is not a lost frame) and becomes the constant velocity.
+  // A turn in front of a plain wall whose features are too few for any matcher (texture seed 3,
+  // stride 1: 1-14 a frame for 21 frames) is measured from its edges, shadows and specks.
+  bool vehicle_direct_alignment = true;
+  DirectAlignmentOptions vehicle_direct;
   // With ground_vehicle and vehicle_planar_ba, the window's bundle adjustment links
   // consecutive poses by a planar motion prior (planar_motion_prior.h): no change of roll or
   // pitch (σ vehicle_ba_tilt_sigma_deg), no step along up (σ vehicle_ba_lift_sigma_m), no
@@ -534,7 +550,8 @@ OdometryOptions ResolvePlatform(const OdometryOptions& options, double rig_axle_
 enum class TrackingStatus {
   kInitializing,  // first frame (or a frame before the first usable one): pose = initial
   kTracking,      // motion estimated against the previous frame
-  kLost,          // no motion estimate; pose = constant-velocity prediction; see `message`
+  kLost,          // not tracked: pose = constant-velocity prediction, or the direct image
+                  // alignment's measurement (OdometryResult::direct_motion); see `message`
   kRecovered,     // first frame estimated (or re-initialised) after one or more lost frames
 };
 
@@ -551,7 +568,8 @@ struct StageTimes {
   double motion_ms = 0.0;       // correspondences + RANSAC + tracks + initial-pose blend
   double ba_ms = 0.0;           // window problem + bundle adjustment
   double orientation_ms = 0.0;  // first frame only: plane-based initial orientation
-  double predict_ms = 0.0;      // predicted positions + coarse-to-fine image shift (when run)
+  double predict_ms = 0.0;      // predicted positions + coarse-to-fine image shift (when run);
+                                // a lost frame: its bridge and direct image alignment
   double guided_ms = 0.0;       // guided second pass: re-match + RANSAC
   double total_ms = 0.0;        // the whole Process / ProcessFeatures call
 };
@@ -591,7 +609,8 @@ struct OdometryResult {
   bool motion_measured = false;      // T_prev_curr was measured by matching (kTracking or a
                                      // kRecovered frame matched across the gap); false for the
                                      // first frame, lost frames and re-initialisations (their
-                                     // pose is the prior's prediction)
+                                     // pose is the prior's prediction) unless the direct image
+                                     // alignment measured them (direct_motion)
   bool reinitialised = false;        // the pipeline restarted on this frame after a loss
   bool few_point_motion = false;     // the motion came from the few-point solver with the
                                      // prior (RobustTrackingOptions::few_point_motion)
@@ -600,6 +619,9 @@ struct OdometryResult {
   bool bridge_aligned = false;       // lost or re-initialised, its forward step or yaw was
                                      // measured against the previous frame's features
                                      // (tracking.vehicle_bridge_alignment)
+  bool direct_motion = false;        // lost or re-initialised, its motion was measured by
+                                     // direct image alignment (motion_measured;
+                                     // tracking.vehicle_direct_alignment)
   int64_t chained_to_frame = -1;     // lost or re-initialised, its pose was measured against
                                      // this earlier lost frame (tracking.chain_lost_frames;
                                      // -1: not chained) ...
@@ -819,6 +841,13 @@ class StereoOdometry {
   // yaw measured against the previous frame's features (sets result->bridge_aligned); the
   // motion becomes the constant velocity.
   Eigen::Isometry3d AlignedBridgePose(const Eigen::Isometry3d& bridged, OdometryResult* result);
+  // tracking.vehicle_direct_alignment: the bridged pose measured by direct image alignment
+  // against the previous frame on scene_planes_ (sets result->direct_motion and
+  // motion_measured when it is a measurement; the motion becomes the constant velocity).
+  Eigen::Isometry3d DirectAlignedPose(const Eigen::Isometry3d& bridged, OdometryResult* result);
+  // The planes of this frame's features (last_features_), else the previous ones moved by
+  // T_prev_curr, for the next frame's direct alignment.
+  void UpdateScenePlanes(const Eigen::Isometry3d& T_prev_curr);
 
   // A lost frame: pose = constant-velocity prediction (or `chained`, see BridgedPose),
   // reference and tracks kept.
@@ -894,6 +923,10 @@ class StereoOdometry {
   PlaneOrientationResult orientation_result_;
   std::vector<Feature> last_features_;
   std::vector<Feature> previous_frame_features_;  // last_features_ of the previous call
+  // The planes of the features in the previous output's camera frame
+  // (vehicle_direct_alignment), carried for scene_planes_age_ frames since they were fitted.
+  std::vector<ScenePlane> scene_planes_;
+  int scene_planes_age_ = 0;
   std::vector<Match> last_matches_;
   std::vector<bool> last_inlier_mask_;
   std::vector<Feature> last_reference_features_;

@@ -45,7 +45,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
   std::map<std::string, int> counts;
   CountLeaves(yaml, "", &counts);
   const Covered covered[] = {
-      {"", "OdometryOptions", sizeof(vo::OdometryOptions), 1576, 25},
+      {"", "OdometryOptions", sizeof(vo::OdometryOptions), 1680, 25},
       {"detector", "DetectorOptions", sizeof(vo::DetectorOptions), 128, 6},
       {"detector.harris", "HarrisOptions", sizeof(vo::HarrisOptions), 64, 10},
       {"detector.sift", "SiftOptions", sizeof(vo::SiftOptions), 40, 5},
@@ -64,11 +64,13 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
       {"ba", "BundleAdjustmentOptions", sizeof(vo::BundleAdjustmentOptions), 88, 13},
       {"orientation", "PlaneOrientationOptions", sizeof(vo::PlaneOrientationOptions), 80, 9},
       {"floor_refinement", "PlaneRefinementOptions", sizeof(vo::PlaneRefinementOptions), 88, 11},
-      {"tracking", "RobustTrackingOptions", sizeof(vo::RobustTrackingOptions), 424, 33},
+      {"tracking", "RobustTrackingOptions", sizeof(vo::RobustTrackingOptions), 528, 34},
       {"tracking.few_point", "PriorMotionOptions", sizeof(vo::PriorMotionOptions), 80, 10},
       {"tracking.image_shift", "ImageShiftOptions", sizeof(vo::ImageShiftOptions), 56, 8},
       {"tracking.vehicle_bridge", "BridgeAlignmentOptions", sizeof(vo::BridgeAlignmentOptions), 32,
        4},
+      {"tracking.vehicle_direct", "DirectAlignmentOptions", sizeof(vo::DirectAlignmentOptions), 96,
+       13},
   };
   int total = 0;
   for (const Covered& c : covered) {

@@ -12,26 +12,19 @@
 namespace vo {
 namespace {
 
+using test::FeatureAt;
 using test::TestCamera;
 
 constexpr double kDeg = M_PI / 180.0;
 const Eigen::Vector3d kUp(0.0, -1.0, 0.0);  // camera frame: y down, a level camera
 constexpr double kAxleM = 0.15;             // the camera 0.15 m ahead of the wheel axle
 
-// A feature of `camera` at p (camera frame, metres): its pixel, disparity and point.
-Feature At(const StereoCamera& camera, const Eigen::Vector3d& p) {
-  Feature f;
-  EXPECT_TRUE(camera.ProjectLeft(p, &f.uv_px));
-  f.disparity_px = camera.DisparityFromDepth(p.z());
-  f.p_cam0 = p;
-  return f;
-}
-
 // The same points seen after the motion T_prev_curr (p_prev = T · p_curr).
 std::vector<Feature> Moved(const StereoCamera& camera, const std::vector<Eigen::Vector3d>& points,
                            const Eigen::Isometry3d& T_prev_curr) {
   std::vector<Feature> out;
-  for (const Eigen::Vector3d& p : points) out.push_back(At(camera, T_prev_curr.inverse() * p));
+  for (const Eigen::Vector3d& p : points)
+    out.push_back(FeatureAt(camera, T_prev_curr.inverse() * p));
   return out;
 }
 

@@ -1010,6 +1010,69 @@ TEST(OdometryLostTest, GroundVehicleMeasuresALostFrameAgainstThePreviousFeatures
   EXPECT_GT((bridged[5].T_prev_curr.translation() - truth.translation()).norm(), 0.025);
 }
 
+// A ground vehicle turns in place in front of the corridor's end wall (1 m ahead, the camera
+// 0.3 m above the floor and 0.15 m ahead of the axle), 1° a frame, then faster (2.5° a frame)
+// while frames 4-6 have no depth (their right images black: no feature has a disparity, so no
+// matcher can measure them). The previous frames' features lie on the wall: its plane, and the
+// left images, measure those frames directly (tracking.vehicle_direct_alignment): the true
+// motion, not the constant velocity's 1° a frame, and they are not lost frames. Without it they
+// are lost and bridged.
+TEST(OdometryLostTest, GroundVehicleMeasuresFramesWithoutDepthByDirectAlignment) {
+  const StereoCamera cam = HallwayCamera();
+  constexpr double kAxleM = 0.15;
+  const Eigen::Vector3d up_cam(0.0, -1.0, 0.0);
+  std::vector<Eigen::Isometry3d> poses = {
+      MakePose(R_hall_cam(0.0), Eigen::Vector3d(CorridorRenderer::kXMax - 1.0, 0.0, 0.3))};
+  for (int i = 1; i <= 8; ++i) {
+    const double yaw = (i >= 4 && i <= 7 ? 2.5 : 1.0) * kDeg;
+    poses.push_back(poses.back() * VehicleMotion(up_cam, kAxleM, yaw, 0.0));
+  }
+  const CorridorRenderer renderer;
+  std::vector<StereoFrame> frames(poses.size());
+  for (size_t i = 0; i < poses.size(); ++i) {
+    renderer.Render(cam, poses[i], &frames[i].left, &frames[i].right);
+    if (i >= 4 && i <= 6) frames[i].right = cv::Mat::zeros(frames[i].right.size(), CV_8UC1);
+  }
+  auto run = [&](bool direct) {
+    OdometryOptions options;
+    options.tracking.ground_vehicle = true;
+    options.tracking.few_point.axle_behind_camera_m = kAxleM;
+    options.tracking.vehicle_direct_alignment = direct;
+    options.orientation_up_from_mounting = true;  // where the floor is not found
+    options.orientation.expected_up_cam0 = up_cam;
+    StereoOdometry vo(cam, options);
+    std::vector<OdometryResult> results;
+    for (size_t i = 0; i < frames.size(); ++i)
+      results.push_back(vo.Process(frames[i].left, frames[i].right, 0.1 * i));
+    return results;
+  };
+  const std::vector<OdometryResult> direct = run(true);
+  ASSERT_TRUE(direct[0].initial_orientation_ok) << direct[0].message;
+  for (int i = 1; i <= 3; ++i) {
+    ASSERT_EQ(direct[i].status, TrackingStatus::kTracking) << i << ": " << direct[i].message;
+  }
+  for (int i = 4; i <= 6; ++i) {
+    EXPECT_EQ(direct[i].status, TrackingStatus::kLost) << i;
+    EXPECT_EQ(direct[i].num_features_with_depth, 0) << i;
+    EXPECT_TRUE(direct[i].direct_motion) << i << ": " << direct[i].message;
+    EXPECT_TRUE(direct[i].motion_measured) << i;
+    EXPECT_FALSE(IsLostFrame(direct[i])) << i;
+    EXPECT_THAT(direct[i].message, ::testing::HasSubstr("direct image alignment")) << i;
+    EXPECT_THAT(
+        direct[i].T_prev_curr,
+        IsNearPose(Eigen::Isometry3d(poses[i - 1].inverse() * poses[i]), 0.02 * kDeg, 0.001))
+        << i;
+  }
+  EXPECT_EQ(direct[7].status, TrackingStatus::kRecovered) << direct[7].message;
+  EXPECT_TRUE(direct[7].motion_measured) << direct[7].message;
+  // Without it: lost, their poses bridged.
+  const std::vector<OdometryResult> bridged = run(false);
+  for (int i = 4; i <= 6; ++i) {
+    EXPECT_FALSE(bridged[i].direct_motion) << i;
+    EXPECT_TRUE(IsLostFrame(bridged[i])) << i;
+  }
+}
+
 // A vehicle's drive through a hallway: the camera 0.5 m up, 0.3° of yaw and 5 cm a frame, the
 // axle kAxleM behind it; side walls 1 m away, an end wall at 12 m and the floor (with `ceiling`,
 // a ceiling 1.5 m above the camera instead). Every frame but the first gets 0.3 px of noise on

@@ -1,10 +1,13 @@
 // Helpers shared by the vo/ tests: the synthetic stereo head and Gaussian noise.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 
 #include "vo/camera.h"
 #include "vo/ransac.h"
+#include "vo/types.h"
 
 namespace vo {
 namespace test {
@@ -27,6 +30,15 @@ inline double Normal(SplitMix64* rng) {
   const double u1 = 1.0 - rng->Uniform();
   const double u2 = rng->Uniform();
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+// A feature of `camera` at p (camera frame, metres): its pixel, exact disparity and point.
+inline Feature FeatureAt(const StereoCamera& camera, const Eigen::Vector3d& p) {
+  Feature f;
+  EXPECT_TRUE(camera.ProjectLeft(p, &f.uv_px));
+  f.disparity_px = camera.DisparityFromDepth(p.z());
+  f.p_cam0 = p;
+  return f;
 }
 
 }  // namespace test

@@ -1,0 +1,480 @@
+#include "vo/direct_alignment.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <sstream>
+
+#include "vo/prior_motion.h"
+
+namespace vo {
+
+bool DirectAlignmentOptions::IsValid(std::string* error) const {
+  std::string e;
+  if (pyramid_levels < 1 || pyramid_levels > 6)
+    e = "pyramid_levels must be in 1..6";
+  else if (!(min_gradient > 0.0))
+    e = "min_gradient must be > 0";
+  else if (max_pixels < 1)
+    e = "max_pixels must be >= 1";
+  else if (max_iterations < 1)
+    e = "max_iterations must be >= 1";
+  else if (!(huber_k > 0.0))
+    e = "huber_k must be > 0";
+  else if (!(tukey_k >= 0.0))
+    e = "tukey_k must be >= 0";
+  else if (min_pixels < 1)
+    e = "min_pixels must be >= 1";
+  else if (!(max_yaw_sigma_deg > 0.0))
+    e = "max_yaw_sigma_deg must be > 0";
+  else if (!(max_forward_sigma_m > 0.0))
+    e = "max_forward_sigma_m must be > 0";
+  else if (!(max_yaw_change_deg > 0.0))
+    e = "max_yaw_change_deg must be > 0";
+  else if (!(max_forward_change_m > 0.0))
+    e = "max_forward_change_m must be > 0";
+  else if (!(min_depth_m > 0.0) || !(max_depth_m > min_depth_m))
+    e = "need 0 < min_depth_m < max_depth_m";
+  if (!e.empty() && error != nullptr) *error = e;
+  return e.empty();
+}
+
+ScenePlane TransformPlane(const ScenePlane& plane_a, const Eigen::Isometry3d& T_a_b) {
+  // n·(R p_b + t) = d  ⇔  (Rᵀ n)·p_b = d − n·t.
+  ScenePlane b = plane_a;
+  b.normal = T_a_b.linear().transpose() * plane_a.normal;
+  b.distance_m = plane_a.distance_m - plane_a.normal.dot(T_a_b.translation());
+  return b;
+}
+
+namespace {
+
+// A pyramid level: the image (float, lightly smoothed at level 0) and its gradients, with the
+// camera's intrinsics at that scale.
+struct Level {
+  cv::Mat image, gx, gy;  // CV_32F
+  double fx, fy, cx, cy;
+};
+
+std::vector<Level> Pyramid(const cv::Mat& image8, const StereoCamera& camera, int levels) {
+  std::vector<Level> pyramid(levels);
+  cv::Mat f;
+  image8.convertTo(f, CV_32F);
+  cv::GaussianBlur(f, pyramid[0].image, cv::Size(3, 3), 0.8, 0.8, cv::BORDER_REPLICATE);
+  for (int l = 1; l < levels; ++l) cv::pyrDown(pyramid[l - 1].image, pyramid[l].image);
+  for (int l = 0; l < levels; ++l) {
+    Level& L = pyramid[l];
+    // Central differences: (I(x+1) − I(x−1)) / 2.
+    cv::Sobel(L.image, L.gx, CV_32F, 1, 0, 1, 0.5, 0.0, cv::BORDER_REPLICATE);
+    cv::Sobel(L.image, L.gy, CV_32F, 0, 1, 1, 0.5, 0.0, cv::BORDER_REPLICATE);
+    const double s = 1.0 / static_cast<double>(1 << l);
+    L.fx = camera.fx_px * s;
+    L.fy = camera.fy_px * s;
+    L.cx = camera.cx_px * s;  // pyrDown's pixel j is centred on pixel 2j of the level below
+    L.cy = camera.cy_px * s;
+  }
+  return pyramid;
+}
+
+// Bilinear sample of a CV_32F image; false outside [0, size − 1).
+bool Sample(const cv::Mat& m, double x, double y, double* value) {
+  if (!(x >= 0.0 && y >= 0.0 && x < m.cols - 1.0 && y < m.rows - 1.0)) return false;
+  const int x0 = static_cast<int>(x);
+  const int y0 = static_cast<int>(y);
+  const double ax = x - x0;
+  const double ay = y - y0;
+  const float* r0 = m.ptr<float>(y0);
+  const float* r1 = m.ptr<float>(y0 + 1);
+  *value = (1.0 - ay) * ((1.0 - ax) * r0[x0] + ax * r0[x0 + 1]) +
+           ay * ((1.0 - ax) * r1[x0] + ax * r1[x0 + 1]);
+  return true;
+}
+
+struct PlanePixel {
+  Eigen::Vector3d p_prev;  // the pixel's point on the plane (previous camera frame)
+  double intensity;        // previous image's grey level
+};
+
+// The previous level's pixels with a gradient, on the plane within the depth range.
+std::vector<PlanePixel> SelectPixels(const Level& L, const std::vector<ScenePlane>& planes,
+                                     const DirectAlignmentOptions& o) {
+  std::vector<PlanePixel> pixels;
+  const int border = 2;
+  const double g2 = o.min_gradient * o.min_gradient;
+  for (int v = border; v < L.image.rows - border; ++v) {
+    const float* gx = L.gx.ptr<float>(v);
+    const float* gy = L.gy.ptr<float>(v);
+    const float* im = L.image.ptr<float>(v);
+    for (int u = border; u < L.image.cols - border; ++u) {
+      if (static_cast<double>(gx[u]) * gx[u] + static_cast<double>(gy[u]) * gy[u] < g2) continue;
+      const Eigen::Vector3d ray((u - L.cx) / L.fx, (v - L.cy) / L.fy, 1.0);
+      // The nearest plane in front along the ray: the surface seen from inside a convex room.
+      double z = std::numeric_limits<double>::infinity();
+      for (const ScenePlane& plane : planes) {
+        const double denominator = plane.normal.dot(ray);
+        if (denominator > 1e-9) z = std::min(z, plane.distance_m / denominator);
+      }
+      if (!(z >= o.min_depth_m && z <= o.max_depth_m)) continue;
+      pixels.push_back(PlanePixel{z * ray, im[u]});
+    }
+  }
+  if (static_cast<int>(pixels.size()) > o.max_pixels) {  // evenly thinned, deterministic
+    std::vector<PlanePixel> thinned;
+    thinned.reserve(o.max_pixels);
+    const double step = static_cast<double>(pixels.size()) / o.max_pixels;
+    for (int k = 0; k < o.max_pixels; ++k) thinned.push_back(pixels[static_cast<size_t>(k * step)]);
+    pixels.swap(thinned);
+  }
+  return pixels;
+}
+
+bool Project(const Level& L, const Eigen::Isometry3d& T_curr_prev, const Eigen::Vector3d& p_prev,
+             Eigen::Vector2d* uv) {
+  const Eigen::Vector3d p = T_curr_prev * p_prev;
+  if (!(p.z() > 1e-3)) return false;
+  *uv = Eigen::Vector2d(L.fx * p.x() / p.z() + L.cx, L.fy * p.y() / p.z() + L.cy);
+  return true;
+}
+
+// The pixels that (yaw, forward) = theta moves at least 3 pixels inside the current image: the
+// level's fixed set (a pixel that leaves the view later costs as an outlier, Linearise).
+std::vector<PlanePixel> InView(const Level& curr_level, std::vector<PlanePixel> pixels,
+                               const Eigen::Vector3d& up, double axle,
+                               const Eigen::Vector2d& theta) {
+  const Eigen::Isometry3d T = VehicleMotion(up, axle, theta.x(), theta.y()).inverse();
+  const double margin = 3.0;
+  std::vector<PlanePixel> kept;
+  for (const PlanePixel& px : pixels) {
+    Eigen::Vector2d uv;
+    if (Project(curr_level, T, px.p_prev, &uv) && uv.x() >= margin && uv.y() >= margin &&
+        uv.x() <= curr_level.image.cols - 1 - margin &&
+        uv.y() <= curr_level.image.rows - 1 - margin) {
+      kept.push_back(px);
+    }
+  }
+  return kept;
+}
+
+double RobustSigma(std::vector<double> abs_residuals) {
+  if (abs_residuals.empty()) return 1.0;
+  const size_t mid = abs_residuals.size() / 2;
+  std::nth_element(abs_residuals.begin(), abs_residuals.begin() + mid, abs_residuals.end());
+  return std::max(1.0, 1.4826 * abs_residuals[mid]);  // at least one grey level
+}
+
+// One level's residuals, optionally with Jacobians, for parameters (yaw, forward).
+struct Linearisation {
+  int n = 0;
+  double cost = 0.0;  // Σ Huber ρ
+  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d g = Eigen::Vector2d::Zero();
+  std::vector<double> abs_residuals;
+};
+
+Linearisation Linearise(const Level& curr_level, const std::vector<PlanePixel>& pixels,
+                        const Eigen::Vector3d& up, double axle, const Eigen::Vector2d& theta,
+                        double threshold, bool tukey, bool jacobians) {
+  Linearisation lin;
+  const Eigen::Isometry3d T = VehicleMotion(up, axle, theta.x(), theta.y()).inverse();
+  constexpr double kEpsYaw = 1e-5;
+  constexpr double kEpsForward = 1e-5;
+  Eigen::Isometry3d T_yaw, T_forward;
+  if (jacobians) {
+    T_yaw = VehicleMotion(up, axle, theta.x() + kEpsYaw, theta.y()).inverse();
+    T_forward = VehicleMotion(up, axle, theta.x(), theta.y() + kEpsForward).inverse();
+  }
+  lin.abs_residuals.reserve(pixels.size());
+  for (const PlanePixel& px : pixels) {
+    Eigen::Vector2d uv;
+    double value = 0.0;
+    if (!Project(curr_level, T, px.p_prev, &uv) ||
+        !Sample(curr_level.image, uv.x(), uv.y(), &value)) {
+      // Out of view: the cost of a residual of 3 thresholds (Tukey: its ceiling), so that a step
+      // gains nothing by pushing badly matched pixels out of the image.
+      lin.cost += tukey ? threshold * threshold / 6.0 : threshold * (3.0 - 0.5) * threshold;
+      continue;
+    }
+    const double r = value - px.intensity;
+    const double a = std::abs(r);
+    double w = 0.0;
+    if (tukey) {  // Tukey's biweight: residuals beyond the threshold have no weight
+      const double q = a < threshold ? 1.0 - (r / threshold) * (r / threshold) : 0.0;
+      w = q * q;
+      lin.cost += threshold * threshold / 6.0 * (1.0 - q * q * q);
+    } else {  // Huber
+      w = a <= threshold ? 1.0 : threshold / a;
+      lin.cost += a <= threshold ? 0.5 * r * r : threshold * (a - 0.5 * threshold);
+    }
+    lin.abs_residuals.push_back(a);
+    ++lin.n;
+    if (!jacobians) continue;
+    Eigen::Vector2d uv_yaw, uv_forward;
+    double gx = 0.0, gy = 0.0;
+    if (!Project(curr_level, T_yaw, px.p_prev, &uv_yaw) ||
+        !Project(curr_level, T_forward, px.p_prev, &uv_forward) ||
+        !Sample(curr_level.gx, uv.x(), uv.y(), &gx) ||
+        !Sample(curr_level.gy, uv.x(), uv.y(), &gy)) {
+      continue;
+    }
+    const Eigen::Vector2d grad(gx, gy);
+    const Eigen::Vector2d J(grad.dot(uv_yaw - uv) / kEpsYaw,
+                            grad.dot(uv_forward - uv) / kEpsForward);
+    lin.H += w * J * J.transpose();
+    lin.g += w * J * r;
+  }
+  return lin;
+}
+
+}  // namespace
+
+DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::Mat& prev,
+                                         const cv::Mat& curr, const std::vector<ScenePlane>& planes,
+                                         const Eigen::Vector3d& up_prev,
+                                         double axle_behind_camera_m, double yaw0_rad,
+                                         double forward0_m, const DirectAlignmentOptions& options) {
+  DirectAlignmentResult result;
+  result.yaw_rad = yaw0_rad;
+  result.forward_m = forward0_m;
+  std::string error;
+  if (!options.IsValid(&error)) {
+    result.message = "invalid options: " + error;
+    return result;
+  }
+  if (prev.empty() || curr.empty() || prev.type() != CV_8UC1 || curr.type() != CV_8UC1 ||
+      prev.size() != curr.size() || prev.cols != camera.width || prev.rows != camera.height) {
+    result.message = "images must be 8-bit grey of the camera's size";
+    return result;
+  }
+  std::vector<ScenePlane> unit;
+  for (const ScenePlane& plane : planes) {
+    if (!plane.normal.allFinite() || !(plane.normal.norm() > 0.5) || !(plane.distance_m > 0.0) ||
+        !std::isfinite(plane.distance_m)) {
+      result.message = "invalid plane";
+      return result;
+    }
+    unit.push_back(plane);
+    unit.back().distance_m /= plane.normal.norm();
+    unit.back().normal.normalize();
+  }
+  if (unit.empty() || !up_prev.allFinite() || !(up_prev.norm() > 0.0) || !std::isfinite(yaw0_rad) ||
+      !std::isfinite(forward0_m)) {
+    result.message = "no plane, or an invalid up or start";
+    return result;
+  }
+  // Levels that keep at least 40 pixels across.
+  int levels = options.pyramid_levels;
+  while (levels > 1 && (std::min(camera.width, camera.height) >> (levels - 1)) < 40) --levels;
+  const std::vector<Level> P = Pyramid(prev, camera, levels);
+  const std::vector<Level> C = Pyramid(curr, camera, levels);
+  const Eigen::Vector3d up = up_prev.normalized();
+
+  Eigen::Vector2d theta(yaw0_rad, forward0_m);
+  for (int l = levels - 1; l >= 0; --l) {
+    const std::vector<PlanePixel> pixels =
+        InView(C[l], SelectPixels(P[l], unit, options), up, axle_behind_camera_m, theta);
+    if (pixels.empty()) continue;
+    // Huber weights on every level; on the finest, then Tukey's biweight (tukey_k > 0), which
+    // gives the pixels off the plane (the floor below a wall) no weight at all.
+    const int passes = l == 0 && options.tukey_k > 0.0 ? 2 : 1;
+    double threshold = 0.0;
+    bool tukey = false;
+    for (int pass = 0; pass < passes; ++pass) {
+      tukey = pass == 1;
+      const double sigma =
+          RobustSigma(Linearise(C[l], pixels, up, axle_behind_camera_m, theta, 1e300, false, false)
+                          .abs_residuals);
+      threshold = (tukey ? options.tukey_k : options.huber_k) * sigma;
+      bool converged = false;
+      for (int it = 0; it < options.max_iterations && !converged; ++it) {
+        ++result.iterations;
+        const Linearisation lin =
+            Linearise(C[l], pixels, up, axle_behind_camera_m, theta, threshold, tukey, true);
+        if (lin.n < 3 || !(lin.H.determinant() > 0.0)) break;
+        Eigen::Vector2d step = -lin.H.ldlt().solve(lin.g);
+        if (!step.allFinite()) break;
+        bool improved = false;
+        for (int halving = 0; halving < 6 && !improved; ++halving, step *= 0.5) {
+          const Linearisation trial = Linearise(C[l], pixels, up, axle_behind_camera_m,
+                                                theta + step, threshold, tukey, false);
+          if (trial.cost < lin.cost) {
+            theta += step;
+            improved = true;
+          }
+        }
+        converged = !improved || (std::abs(step.x()) < 1e-7 && std::abs(step.y()) < 1e-7);
+      }
+    }
+    if (l > 0) continue;
+    // The finest level: the measurement's support and uncertainty.
+    const Linearisation final_lin =
+        Linearise(C[0], pixels, up, axle_behind_camera_m, theta, threshold, tukey, true);
+    result.pixels = final_lin.n;
+    result.residual_sigma = RobustSigma(final_lin.abs_residuals);
+    if (final_lin.n >= 3 && final_lin.H.determinant() > 0.0) {
+      // The robustly weighted information, the robust residual variance.
+      const Eigen::Matrix2d covariance =
+          result.residual_sigma * result.residual_sigma * final_lin.H.inverse();
+      result.yaw_sigma_rad = std::sqrt(std::max(0.0, covariance(0, 0)));
+      result.forward_sigma_m = std::sqrt(std::max(0.0, covariance(1, 1)));
+    } else {
+      result.yaw_sigma_rad = result.forward_sigma_m = std::numeric_limits<double>::infinity();
+    }
+  }
+  if (!theta.allFinite()) {
+    result.message = "did not converge";
+    return result;
+  }
+  std::ostringstream why;
+  if (result.pixels < options.min_pixels) {
+    why << result.pixels << " pixels in view (need " << options.min_pixels << ")";
+  } else if (result.yaw_sigma_rad > options.max_yaw_sigma_deg * M_PI / 180.0 ||
+             result.forward_sigma_m > options.max_forward_sigma_m) {
+    why << "uncertain: sigma(yaw) " << result.yaw_sigma_rad * 180.0 / M_PI
+        << " deg, sigma(forward) " << result.forward_sigma_m << " m";
+  } else if (std::abs(theta.x() - yaw0_rad) > options.max_yaw_change_deg * M_PI / 180.0 ||
+             std::abs(theta.y() - forward0_m) > options.max_forward_change_m) {
+    why << "moved too far from the start (yaw " << (theta.x() - yaw0_rad) * 180.0 / M_PI
+        << " deg, forward " << theta.y() - forward0_m << " m)";
+  }
+  result.message = why.str();
+  result.ok = result.message.empty();
+  if (result.ok) {
+    result.yaw_rad = theta.x();
+    result.forward_m = theta.y();
+  }
+  return result;
+}
+
+namespace {
+
+// RANSAC over triples of `f` (deterministic), refined by least squares on the inliers: the
+// plane and its inliers (indices into f). False when fewer than max(3, min_inliers) lie on the
+// best plane or its inliers spread less than min_spread_m across their second principal axis.
+bool FitPlane(const StereoCamera& camera, const std::vector<const Feature*>& f, double tolerance_px,
+              int min_inliers, double min_spread_m, ScenePlane* plane, std::vector<int>* inliers) {
+  const int n = static_cast<int>(f.size());
+  if (n < std::max(3, min_inliers)) return false;
+  const double fb = camera.fx_px * camera.baseline_m;
+  // Disparity of the plane n·X = d at a feature's pixel: fb / z with z = d / (n·ray).
+  auto on_plane = [&](const Eigen::Vector3d& normal, double d, const Feature& x) {
+    const Eigen::Vector3d ray = x.p_cam0 / x.p_cam0.z();
+    const double denominator = normal.dot(ray);
+    if (!(d > 0.0) || !(denominator > 1e-9)) return false;
+    return std::abs(fb * denominator / d - x.disparity_px) <= tolerance_px;
+  };
+  std::mt19937 rng(12345u);
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  // At most 200 triples, fewer once the best plane's share w makes a triple of its inliers
+  // drawn with probability 0.999 (the usual adaptive count log(0.001) / log(1 − w³)).
+  int trials = std::min(200, n * (n - 1) * (n - 2) / 6 * 2);
+  int best = 0;
+  Eigen::Vector3d best_normal = Eigen::Vector3d::UnitZ();
+  double best_d = 0.0;
+  for (int t = 0; t < trials; ++t) {
+    const int a = pick(rng), b = pick(rng), c = pick(rng);
+    if (a == b || b == c || a == c) continue;
+    Eigen::Vector3d normal = (f[b]->p_cam0 - f[a]->p_cam0).cross(f[c]->p_cam0 - f[a]->p_cam0);
+    if (!(normal.norm() > 1e-9)) continue;
+    normal.normalize();
+    double d = normal.dot(f[a]->p_cam0);
+    if (d < 0.0) {
+      normal = -normal;
+      d = -d;
+    }
+    int count = 0;
+    for (const Feature* x : f) count += on_plane(normal, d, *x) ? 1 : 0;
+    if (count > best) {
+      best = count;
+      best_normal = normal;
+      best_d = d;
+      const double w = static_cast<double>(best) / n;
+      const double miss = 1.0 - w * w * w;
+      if (miss < 1e-12) break;
+      trials = std::min(trials, static_cast<int>(std::ceil(std::log(1e-3) / std::log(miss))));
+    }
+  }
+  if (best < std::max(3, min_inliers)) return false;
+  inliers->clear();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    if (!on_plane(best_normal, best_d, *f[i])) continue;
+    inliers->push_back(i);
+    mean += f[i]->p_cam0;
+  }
+  mean /= static_cast<double>(inliers->size());
+  Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+  for (int i : *inliers) S += (f[i]->p_cam0 - mean) * (f[i]->p_cam0 - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(S);  // ascending eigenvalues
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  double d = normal.dot(mean);
+  if (d < 0.0) {
+    normal = -normal;
+    d = -d;
+  }
+  const double spread =
+      std::sqrt(std::max(0.0, eig.eigenvalues()(1)) / static_cast<double>(inliers->size()));
+  if (!(spread >= min_spread_m) || !(d > 0.0) || !normal.allFinite()) return false;
+  plane->normal = normal;
+  plane->distance_m = d;
+  plane->inliers = static_cast<int>(inliers->size());
+  return true;
+}
+
+std::vector<const Feature*> WithDepth(const std::vector<Feature>& features) {
+  std::vector<const Feature*> f;
+  for (const Feature& x : features) {
+    if (x.has_depth() && x.p_cam0.allFinite() && x.uv_px.allFinite() && x.p_cam0.z() > 0.0)
+      f.push_back(&x);
+  }
+  return f;
+}
+
+}  // namespace
+
+bool FitDominantPlane(const StereoCamera& camera, const std::vector<Feature>& features,
+                      double tolerance_px, int min_inliers, double min_fraction,
+                      double min_spread_m, ScenePlane* plane) {
+  const std::vector<const Feature*> f = WithDepth(features);
+  std::vector<int> inliers;
+  ScenePlane fitted;
+  if (plane == nullptr ||
+      !FitPlane(camera, f, tolerance_px, min_inliers, min_spread_m, &fitted, &inliers) ||
+      fitted.inliers < min_fraction * static_cast<double>(f.size())) {
+    return false;
+  }
+  *plane = fitted;
+  return true;
+}
+
+bool FitScenePlanes(const StereoCamera& camera, const std::vector<Feature>& features,
+                    double tolerance_px, int min_inliers, double min_fraction, double min_spread_m,
+                    int max_planes, std::vector<ScenePlane>* planes) {
+  if (planes == nullptr) return false;
+  std::vector<const Feature*> remaining = WithDepth(features);
+  const double total = static_cast<double>(remaining.size());
+  std::vector<ScenePlane> found;
+  int on_planes = 0;
+  while (static_cast<int>(found.size()) < max_planes) {
+    ScenePlane plane;
+    std::vector<int> inliers;
+    if (!FitPlane(camera, remaining, tolerance_px, min_inliers, min_spread_m, &plane, &inliers))
+      break;
+    found.push_back(plane);
+    on_planes += plane.inliers;
+    std::vector<bool> used(remaining.size(), false);
+    for (int i : inliers) used[i] = true;
+    std::vector<const Feature*> rest;
+    for (size_t i = 0; i < remaining.size(); ++i) {
+      if (!used[i]) rest.push_back(remaining[i]);
+    }
+    remaining.swap(rest);
+  }
+  if (found.empty() || on_planes < min_fraction * total) return false;
+  *planes = found;
+  return true;
+}
+
+}  // namespace vo

@@ -1,0 +1,117 @@
+// A ground vehicle's motion measured by aligning two images directly (photometrically), for the
+// frames that have too few features for any matcher: a robot turning in front of a plain wall.
+//
+// l_hallway texture seed 3, stride 1, frames 209-229: the view is the end wall, 1-14 features
+// with depth a frame (too few for RANSAC and, after the first loss, for the few-point solver),
+// yet the images hold the lower edge of a picture frame, a poster's corner, shadows, a socket and
+// a few specks. The feature-based bridge (bridge_alignment.h) needs three features paired per
+// frame; the prior carried the braking robot's cruise step (18 mm a frame for -2) and 0.6 deg a
+// frame too much yaw through the gap. Every pixel with a gradient says something, though, once
+// its depth is known: on a wall, the plane through the last features with depth gives it.
+//
+// The model. The previous left image's pixels x with a gradient lie on the scene's planes
+// n·X = d (previous camera frame, |n| = 1, d > 0; the planes of the features, FitScenePlanes: a
+// wall, the floor; carried through the frames with too few features by their motion); a pixel's
+// point X(x) is where its ray meets the nearest of them (the surface seen from inside a convex
+// room: a hallway's floor, walls and end wall). The vehicle's motion
+// T = VehicleMotion(up, axle, yaw, forward) (prior_motion.h: a yaw about up and a forward step of
+// the axle, no sideways slip) moves X into the current camera, where the current image should
+// show the same grey level:
+//     r(x) = I_curr(π(T⁻¹ · X(x))) − I_prev(x).
+// (yaw, forward) minimise Σ ρ(r) by Gauss-Newton, coarse to fine on an image pyramid (pyrDown),
+// from the caller's start (the bridged motion): Huber's ρ on every level (its scale from the
+// residuals' median absolute deviation at the start), then on the finest level Tukey's biweight,
+// so the pixels that lie on no fitted plane (an object in front of the wall) have no weight. This
+// is a direct method (as in LSD-SLAM or DSO; here two parameters and a few planes) beyond the
+// paper, which has no answer for a view without features.
+//
+// Whether the result is a measurement: it converged on the finest level, at least min_pixels
+// pixels took part, the Gauss-Newton covariance (the robust residual variance times the inverse
+// information) gives σ(yaw) <= max_yaw_sigma_deg and σ(forward) <= max_forward_sigma_m, and the
+// result moved no further than max_yaw_change_deg / max_forward_change_m from the start (a
+// wrong basin of a repeating texture). Deterministic; O(iterations · pixels).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "vo/camera.h"
+#include "vo/tracks.h"
+
+namespace vo {
+
+struct DirectAlignmentOptions {
+  int pyramid_levels = 3;              // coarse-to-fine levels (1 = full resolution only), 1..6
+  double min_gradient = 4.0;           // a pixel takes part when its grey-level gradient
+                                       // (central differences, lightly smoothed) is at least
+                                       // this (grey levels per pixel of its level), > 0
+  int max_pixels = 6000;               // at most this many pixels per level (evenly thinned), > 0
+  int max_iterations = 30;             // Gauss-Newton iterations per level, >= 1
+  double huber_k = 1.345;              // Huber threshold in robust σ of the residuals, > 0
+  double tukey_k = 4.685;              // the finest level is then refined with Tukey's
+                                       // biweight at this many robust σ, >= 0 (0: Huber only)
+  int min_pixels = 200;                // finest level: fewer pixels in view: no measurement, >= 1
+  double max_yaw_sigma_deg = 0.05;     // finest level's σ(yaw) above this: no measurement, > 0
+  double max_forward_sigma_m = 0.002;  // finest level's σ(forward) above this: none, > 0
+  double max_yaw_change_deg = 3.0;     // a result further than this from the start: none, > 0
+  double max_forward_change_m = 0.05;  // the same for the forward step (metres), > 0
+  double min_depth_m = 0.1;            // pixels whose depth on the planes is outside [min, max]
+  double max_depth_m = 20.0;           // are not used (metres), 0 < min < max
+
+  bool IsValid(std::string* error) const;
+};
+
+// A plane n·X = d in a camera frame (|n| = 1, d > 0: the camera is on the side n points away
+// from).
+struct ScenePlane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double distance_m = 0.0;
+  int inliers = 0;  // features on it when fitted
+};
+
+struct DirectAlignmentResult {
+  bool ok = false;       // a measurement (see the header comment)
+  double yaw_rad = 0.0;  // the result (the start when not ok)
+  double forward_m = 0.0;
+  int pixels = 0;               // finest level's pixels in view
+  int iterations = 0;           // over all levels
+  double residual_sigma = 0.0;  // finest level's robust σ of the residuals (grey levels)
+  double yaw_sigma_rad = 0.0;   // finest level's Gauss-Newton σ
+  double forward_sigma_m = 0.0;
+  std::string message;  // why not ok
+};
+
+// (yaw, forward) of the vehicle motion T_prev_curr = VehicleMotion(up_prev, axle_behind_camera_m,
+// yaw, forward) that aligns `curr` with `prev` (8-bit grey left images of the same size as the
+// camera's), the previous image's pixels on `planes` (previous camera frame), starting at
+// (yaw0_rad, forward0_m).
+DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::Mat& prev,
+                                         const cv::Mat& curr, const std::vector<ScenePlane>& planes,
+                                         const Eigen::Vector3d& up_prev,
+                                         double axle_behind_camera_m, double yaw0_rad,
+                                         double forward0_m, const DirectAlignmentOptions& options);
+
+// The plane that most features with depth lie on (camera frame): a feature is on it when its
+// disparity is within tolerance_px of the plane's at its pixel. Deterministic RANSAC over
+// triples, refined by least squares on the inliers. False when fewer than min_inliers features
+// (>= 3) or fewer than min_fraction of them lie on the best plane, or when the inliers are all
+// near one line (the plane would turn about it freely: their second principal spread below
+// min_spread_m).
+bool FitDominantPlane(const StereoCamera& camera, const std::vector<Feature>& features,
+                      double tolerance_px, int min_inliers, double min_fraction,
+                      double min_spread_m, ScenePlane* plane);
+
+// Up to max_planes planes of the features, one after the other (FitDominantPlane's test on
+// the features no earlier plane took): a hallway's floor, walls and end wall. False (planes
+// unchanged) when none is found or fewer than min_fraction of the features lie on them.
+bool FitScenePlanes(const StereoCamera& camera, const std::vector<Feature>& features,
+                    double tolerance_px, int min_inliers, double min_fraction, double min_spread_m,
+                    int max_planes, std::vector<ScenePlane>* planes);
+
+// The plane of frame a (n·X_a = d) in frame b, for p_a = T_a_b · p_b.
+ScenePlane TransformPlane(const ScenePlane& plane_a, const Eigen::Isometry3d& T_a_b);
+
+}  // namespace vo
