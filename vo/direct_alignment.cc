@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -369,7 +370,8 @@ bool FitPlane(const StereoCamera& camera, const std::vector<const Feature*>& f, 
   std::uniform_int_distribution<int> pick(0, n - 1);
   // At most 200 triples, fewer once the best plane's share w makes a triple of its inliers
   // drawn with probability 0.999 (the usual adaptive count log(0.001) / log(1 − w³)).
-  int trials = std::min(200, n * (n - 1) * (n - 2) / 6 * 2);
+  const int64_t triples = static_cast<int64_t>(n) * (n - 1) * (n - 2) / 6;
+  int trials = static_cast<int>(std::min<int64_t>(200, 2 * triples));
   int best = 0;
   Eigen::Vector3d best_normal = Eigen::Vector3d::UnitZ();
   double best_d = 0.0;
@@ -393,7 +395,10 @@ bool FitPlane(const StereoCamera& camera, const std::vector<const Feature*>& f, 
       const double w = static_cast<double>(best) / n;
       const double miss = 1.0 - w * w * w;
       if (miss < 1e-12) break;
-      trials = std::min(trials, static_cast<int>(std::ceil(std::log(1e-3) / std::log(miss))));
+      if (miss < 1.0) {  // (miss == 1 when w³ underflows: no bound)
+        const double needed = std::ceil(std::log(1e-3) / std::log(miss));  // may exceed an int
+        if (needed < trials) trials = static_cast<int>(needed);
+      }
     }
   }
   if (best < std::max(3, min_inliers)) return false;
