@@ -1,12 +1,17 @@
 #include "harness/check.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
+#include <vector>
 
 namespace harness {
 
@@ -57,16 +62,45 @@ Baseline DefaultBaselineRule() {
 }
 
 bool LoadBaseline(const std::string& path, Baseline* baseline, std::string* error) {
-  std::ifstream in(path);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    *error = path + ": is a folder, not a baseline file (name the JSON file, e.g. " +
+             "results/baseline.json)";
+    return false;
+  }
+  std::ifstream in(path, std::ios::binary);
   if (!in) {
+    *error = path + ": cannot read the baseline file: " + std::strerror(errno);
+    return false;
+  }
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) {
     *error = path + ": cannot read the baseline file";
     return false;
   }
+  // A key twice in one object: nlohmann keeps the last silently; a baseline with two entries of
+  // one run (a merge gone wrong) must not check only one of them.
+  std::vector<std::set<std::string>> keys;  // the keys seen in each open object
+  std::string duplicate;
+  const json::parser_callback_t on_event = [&](int /*depth*/, json::parse_event_t event,
+                                               json& parsed) {
+    if (event == json::parse_event_t::object_start) keys.emplace_back();
+    if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+    if (event == json::parse_event_t::key && !keys.empty() &&
+        !keys.back().insert(parsed.get<std::string>()).second && duplicate.empty())
+      duplicate = parsed.get<std::string>();
+    return true;
+  };
   json j;
   try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
+    j = json::parse(text, on_event);
+  } catch (const std::exception& e) {
     *error = path + ": malformed JSON: " + e.what();
+    return false;
+  }
+  if (!duplicate.empty()) {
+    *error = path + ": key '" + duplicate + "': appears twice in one object (a JSON reader keeps " +
+             "one of them silently); remove one";
     return false;
   }
   Baseline b;
@@ -125,8 +159,11 @@ bool LoadBaseline(const std::string& path, Baseline* baseline, std::string* erro
       BaselineMetric bm;
       bm.name = name;
       if (!m.contains("value") || !(m["value"].is_number() || m["value"].is_null()))
-        return fail(key + ".value", "expected a number (or null for none)");
+        return fail(key + ".value",
+                    "expected a number (or null: the run is expected to give no value)");
       bm.value = m["value"].is_null() ? std::nan("") : m["value"].get<double>();
+      if (!m["value"].is_null() && !std::isfinite(bm.value))
+        return fail(key + ".value", "expected a finite number");
       if (!m.contains("tolerance") || !m["tolerance"].is_number() ||
           !(m["tolerance"].get<double>() >= 0))
         return fail(key + ".tolerance", "expected a number >= 0");
@@ -233,7 +270,10 @@ CheckReport CompareToBaseline(const Baseline& baseline, const SuiteResult& resul
       c.now = v.is_number() ? v.get<double>() : std::nan("");
       const double worsening = m.lower_is_better ? c.now - c.baseline : c.baseline - c.now;
       if (!std::isfinite(c.baseline)) {
-        c.verdict = "OK";  // nothing to compare with
+        // null in the baseline: the run is expected to give no value either (a metric that
+        // does not apply). A value now is a change the baseline must record, not a pass.
+        c.verdict = std::isfinite(c.now) ? "WORSE" : "OK";
+        if (std::isfinite(c.now)) ++report.worse;
       } else if (!std::isfinite(c.now) || worsening > c.tolerance) {
         c.verdict = "WORSE";
         ++report.worse;

@@ -3,7 +3,6 @@
 #include <signal.h>
 
 #include <atomic>
-#include <utility>
 
 namespace harness {
 namespace {
@@ -23,15 +22,14 @@ ScopedInterruptHandlers::ScopedInterruptHandlers() {
   sa.sa_handler = OnSignal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = SA_RESETHAND | SA_RESTART;  // a second Ctrl-C gets the default: ends at once
-  for (const auto& [sig, old] : {std::pair{SIGINT, &old_int_}, std::pair{SIGTERM, &old_term_}}) {
-    sigaction(sig, nullptr, old);
-    if (old->sa_handler != SIG_IGN) sigaction(sig, &sa, nullptr);
+  for (size_t i = 0; i < kSignals.size(); ++i) {
+    sigaction(kSignals[i], nullptr, &old_[i]);
+    if (old_[i].sa_handler != SIG_IGN) sigaction(kSignals[i], &sa, nullptr);
   }
 }
 
 ScopedInterruptHandlers::~ScopedInterruptHandlers() {
-  sigaction(SIGINT, &old_int_, nullptr);
-  sigaction(SIGTERM, &old_term_, nullptr);
+  for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &old_[i], nullptr);
 }
 
 int InterruptSignal() { return g_signal.load(); }

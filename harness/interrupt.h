@@ -1,17 +1,23 @@
-// SIGINT / SIGTERM for the long commands (run, eval, render, match-eval, tune, suite, check):
-// the handler only records the signal; the frame loops poll InterruptSignal(), stop, let their
-// work folders be removed (OutputFolder, DatasetWriter) and fail with InterruptedMessage();
-// main() then exits with InterruptExitCode() (128 + the signal: 130 for SIGINT, 143 for
-// SIGTERM). A second signal of the same kind kills at once (the handler resets itself).
+// SIGINT / SIGTERM / SIGHUP / SIGQUIT for the long commands (run, eval, render, match-eval,
+// tune, suite, check): the handler only records the signal; the frame loops poll
+// InterruptSignal(), stop, let their work folders and locks be removed (OutputFolder,
+// DatasetWriter) and fail with InterruptedMessage(); main() then exits with InterruptExitCode()
+// (128 + the signal: 130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP — a closed terminal or a
+// dropped ssh session — and 131 for SIGQUIT, Ctrl-\, without a core dump). A second signal of
+// the same kind kills at once (the handler resets itself).
 #pragma once
 
 #include <signal.h>
 
+#include <array>
 #include <string>
 
 namespace harness {
 
-// Installs the recording handler for SIGINT and SIGTERM for the object's lifetime and puts the
+// The signals handled: SIGINT, SIGTERM, SIGHUP, SIGQUIT.
+inline constexpr std::array<int, 4> kSignals = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+
+// Installs the recording handler for kSignals for the object's lifetime and puts the
 // earlier handlers back after it (nesting is fine). A signal that was ignored when the process
 // started (nohup, a background job of a script) stays ignored.
 class ScopedInterruptHandlers {
@@ -22,10 +28,10 @@ class ScopedInterruptHandlers {
   ScopedInterruptHandlers& operator=(const ScopedInterruptHandlers&) = delete;
 
  private:
-  struct sigaction old_int_ = {}, old_term_ = {};
+  std::array<struct sigaction, kSignals.size()> old_ = {};
 };
 
-// The first signal recorded by the handler (SIGINT, SIGTERM), 0 when none.
+// The first signal recorded by the handler (one of kSignals), 0 when none.
 int InterruptSignal();
 
 // 128 + InterruptSignal(), the exit status of a command stopped by the signal.

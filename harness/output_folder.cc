@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <ctime>
@@ -15,6 +16,8 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+
+#include "harness/trajectory_io.h"
 
 #ifndef VOBENCH_VERSION
 #define VOBENCH_VERSION "unknown"
@@ -36,7 +39,8 @@ bool Fail(std::string* error, const std::string& message) {
   return false;
 }
 
-// "out/" -> "out", "a//b/" -> "a/b" (so "DIR.partial-*" and "DIR.lock" are siblings of DIR).
+// "out/" -> "out", "a//b/" -> "a/b" (so "DIR.partial-*" and "DIR.vobench-lock" are siblings of
+// DIR).
 std::string NormalizeDir(const std::string& dir) {
   std::string s = fs::path(dir).lexically_normal().string();
   while (s.size() > 1 && s.back() == '/') s.pop_back();
@@ -92,22 +96,31 @@ bool IsDeadHere(const FolderMarker& marker) {
   return ::kill(static_cast<pid_t>(marker.pid), 0) == -1 && errno == ESRCH;
 }
 
-// Removes "DIR.partial-*" and "DIR.old-*" siblings that a vobench killed outright left behind:
-// only marked folders whose writer no longer runs; anything else there is left alone.
+// The pid in a work folder's name "<prefix><pid>-XXXXXX" (mkdtemp's six letters and digits);
+// 0 when `entry` is not exactly such a name.
+long WorkFolderPid(const std::string& entry, const std::string& prefix) {
+  if (entry.size() <= prefix.size() + 7 || entry.compare(0, prefix.size(), prefix) != 0) return 0;
+  const std::string rest = entry.substr(prefix.size());
+  const size_t dash = rest.find('-');
+  if (dash == 0 || dash == std::string::npos || rest.size() - dash - 1 != 6 || dash > 10) return 0;
+  long pid = 0;
+  for (size_t i = 0; i < dash; ++i) {
+    if (rest[i] < '0' || rest[i] > '9') return 0;
+    pid = pid * 10 + (rest[i] - '0');
+  }
+  for (size_t i = dash + 1; i < rest.size(); ++i)
+    if (!std::isalnum(static_cast<unsigned char>(rest[i]))) return 0;
+  return pid;
+}
+
+// Removes the "DIR.partial-<pid>-XXXXXX" work folders that a vobench killed outright left behind
+// (see IsStaleWorkFolder); anything else beside DIR is left alone.
 void RemoveStaleWorkFolders(const std::string& dir) {
-  const std::string name = fs::path(dir).filename().string();
-  const std::string partial = name + ".partial-", old = name + ".old-";
   std::error_code ec;
   std::vector<fs::path> stale;
-  for (fs::directory_iterator it(ParentOf(dir), ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string entry = it->path().filename().string();
-    if (entry.rfind(partial, 0) != 0 && entry.rfind(old, 0) != 0) continue;
-    std::error_code type_ec;
-    if (!fs::is_directory(fs::symlink_status(it->path(), type_ec))) continue;
-    FolderMarker marker;
-    if (ReadFolderMarker(it->path().string(), &marker, nullptr) && IsDeadHere(marker))
+  for (fs::directory_iterator it(ParentOf(dir), ec), end; !ec && it != end; it.increment(ec))
+    if (IsStaleWorkFolder(it->path().string(), fs::path(dir).filename().string()))
       stale.push_back(it->path());
-  }
   for (const fs::path& p : stale) fs::remove_all(p, ec);
 }
 
@@ -138,7 +151,23 @@ std::string VobenchVersion() {
   return std::string(VOBENCH_VERSION) + (describe.empty() ? "" : " (" + describe + ")");
 }
 
-bool WriteFolderMarker(const std::string& dir, const std::string& kind, std::string* error) {
+bool IsStaleWorkFolder(const std::string& path, const std::string& name) {
+  const fs::path p = fs::path(path).lexically_normal();
+  const std::string entry = p.filename().string();
+  const std::string tag = ".partial-";
+  const size_t at = name.empty() ? entry.rfind(tag) : name.size();
+  if (at == std::string::npos || (!name.empty() && entry.compare(0, at, name) != 0)) return false;
+  const long name_pid = WorkFolderPid(entry, entry.substr(0, at) + tag);
+  if (name_pid <= 0) return false;
+  std::error_code ec;
+  if (!fs::is_directory(fs::symlink_status(p, ec))) return false;
+  FolderMarker marker;
+  return ReadFolderMarker(p.string(), &marker, nullptr) && marker.work_folder_of_pid == name_pid &&
+         marker.pid == name_pid && IsDeadHere(marker);
+}
+
+bool WriteFolderMarker(const std::string& dir, const std::string& kind, std::string* error,
+                       bool work_folder) {
   nlohmann::ordered_json j;  // in this order in the file
   j["vobench_folder"] = kFolderMarkerFormat;
   j["kind"] = kind;
@@ -147,15 +176,11 @@ bool WriteFolderMarker(const std::string& dir, const std::string& kind, std::str
   j["created_utc"] = NowUtc();
   j["pid"] = static_cast<long>(::getpid());
   j["host"] = HostName();
+  if (work_folder) j[kWorkFolderKey] = static_cast<long>(::getpid());
   const fs::path path = fs::path(dir) / kFolderMarkerFile;
   const fs::path tmp =
       fs::path(dir) / (std::string(kFolderMarkerFile) + ".tmp-" + std::to_string(::getpid()));
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << j.dump(2) << "\n";
-    out.close();
-    if (!out) return Fail(error, tmp.string() + ": cannot write the vobench folder marker");
-  }
+  if (!WriteTextFile(tmp.string(), j.dump(2) + "\n", error)) return false;
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
@@ -182,6 +207,7 @@ bool ReadFolderMarker(const std::string& dir, FolderMarker* marker, std::string*
     if (j.contains("created_utc")) m.created_utc = j["created_utc"].get<std::string>();
     if (j.contains("pid")) m.pid = j["pid"].get<long>();
     if (j.contains("host")) m.host = j["host"].get<std::string>();
+    if (j.contains(kWorkFolderKey)) m.work_folder_of_pid = j[kWorkFolderKey].get<long>();
     if (m.kind.empty()) throw std::runtime_error("empty kind");
     *marker = m;
   } catch (const std::exception& e) {
@@ -271,13 +297,13 @@ bool AdoptFolder(const std::string& dir_arg, const std::string& kind, std::strin
     if (ec) return Fail(error, ParentOf(dir).string() + ": cannot create: " + ec.message());
     std::string work;
     if (!MakeUniqueFolder(dir + ".partial-", &work, error)) return false;
-    if (!WriteFolderMarker(work, kind, error)) {
+    if (!WriteFolderMarker(work, kind, error, /*work_folder=*/true)) {
       fs::remove_all(work, ec);
       return false;
     }
     const bool moved = ::rename(work.c_str(), dir.c_str()) == 0;
     const int rename_errno = errno;
-    if (moved) return true;
+    if (moved) return WriteFolderMarker(dir, kind, error);  // published: never a work folder
     fs::remove_all(work, ec);
     if (rename_errno != ENOTEMPTY && rename_errno != EEXIST)
       return Fail(error, dir + ": cannot create: " + std::strerror(rename_errno));
@@ -288,26 +314,54 @@ bool AdoptFolder(const std::string& dir_arg, const std::string& kind, std::strin
 // ---------------------------------------------------------------------------------------------
 // FolderLock
 
+namespace {
+
+constexpr const char* kLockSignature = "vobench-lock pid=";
+
+// The pid in a lock file's text "vobench-lock pid=N host=H\n"; 0 when it is not such a text.
+long LockHolder(int fd) {
+  char buf[256] = {};
+  const ssize_t n = ::pread(fd, buf, sizeof(buf) - 1, 0);
+  const size_t sig = std::strlen(kLockSignature);
+  if (n <= static_cast<ssize_t>(sig) || std::strncmp(buf, kLockSignature, sig) != 0) return 0;
+  long pid = 0;
+  for (size_t i = sig; i < static_cast<size_t>(n) && buf[i] >= '0' && buf[i] <= '9'; ++i)
+    pid = pid * 10 + (buf[i] - '0');
+  return pid;
+}
+
+}  // namespace
+
 bool FolderLock::Acquire(const std::string& lock_path, const std::string& what,
                          std::string* error) {
   Release();
+  const std::string not_ours = lock_path +
+                               ": exists and is not a vobench lock file; remove it yourself or "
+                               "choose another --out";
   for (int attempt = 0; attempt < kLockAttempts; ++attempt) {
-    const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
-    if (fd < 0)
-      return Fail(error, lock_path + ": cannot open the lock file: " + std::strerror(errno));
+    // Created exclusively: a file of that name that vobench did not create now is never written.
+    int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
+    const bool created = fd >= 0;
+    if (!created) {
+      if (errno != EEXIST)
+        return Fail(error, lock_path + ": cannot create the lock file: " + std::strerror(errno));
+      fd = ::open(lock_path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+      if (fd < 0) {
+        if (errno == ENOENT) continue;  // removed by its holder meanwhile
+        if (errno == ELOOP) return Fail(error, not_ours);
+        return Fail(error, lock_path + ": cannot open the lock file: " + std::strerror(errno));
+      }
+    }
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
       const int flock_errno = errno;
-      std::string holder;
-      char buf[32] = {};
-      const ssize_t n = ::pread(fd, buf, sizeof(buf) - 1, 0);
-      for (ssize_t i = 0; i < n && buf[i] >= '0' && buf[i] <= '9'; ++i) holder += buf[i];
+      const long holder = LockHolder(fd);
       ::close(fd);
-      if (flock_errno == EWOULDBLOCK)
-        return Fail(error, what + ": another vobench (pid " +
-                               (holder.empty() ? "unknown" : holder) +
-                               ") is writing this folder; wait for it to end or choose another "
-                               "--out");
-      return Fail(error, lock_path + ": cannot lock: " + std::strerror(flock_errno));
+      if (flock_errno != EWOULDBLOCK)
+        return Fail(error, lock_path + ": cannot lock: " + std::strerror(flock_errno));
+      if (holder <= 0) return Fail(error, not_ours + " (another process holds a lock on it)");
+      return Fail(error, what + ": another vobench (pid " + std::to_string(holder) +
+                             ") is writing this folder; wait for it to end or choose another "
+                             "--out");
     }
     // The holder before us may have removed the file after we opened it: then our lock is on a
     // file nobody else sees; open the path again.
@@ -317,21 +371,21 @@ bool FolderLock::Acquire(const std::string& lock_path, const std::string& what,
       ::close(fd);
       continue;
     }
-    // A file of that name that is not a lock file of vobench's (a pid line, or empty) is not
-    // truncated nor removed.
-    char held[64] = {};
-    const ssize_t n = ::pread(fd, held, sizeof(held) - 1, 0);
-    bool pid_line = n >= 0;
-    for (ssize_t i = 0; i < n; ++i)
-      pid_line &= (held[i] >= '0' && held[i] <= '9') || (held[i] == '\n' && i + 1 == n);
-    if (!pid_line) {
+    if (!created) {
+      // Nobody holds it. A lock file of a vobench killed outright (its own text, written by a
+      // process that no longer holds it) is removed and created anew; anything else is kept.
+      if (LockHolder(fd) <= 0) {
+        ::close(fd);
+        return Fail(error, not_ours);
+      }
+      ::unlink(lock_path.c_str());  // while holding it: a concurrent opener re-checks the inode
       ::close(fd);
-      return Fail(error, lock_path + ": exists and is not a vobench lock file; remove it " +
-                             "yourself or choose another --out");
+      continue;
     }
-    const std::string pid = std::to_string(::getpid()) + "\n";
-    if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {
-      // The lock holds without the pid; only the message of a refused writer is poorer.
+    const std::string text =
+        std::string(kLockSignature) + std::to_string(::getpid()) + " host=" + HostName() + "\n";
+    if (::pwrite(fd, text.data(), text.size(), 0) < 0) {
+      // The lock holds without the text; only the message of a refused writer is poorer.
     }
     fd_ = fd;
     path_ = lock_path;
@@ -342,7 +396,7 @@ bool FolderLock::Acquire(const std::string& lock_path, const std::string& what,
 
 void FolderLock::Release() {
   if (fd_ < 0) return;
-  ::unlink(path_.c_str());  // while still holding it: see Acquire's re-check
+  ::unlink(path_.c_str());  // this process created it; while still holding it: see Acquire
   ::close(fd_);
   fd_ = -1;
   path_.clear();
@@ -377,7 +431,7 @@ bool OutputFolder::Create(const std::string& dir, const std::string& kind, const
   const fs::path parent = ParentOf(dir_);
   fs::create_directories(parent, ec);
   if (ec) return Fail(error, parent.string() + ": cannot create folder: " + ec.message());
-  if (!lock_.Acquire(dir_ + ".lock", dir_, error)) return false;
+  if (!lock_.Acquire(dir_ + kLockSuffix, dir_, error)) return false;
 
   // An existing DIR: refused unless it may be replaced (and replacing was asked for).
   if (fs::exists(fs::symlink_status(dir_, ec))) {
@@ -399,7 +453,7 @@ bool OutputFolder::Create(const std::string& dir, const std::string& kind, const
     lock_.Release();
     return false;
   }
-  if (!WriteFolderMarker(work_, kind_, error)) {  // the marker first
+  if (!WriteFolderMarker(work_, kind_, error, /*work_folder=*/true)) {  // the marker first
     Discard();
     return false;
   }
@@ -415,6 +469,8 @@ bool OutputFolder::Publish(std::string* error) {
                                 ? "choose another --out"
                                 : "pass " + options_.replace_flag + " to replace it") +
                            ")");
+  // The published folder's marker no longer says "work folder" (nothing may remove it).
+  if (!WriteFolderMarker(work_, kind_, error)) return false;
   if (!ReplaceFolder(work_, dir_, kind_, error)) return false;
   published_ = true;
   lock_.Release();

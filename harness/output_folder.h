@@ -12,19 +12,26 @@
 //    folder; remove it yourself or choose another --out"
 // Folders of vobench versions before the marker have none and are refused the same way.
 //
-// Concurrency: a writer holds an exclusive flock(2) on the lock file "DIR.lock" beside DIR (in
-// DIR's parent) from Create() until it is done, so a second writer of the same DIR fails at
-// once with "DIR: another vobench (pid N) is writing this folder". The lock file sits beside
-// DIR, not inside it, because DIR does not exist at the start and is replaced by a rename at
-// the end; one file per name keeps writers of sibling folders independent. The kernel drops
-// the lock when its process dies (also on SIGKILL); the holder removes the file when done (and
-// an acquirer re-checks that the file it locked is still the one at the path), so a file left by
-// a killed process is simply taken over.
+// A work folder's marker also says whose work folder it is: "work_folder_of_pid": P. Publishing
+// rewrites the marker without it, so a finished folder (and any copy or renamed backup of one:
+// `mv r r.old-1`, `cp -a r r.partial-1-abcdef`) never looks like a work folder.
 //
-// Work folders are unique per process, "DIR.partial-<pid>-<random>" (mkdtemp), marked like the
-// final folder. Create() removes stale ones of DIR left by processes killed outright, but only
-// those whose marker names a process of this host that no longer runs; a "DIR.partial-*" without
-// a marker is never touched.
+// Concurrency: a writer holds an exclusive flock(2) on the lock file "DIR.vobench-lock" beside
+// DIR (in DIR's parent) from Create() until it is done, so a second writer of the same DIR fails
+// at once with "DIR: another vobench (pid N) is writing this folder". The lock file sits beside
+// DIR, not inside it, because DIR does not exist at the start and is replaced by a rename at the
+// end; one file per name keeps writers of sibling folders independent. The lock file is created
+// exclusively (O_EXCL) and holds "vobench-lock pid=N host=H"; a file of that name that vobench
+// did not create is never written, truncated nor removed (refused instead), so a user's own
+// "DIR.lock" (`flock DIR.lock vobench run --out DIR`) is none of vobench's business. The kernel
+// drops the lock when its process dies (also on SIGKILL); the holder removes the file when done,
+// and a lock file of a killed vobench (its text, nobody holding it) is removed and created anew.
+//
+// Work folders are unique per process, "DIR.partial-<pid>-<random>" (mkdtemp). Create() removes
+// stale ones of DIR left by processes killed outright, and only those: the exact name
+// DIR.partial-<pid>-XXXXXX, a marker saying "work folder of pid <pid>" (the same pid), of this
+// host, and that process no longer runs (IsStaleWorkFolder). Nothing else is ever removed: not a
+// published folder, not "DIR.old-*", not a folder without a marker.
 #pragma once
 
 #include <string>
@@ -34,6 +41,8 @@ namespace harness {
 
 constexpr const char* kFolderMarkerFile = ".vobench.json";
 constexpr int kFolderMarkerFormat = 1;  // "vobench_folder" field of the marker
+constexpr const char* kWorkFolderKey = "work_folder_of_pid";  // marker key of a work folder only
+constexpr const char* kLockSuffix = ".vobench-lock";          // DIR's lock file: DIR + this
 
 // The contents of a marker file.
 struct FolderMarker {
@@ -44,13 +53,16 @@ struct FolderMarker {
   std::string created_utc;           // ISO 8601, seconds, UTC ("2026-12-01T21:46:24Z")
   long pid = 0;                      // the writing process
   std::string host;                  // its host name (pids mean something only there)
+  long work_folder_of_pid = 0;       // > 0: an unpublished work folder of this pid
 };
 
 // "0.1.0 (g8493cb3)": the version written into markers.
 std::string VobenchVersion();
 
-// Writes DIR/.vobench.json for `kind` (this process, now) through a temporary file and a rename.
-bool WriteFolderMarker(const std::string& dir, const std::string& kind, std::string* error);
+// Writes DIR/.vobench.json for `kind` (this process, now) through a temporary file and a rename;
+// `work_folder`: marked as this process's unpublished work folder.
+bool WriteFolderMarker(const std::string& dir, const std::string& kind, std::string* error,
+                       bool work_folder = false);
 // Reads DIR/.vobench.json. False when it is missing (*error says so) or malformed.
 bool ReadFolderMarker(const std::string& dir, FolderMarker* marker, std::string* error);
 
@@ -71,6 +83,12 @@ bool ReplaceFolder(const std::string& from, const std::string& to, const std::st
 // onto it; concurrent callers agree on one); a DIR with a marker of `kind` is kept as it is;
 // anything else is refused as by CheckReplaceable.
 bool AdoptFolder(const std::string& dir, const std::string& kind, std::string* error);
+
+// True for a work folder that a vobench killed outright left behind, the only kind of folder
+// vobench removes without being asked: named exactly "<name>.partial-<pid>-XXXXXX" (`name`
+// empty: any name), a folder (not a link), its marker saying "work folder of pid <pid>", of this
+// host, and that process no longer runs.
+bool IsStaleWorkFolder(const std::string& path, const std::string& name = "");
 
 // True for a folder holding a readable marker (of any kind when `kind` is empty).
 bool HasFolderMarker(const std::string& dir, const std::string& kind = "");
@@ -97,8 +115,8 @@ class FolderLock {
 };
 
 // An output folder written as a marked work folder "DIR.partial-<pid>-<random>" and moved to DIR
-// only by Publish(), under the lock "DIR.lock". Destroying it before Publish() (an error, an
-// exception, SIGINT/SIGTERM seen by the command: harness/interrupt.h) removes the work folder,
+// only by Publish(), under the lock "DIR.vobench-lock". Destroying it before Publish() (an error,
+// an exception, SIGINT/SIGTERM seen by the command: harness/interrupt.h) removes the work folder,
 // so a half-written DIR never exists.
 //
 // Usage:  OutputFolder folder;

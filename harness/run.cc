@@ -53,6 +53,19 @@ bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_op
          RunSequence(sequence, vo_options, options, summary, error);
 }
 
+std::string FrameBudgetProblem(int frames, bool estimated, int max_frames, int stride) {
+  if (max_frames == 1) return "--max-frames 1: the VO needs at least 2 frames (0 = all)";
+  if (max_frames > 1 && max_frames <= stride)
+    return "--stride " + std::to_string(stride) + " with --max-frames " +
+           std::to_string(max_frames) + " leaves the VO 1 frame; it needs at least 2";
+  const int available = estimated ? 2 * frames : frames;
+  if (available <= stride && (max_frames == 0 || max_frames > frames))
+    return "--stride " + std::to_string(stride) + ": the sequence has " +
+           (estimated ? "about " : "") + std::to_string(frames) +
+           " frames, so the VO would see 1; it needs at least 2";
+  return "";
+}
+
 bool RunKittiDataset(const std::string& dir, const vo::OdometryOptions& vo_options,
                      const RunOptions& options, RunSummary* summary, std::string* error) {
   EvalOptions kitti;  // the KITTI layout with its own poses.txt, if any

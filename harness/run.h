@@ -52,6 +52,12 @@ bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_o
 bool RunScenario(const sim::Scenario& scenario, const vo::OdometryOptions& vo_options,
                  const RunOptions& options, RunSummary* summary, std::string* error);
 
+// Whether a frame limit and stride leave the VO at least the 2 frames it needs, from the frames
+// a source gives (`estimated`: about that many, sim::EstimatedFrames; refused only when twice
+// the estimate would not do). "" when fine, else the problem, naming the option: "--max-frames
+// 1: ...", "--stride 1000: ...". Checked before anything is simulated or written.
+std::string FrameBudgetProblem(int frames, bool estimated, int max_frames, int stride);
+
 // Runs the VO on a dataset folder in the KITTI layout.
 bool RunKittiDataset(const std::string& dir, const vo::OdometryOptions& vo_options,
                      const RunOptions& options, RunSummary* summary, std::string* error);

@@ -217,7 +217,12 @@ void MakePlots(const std::string& folder, bool has_ground_truth, const std::stri
          RunPlot({"errors", p.string(), (p / "errors.png").string()}, &plot_error);
   }
   ok = ok && RunPlot({"timing", p.string(), (p / "timing.png").string()}, &plot_error);
-  if (!ok) std::fprintf(stderr, "warning: plots not made: %s\n", plot_error.c_str());
+  if (!ok) {
+    // No plot at all rather than a half-written one (a full disk cuts a PNG short).
+    std::error_code ec;
+    for (const char* png : {"trajectory.png", "errors.png", "timing.png"}) fs::remove(p / png, ec);
+    std::fprintf(stderr, "warning: plots not made: %s\n", plot_error.c_str());
+  }
 }
 
 bool WriteRunFolder(const RunRecords& records, const RunSummary& s,

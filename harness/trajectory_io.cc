@@ -1,10 +1,16 @@
 #include "harness/trajectory_io.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <tuple>
@@ -50,19 +56,40 @@ bool ReadTextLines(const std::string& path, std::vector<std::string>* lines, std
   return true;
 }
 
-bool WriteTextFile(const std::string& path, const std::string& text, std::string* error) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) {
-    SetError(error, path + ": cannot open for writing");
+bool WriteFileBytes(const std::string& path, const void* data, std::size_t size,
+                    std::string* error) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    SetError(error, path + ": cannot open for writing: " + std::strerror(errno));
     return false;
   }
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  out.close();
-  if (!out) {
-    SetError(error, path + ": write error");
+  const char* p = static_cast<const char*>(data);
+  std::size_t left = size;
+  int write_errno = 0;
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      write_errno = n < 0 ? errno : EIO;
+      break;
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  struct stat st = {};
+  const bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+  // close() reports a delayed write error (NFS, quotas): a file is written only when it says so.
+  if (::close(fd) != 0 && write_errno == 0) write_errno = errno;
+  if (write_errno != 0) {
+    if (regular) ::unlink(path.c_str());  // nothing written half-way (never a device: /dev/full)
+    SetError(error, path + ": cannot write: " + std::strerror(write_errno));
     return false;
   }
   return true;
+}
+
+bool WriteTextFile(const std::string& path, const std::string& text, std::string* error) {
+  return WriteFileBytes(path, text.data(), text.size(), error);
 }
 
 bool IsBlankOrComment(std::string_view line) {
@@ -174,6 +201,23 @@ bool WriteTum(const std::string& path, const std::vector<StampedPose>& poses, st
   return WriteTextFile(path, text, error);
 }
 
+namespace {
+
+// A position farther than this from the origin is no robot's (1000 km: a GPS/INS drive in a
+// local frame stays far inside; 1e300 m would turn every metric into inf or 0).
+constexpr double kMaxPositionM = 1e6;
+
+bool PositionIsPlausible(const Eigen::Vector3d& t, const std::string& path, int line_no,
+                         std::string* error) {
+  if (t.stableNorm() <= kMaxPositionM) return true;  // stable: 1e300 does not overflow to inf
+  SetError(error, Where(path, line_no) + "position " + FormatDouble(t.stableNorm()) +
+                      " m from the origin is beyond " + FormatDouble(kMaxPositionM) +
+                      " m (1000 km): not a trajectory a VO can be measured on");
+  return false;
+}
+
+}  // namespace
+
 bool ReadTum(const std::string& path, std::vector<StampedPose>* poses, std::string* error) {
   std::vector<std::string> lines;
   if (!ReadTextLines(path, &lines, error)) return false;
@@ -196,6 +240,7 @@ bool ReadTum(const std::string& path, std::vector<StampedPose>* poses, std::stri
                           FormatDouble(norm));
       return false;
     }
+    if (!PositionIsPlausible(Eigen::Vector3d(v[1], v[2], v[3]), path, line_no, error)) return false;
     q.normalize();
     StampedPose p;
     p.time_s = v[0];
@@ -249,6 +294,7 @@ bool ReadKittiPoses(const std::string& path, std::vector<Eigen::Isometry3d>* pos
                    FormatDouble(orth_err) + ", det = " + FormatDouble(R.determinant()) + ")");
       return false;
     }
+    if (!PositionIsPlausible(T.translation(), path, line_no, error)) return false;
     out.push_back(T);
   }
   *poses = std::move(out);

@@ -89,7 +89,12 @@ bool ParseNumbers(std::string_view text, std::size_t count, std::vector<double>*
                   std::string* what);
 // Reads a text file into lines (without the line ends; "\r\n" accepted). Error names the file.
 bool ReadTextLines(const std::string& path, std::vector<std::string>* lines, std::string* error);
-// Writes `text` to `path` byte for byte (replacing the file). Error names the file.
+// Writes `size` bytes to `path` (replacing the file). On failure the file is removed (nothing
+// is left half-written) and the error names the file and the system's reason ("No space left
+// on device").
+bool WriteFileBytes(const std::string& path, const void* data, std::size_t size,
+                    std::string* error);
+// WriteFileBytes of a text.
 bool WriteTextFile(const std::string& path, const std::string& text, std::string* error);
 
 // True for a line that is empty, blank, or whose first non-blank character is '#'.

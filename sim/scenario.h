@@ -82,6 +82,11 @@ struct Scenario {
 
 // Reads and validates a scenario file. On failure returns false and *error names the file,
 // the key (and line where known) and what was expected. Unknown keys are errors.
+// About how many frames the scenario renders (the path at speed_mps, in-place turns at
+// turn_rate_dps, at rate_hz, at most max_duration_s): an estimate for refusing a stride or frame
+// limit that cannot leave the VO two frames, before anything is simulated.
+int EstimatedFrames(const Scenario& scenario);
+
 bool LoadScenario(const std::string& path, Scenario* scenario, std::string* error);
 
 // Parses a scenario from YAML text; `source_name` is used in messages and `base_dir` to

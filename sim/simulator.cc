@@ -191,8 +191,9 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   // A path through a wall (scenarios built in code; files are checked when read).
   int waypoint = -1;
   std::vector<SceneWall> walls;
-  WallsOfModel(m, &walls);  // from the model just loaded: no second load of the scene
-  if (const std::string through = PathThroughWallProblem(scenario, walls, &waypoint);
+  std::vector<SceneFloor> floors;
+  WallsOfModel(m, &walls, &floors);  // from the model just loaded: no second load of the scene
+  if (const std::string through = PathProblem(scenario, walls, floors, &waypoint);
       !through.empty()) {
     *error = (scenario.source_path.empty() ? "scenario" : scenario.source_path) + ": key 'path[" +
              std::to_string(waypoint) + "]': " + through;

@@ -60,6 +60,19 @@ int RunCheckCommand(const CheckArgs& a) {
   if (!a.update && fs::path(a.baseline).is_relative() && !fs::exists(a.baseline) &&
       fs::exists(in_source))
     baseline_path = in_source;
+  std::error_code ec;
+  if (fs::is_directory(baseline_path, ec))
+    return PrintFailure("check", kExitBadInput,
+                        baseline_path +
+                            ": is a folder, not a baseline file (name the JSON file, e.g. "
+                            "results/baseline.json)");
+  // --update writes through a symbolic link to its target (the link stays a link).
+  const std::string write_path = fs::is_symlink(fs::symlink_status(a.baseline, ec))
+                                     ? fs::weakly_canonical(a.baseline, ec).string()
+                                     : a.baseline;
+  if (a.update && fs::is_directory(write_path, ec))
+    return PrintFailure("check", kExitBadInput,
+                        a.baseline + ": is a folder, not a baseline file (name the JSON file)");
   const bool have_baseline = fs::exists(baseline_path);
   if (have_baseline) {
     if (!LoadBaseline(baseline_path, &baseline, &error))
@@ -115,7 +128,7 @@ int RunCheckCommand(const CheckArgs& a) {
     Baseline fresh;
     if (!MakeBaseline(result, baseline, &fresh, &error))
       return PrintFailure("check", kExitFailed, error);
-    if (!WriteFileAtomically(a.baseline, BaselineJson(fresh), &error))
+    if (!WriteFileAtomically(write_path, BaselineJson(fresh), &error))
       return PrintFailure("check", kExitFailed, error);
     std::printf("%s", SuiteTableText(result).c_str());
     std::printf("\nwrote %s: %zu runs x %zu metrics (suite %s, %.1f s)\n", a.baseline.c_str(),

@@ -20,6 +20,15 @@ int RunGivenCommand(const std::vector<Command>& commands) {
   return kExitOk;
 }
 
+CLI::Validator NonEmpty() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        return text.empty() ? "empty: name a folder (or leave the option out for the default)"
+                            : std::string();
+      },
+      "DIR");
+}
+
 CLI::Validator AtLeast(long min) {
   const std::string bound = std::to_string(min);
   return CLI::Validator(

@@ -44,6 +44,8 @@ int RunGivenCommand(const std::vector<Command>& commands);
 // got 'x'" for text that is not an integer. Replaces CLI::PositiveNumber and friends, whose
 // messages print the double range ("Value 0 not in range 0.000000 to 1797693...").
 CLI::Validator AtLeast(long min);
+// A value that is not empty ("--out ''" names no folder).
+CLI::Validator NonEmpty();
 
 // Parses the command line. Returns -1 when the command should run; otherwise the exit code to
 // return at once: 0 after --help, 2 after any argument error (printed as one line on stderr,

@@ -64,7 +64,13 @@ int RunEval(const EvalArgs& a, bool max_difference_given) {
   run_options.max_frames = a.max_frames;
   RunSummary summary;
   EvalInfo info;
-  if (!EvalDataset(a.dataset, options, vo_options, run_options, &summary, &info, &error)) {
+  // A dataset its reader refuses is bad input (exit 2, nothing written); a run that fails, 1.
+  StereoSequence sequence;
+  if (!OpenDataset(a.dataset, options, &sequence, &info, &error)) {
+    std::fprintf(stderr, "vobench eval: %s\n", error.c_str());
+    return 2;
+  }
+  if (!RunSequence(sequence, vo_options, run_options, &summary, &error)) {
     std::fprintf(stderr, "vobench eval: %s\n", error.c_str());
     return 1;
   }

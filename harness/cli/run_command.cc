@@ -59,6 +59,12 @@ int RunRun(const std::string& scenario_arg, const std::string& config, const std
       std::fprintf(stderr, "vobench run: %s\n", error.c_str());
       return 2;
     }
+    if (const std::string problem =
+            FrameBudgetProblem(sim::EstimatedFrames(scenario), true, max_frames, stride);
+        !problem.empty()) {
+      std::fprintf(stderr, "vobench run: %s\n", problem.c_str());
+      return 2;
+    }
     if (out.empty()) {
       if (!CheckPathName(scenario.name, "scenario name", &error)) {
         std::fprintf(stderr, "vobench run: %s (give --out)\n", error.c_str());
@@ -120,7 +126,8 @@ Command AddRunCommand(CLI::App& app) {
   run->add_option("--dataset", a->dataset,
                   "Read a dataset folder in the KITTI layout instead of simulating");
   run->add_option("--out,-o", a->out,
-                  "Run folder (default out/run/<name>); an earlier run there is replaced");
+                  "Run folder (default out/run/<name>); an earlier run there is replaced")
+      ->check(NonEmpty());
   run->add_option("--max-frames", a->max_frames, "Stop after N frames (0 = all)")
       ->check(AtLeast(0));
   run->add_option("--stride", a->stride,

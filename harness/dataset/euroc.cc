@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "harness/dataset/internal.h"
+#include "sim/scenario.h"
 #include "sim/yaml_input.h"
 
 namespace harness {
@@ -20,6 +21,8 @@ using dataset_internal::AssociateWithFrames;
 using dataset_internal::CheckFrameIndex;
 using dataset_internal::CountAssociated;
 using dataset_internal::Fail;
+using dataset_internal::FirstPairBits;
+using dataset_internal::IntrinsicsProblem;
 using dataset_internal::IsRotation;
 using dataset_internal::Join;
 using dataset_internal::NormalizeDir;
@@ -161,6 +164,12 @@ bool ReadEurocSensorYaml(const std::string& path, EurocCameraCalibration* calibr
     r.String(root, "", "camera_model", &c.camera_model);
   if (r.Require(root, "", "distortion_model", "radial-tangential | equidistant"))
     r.String(root, "", "distortion_model", &c.distortion_model);
+  if (r.ok()) {
+    const std::string problem = IntrinsicsProblem(c.width, c.height, c.fu_px, c.fv_px, c.cu_px,
+                                                  c.cv_px, c.distortion_model == "equidistant");
+    r.Check(problem.empty(), root, "", "intrinsics", problem);
+  }
+  c.t_bs_line = root["T_BS"].Mark().line + 1;
   if (r.Require(root, "", "distortion_coefficients", "a list of numbers"))
     r.ReadNumbers(root["distortion_coefficients"], "distortion_coefficients", 0,
                   &c.distortion_coefficients);
@@ -189,6 +198,14 @@ bool EurocReader::Open(const std::string& dir, const Options& options, std::stri
     if (!ReadEurocCameraCsv(Join(base, "data.csv"), Join(base, "data"), &images[cam], error))
       return false;
   }
+  // The stereo baseline from the two T_BS, in the range every layout keeps (RigProblem).
+  const double baseline_m =
+      (cam_[0].T_body_cam.inverse() * cam_[1].T_body_cam).translation().norm();
+  if (!(baseline_m >= sim::kMinBaselineM && baseline_m <= sim::kMaxBaselineM))
+    return Fail(error, Where(cam_[1].path, cam_[1].t_bs_line) + "key 'T_BS': the baseline " +
+                           "between cam0 and cam1 is " + FormatDouble(baseline_m) +
+                           " m, outside the plausible range " + FormatDouble(sim::kMinBaselineM) +
+                           " .. " + FormatDouble(sim::kMaxBaselineM) + " m (1 mm to 5 m)");
   // Stereo frames: stamps present in both cameras.
   for (const auto& [t_ns, path0] : images[0]) {
     const auto it = images[1].find(t_ns);
@@ -205,6 +222,7 @@ bool EurocReader::Open(const std::string& dir, const Options& options, std::stri
       if (!fs::is_regular_file(files_[cam][i], ec))
         return Fail(error, files_[cam][i] + ": missing image file (listed in cam" +
                                std::to_string(cam) + "/data.csv)");
+  if (!FirstPairBits(files_[0][0], files_[1][0], &bits_, error)) return false;
 
   // Ground truth (optional): the given file, else the first that exists.
   gt_index_.assign(t_ns_.size(), -1);
@@ -244,7 +262,7 @@ bool EurocReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* erro
   cv::Mat images[2];
   for (int cam = 0; cam < 2; ++cam) {
     if (!ReadGreyImage(files_[cam][index], cv::Size(cam_[cam].width, cam_[cam].height),
-                       "resolution in sensor.yaml", &images[cam], error))
+                       "resolution in sensor.yaml", bits_, &images[cam], error))
       return false;
   }
   frame->time_s = NsToSeconds(t_ns_[index]);

@@ -72,6 +72,7 @@ class EurocReader {
   Options options_;
   std::string dir_;
   EurocCameraCalibration cam_[2];
+  int bits_ = 8;  // the images' bit depth (dataset_internal::FirstPairBits)
   std::vector<int64_t> t_ns_;
   std::vector<std::string> files_[2];  // image paths per camera, aligned with t_ns_
   std::vector<StampedPose> gt_body_;

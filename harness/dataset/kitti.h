@@ -62,6 +62,7 @@ class KittiReader {
   Options options_;
   std::string dir_;
   vo::StereoCamera camera_;
+  int bits_ = 8;  // the images' bit depth (dataset_internal::FirstPairBits)
   std::vector<double> times_s_;
   std::vector<Eigen::Isometry3d> T_cam0first_cam0_;
   Eigen::Isometry3d T_world_cam0first_ = Eigen::Isometry3d::Identity();

@@ -31,6 +31,7 @@ struct EurocCameraCalibration {
   int height = 0;
   double rate_hz = 0.0;  // nominal frame rate (Hz)
   std::string path;      // the file it was read from ("" when made in code); named in errors
+  int t_bs_line = 0;     // the line of its T_BS key (0: unknown); named in errors
 };
 
 // Maps a raw stereo pair onto the ideal rectified camera the VO expects (vo::StereoCamera:

@@ -92,7 +92,7 @@ bool TumReader::Open(const std::string& dir, const Options& options, std::string
       if (!fs::is_regular_file(files_[cam][i], ec))
         return Fail(error, files_[cam][i] + ": missing image file (listed in " + lists[cam] + ")");
   if (!TakeImageSizeFromFirstPair(files_[0][0], files_[1][0], Join(dir_, "calib.txt"), &camera_,
-                                  error))
+                                  &bits_, error))
     return false;
 
   // Ground truth (optional).
@@ -113,7 +113,8 @@ bool TumReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* error)
   const cv::Size size(camera_.width, camera_.height);
   cv::Mat images[2];
   for (int cam = 0; cam < 2; ++cam) {
-    if (!ReadGreyImage(files_[cam][index], size, "the size of the first pair", &images[cam], error))
+    if (!ReadGreyImage(files_[cam][index], size, "the size of the first pair", bits_, &images[cam],
+                       error))
       return false;
   }
   frame->time_s = times_s_[index];

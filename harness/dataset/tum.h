@@ -59,6 +59,7 @@ class TumReader {
   Options options_;
   std::string dir_;
   vo::StereoCamera camera_;
+  int bits_ = 8;  // the images' bit depth (dataset_internal::FirstPairBits)
   std::vector<double> times_s_;
   std::vector<std::string> files_[2];  // image paths (left, right), aligned with times_s_
   std::vector<StampedPose> gt_;

@@ -31,13 +31,7 @@ constexpr const char* kEurocGroundTruthHeader =
     "b_a_RS_S_z [m s^-2]";
 
 bool WriteBytes(const std::string& path, const std::vector<uchar>& bytes, std::string* error) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) return Fail(error, path + ": cannot open for writing");
-  out.write(reinterpret_cast<const char*>(bytes.data()),
-            static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  if (!out) return Fail(error, path + ": write error");
-  return true;
+  return WriteFileBytes(path, bytes.data(), bytes.size(), error);
 }
 
 bool MakeDir(const std::string& path, std::string* error) {

@@ -57,7 +57,7 @@ class DatasetWriter {
 
   // Checks options and camera, refuses an existing DIR unless options.overwrite (and then any
   // DIR vobench did not write as a dataset), creates the partial folder (and DIR's parent
-  // folders) under the lock DIR.lock.
+  // folders) under the lock DIR.vobench-lock.
   bool Open(const std::string& dir, const vo::StereoCamera& camera, std::string* error);
   // Writes the frame's images at once. Frames must come in strictly increasing time (distinct
   // t_ns); images must be CV_8UC1 of the camera's size, depth empty or CV_32FC1 of that size.

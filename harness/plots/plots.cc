@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <string>
 
 #include "sim/data_dir.h"
 
@@ -38,8 +40,15 @@ bool RunPythonScript(const std::string& script, const std::vector<std::string>& 
   while (fgets(buf, sizeof(buf), pipe)) out += buf;
   const int status = pclose(pipe);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    // The reason is the last line Python printed ("OSError: [Errno 28] No space left on
+    // device"), not its traceback.
+    std::string reason;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);)
+      if (line.find_first_not_of(" \t\r") != std::string::npos) reason = line;
+    if (reason.empty()) reason = "exit status " + std::to_string(WEXITSTATUS(status));
     *error = script + (args.empty() || script != "plot.py" ? std::string() : " " + args[0]) +
-             " failed: " + out;
+             " failed: " + reason;
     return false;
   }
   return true;

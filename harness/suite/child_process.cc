@@ -11,6 +11,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "harness/interrupt.h"
 #include "harness/plots/plots.h"
 #include "harness/suite/folder.h"
 
@@ -44,9 +45,8 @@ bool Spawn(const std::vector<std::string>& argv, const std::string& log_path, pi
   if (child == 0) {
     setpgid(0, 0);
     prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (getppid() != parent) _exit(127);  // the parent died before prctl
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
+    if (getppid() != parent) _exit(127);                  // the parent died before prctl
+    for (const int sig : kSignals) signal(sig, SIG_DFL);  // the parent's recording handlers
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);

@@ -17,7 +17,7 @@ using json = nlohmann::ordered_json;
 
 bool WriteFileAtomically(const std::string& path, const std::string& text, std::string* error) {
   const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-  if (!WriteTextFile(tmp, text, error)) return false;
+  if (!WriteTextFile(tmp, text, error)) return false;  // removes tmp when it fails
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
@@ -154,11 +154,9 @@ void RemoveLeftovers(const fs::path& out, const fs::path& work) {
   std::error_code ec;
   fs::remove_all(work, ec);
   fs::remove(out / "tmp", ec);    // only if empty
-  std::vector<fs::path> partial;  // only folders vobench marked as its own
+  std::vector<fs::path> partial;  // only work folders of killed vobench processes
   for (fs::directory_iterator it(out / "runs", ec), end; !ec && it != end; it.increment(ec))
-    if (it->path().filename().string().find(".partial") != std::string::npos &&
-        HasFolderMarker(it->path().string()))
-      partial.push_back(it->path());
+    if (IsStaleWorkFolder(it->path().string())) partial.push_back(it->path());
   for (const auto& p : partial) fs::remove_all(p, ec);
 }
 

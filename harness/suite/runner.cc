@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <deque>
@@ -279,6 +280,15 @@ bool MergeSuiteShards(const std::vector<std::string>& shard_dirs, const std::str
     std::error_code ec;
     if (fs::exists(out_dir) && fs::equivalent(shard_dirs[k], out_dir, ec)) {
       *error = out_dir + ": the merge output must not be one of the shard folders";
+      return false;
+    }
+    // Nor inside one: a later merge or resume of that shard would read it as its own runs.
+    const fs::path shard_path = fs::weakly_canonical(shard_dirs[k], ec);
+    const fs::path out_path = fs::weakly_canonical(out_dir, ec);
+    const auto [end, ignored] =
+        std::mismatch(shard_path.begin(), shard_path.end(), out_path.begin(), out_path.end());
+    if (!shard_path.empty() && end == shard_path.end()) {
+      *error = out_dir + ": the merge output must not be inside the shard folder " + shard_dirs[k];
       return false;
     }
     if (k == 0) {

@@ -9,9 +9,11 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <string>
 
 #include "harness/overrides.h"
 #include "harness/path_names.h"
+#include "harness/run.h"
 #include "harness/suite/folder.h"
 #include "harness/vo_config.h"
 #include "sim/yaml_input.h"
@@ -94,6 +96,56 @@ bool CheckRunIdPart(const std::string& name, const std::string& what, std::strin
   *why = what + " '" + name + "': expected letters, digits, '_', '.', '-' (no '__')";
   return false;
 }
+
+namespace {
+
+// What vobench appends to a run id in a file name: "<id>.partial-<pid>-XXXXXX" (the run's work
+// folder), "<id>.failed.txt.tmp<pid>"; a pid has at most 7 digits (pid_max 4194304).
+constexpr size_t kLongestIdSuffix = std::char_traits<char>::length(".failed.txt.tmp") + 7 + 2;
+
+// Before the first run starts: every run id fits in a file name with the longest suffix, and
+// each scenario's frame limit and the strides leave the VO 2 frames (a suite of runs that
+// would all fail is refused at the line to change).
+void CheckRunsCanRun(const Suite& s, const YAML::Node& root, YamlReader* r) {
+  const std::vector<uint64_t> no_seeds;
+  for (size_t i = 0; i < s.scenarios.size() && r->ok(); ++i) {
+    const SuiteScenario& sc = s.scenarios[i];
+    const YAML::Node entry = root["scenarios"][i];
+    const std::string key = "scenarios[" + std::to_string(i) + "]";
+    const std::vector<uint64_t> seeds =
+        s.seeds.empty() ? std::vector<uint64_t>{sc.scenario.seed} : s.seeds;
+    for (const SuiteConfig& c : s.configs)
+      for (uint64_t seed : seeds)
+        for (int stride : s.strides) {
+          const std::string id = sc.name + "__" + c.name + "__s" + std::to_string(seed) + "__k" +
+                                 std::to_string(stride);
+          if (id.size() + kLongestIdSuffix > kMaxPathNameBytes && r->ok())
+            r->Fail(entry["name"].IsDefined() ? entry["name"] : entry, key + ".name",
+                    "run id '" + id.substr(0, 40) + "...' (" + std::to_string(id.size()) +
+                        " bytes: scenario, configuration, seed and stride) leaves no room for "
+                        "the file names made from it (" +
+                        std::to_string(kLongestIdSuffix) + " more bytes, at most " +
+                        std::to_string(kMaxPathNameBytes) +
+                        "): shorten the scenario or configuration name");
+        }
+    for (int stride : s.strides) {
+      const std::string problem =
+          FrameBudgetProblem(sim::EstimatedFrames(sc.scenario), true, sc.max_frames, stride);
+      if (problem.empty() || !r->ok()) continue;
+      const YAML::Node at = entry["max_frames"].IsDefined() ? entry["max_frames"]
+                            : root["max_frames"].IsDefined() && sc.max_frames > 0
+                                ? root["max_frames"]
+                            : root["strides"].IsDefined() ? root["strides"]
+                                                          : entry;
+      // The option names of `vobench run` read as the suite's keys here.
+      std::string what = std::regex_replace(problem, std::regex("--max-frames"), "max_frames");
+      what = std::regex_replace(what, std::regex("--stride"), "stride");
+      r->Fail(at, key, what);
+    }
+  }
+}
+
+}  // namespace
 
 bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
                 const std::string& base_dir, Suite* suite, std::string* error) {
@@ -225,6 +277,7 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
       s.strides.push_back(v);
     }
   }
+  if (r.ok()) CheckRunsCanRun(s, root, &r);
   if (!r.Report(error)) return false;
   *suite = s;
   return true;

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -80,6 +81,13 @@ std::vector<DatasetFrame> MakeSequence(int n, bool with_gt, bool with_depth) {
     frames.push_back(f);
   }
   return frames;
+}
+
+// A KITTI image's file name: "000042.png".
+std::string FrameNameOf(int index) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06d.png", index);
+  return name;
 }
 
 bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
@@ -395,7 +403,8 @@ TEST_F(DatasetTest, OpenRemovesOnlyMarkedPartialFoldersOfDeadWriters) {
   gethostname(host, sizeof(host) - 1);
   const auto marker = [&](long pid) {
     return "{\"vobench_folder\": 1, \"kind\": \"dataset\", \"pid\": " + std::to_string(pid) +
-           ", \"host\": \"" + std::string(host) + "\"}\n";
+           ", \"host\": \"" + std::string(host) +
+           "\", \"work_folder_of_pid\": " + std::to_string(pid) + "}\n";
   };
   WriteAll(stale / ".vobench.json", marker(2147483646));
   // The same without a marker (written by someone else, or by an older vobench): left alone.
@@ -595,6 +604,70 @@ TEST_F(KittiMalformedTest, DepthWithWrongType) {
   EXPECT_THAT(error, HasSubstr(dir + "/depth/000001.png: expected a 16-bit"));
 }
 
+// Issue #31, item 6: a principal point at x = 1e6 px (2590 m error on a 0.98 m path), a
+// duplicated P0: line (the last won silently), skew and a non-standard third row ran.
+TEST_F(KittiMalformedTest, NonsenseCalibrationsAreRefusedAtTheirLine) {
+  const std::string p1 = "P1: 52.25 0 31.5 -6.53125 0 51.75 23.5 0 0 0 1 0\n";
+  WriteAll(dir_ + "/calib.txt",
+           "P0: 52.25 0 1e6 0 0 51.75 23.5 0 0 0 1 0\n"
+           "P1: 52.25 0 1e6 -6.53125 0 51.75 23.5 0 0 0 1 0\n");
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/calib.txt: principal point (1e+06, 23.5) px "
+                                                 "lies outside the 64x48 image"));
+  WriteAll(dir_ + "/calib.txt", "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1 0\n" + p1 +
+                                    "P0: 60 0 31.5 0 0 51.75 23.5 0 0 0 1 0\n");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/calib.txt:3: key 'P0': given twice (a second line would "
+                               "silently replace the first)"));
+  WriteAll(dir_ + "/calib.txt", "P0: 52.25 0.3 31.5 0 0 51.75 23.5 0 0 0 1 0\n" + p1);
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/calib.txt:1: key 'P0': skew 0.3"));
+  WriteAll(dir_ + "/calib.txt", "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 0.5 0\n" + p1);
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/calib.txt:1: key 'P0': entry 11 is 0.5, expected 1"));
+  WriteAll(dir_ + "/calib.txt", "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0.1 0 1 0\n" + p1);
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/calib.txt:1: key 'P0': entry 9 is 0.1"));
+}
+
+// Issue #31, item 13: a times.txt shorter than the image list used 10 of 32 frames silently.
+TEST_F(KittiMalformedTest, TimesShorterThanTheImagesIsRefused) {
+  WriteAll(dir_ + "/times.txt", "0.0\n0.1\n");
+  EXPECT_THAT(OpenAndReadAll(),
+              HasSubstr(dir_ + "/times.txt: lists 2 frames but " + dir_ + "/image_0/ holds " +
+                        std::to_string(kNumFrames) + " images"));
+}
+
+// Issue #31, item 7: 16-bit PNGs were read by their high byte: a 16-bit frame holding 8-bit
+// values read black, 12-bit data failed as "black, textureless". Now by their bit depth.
+TEST_F(KittiMalformedTest, SixteenBitImagesAreReadByTheirBitDepth) {
+  KittiReader reader;
+  std::string error;
+  ASSERT_TRUE(reader.Open(dir_, &error)) << error;
+  std::vector<DatasetFrame> eight(kNumFrames);
+  for (int i = 0; i < kNumFrames; ++i) ASSERT_TRUE(reader.ReadFrame(i, &eight[i], &error));
+  // The same images as 16-bit PNGs: 8-bit values, then 12-bit ones (value * 16 + 7).
+  for (const int shift : {0, 4}) {
+    for (int i = 0; i < kNumFrames; ++i)
+      for (int cam = 0; cam < 2; ++cam) {
+        cv::Mat wide;
+        (cam == 0 ? eight[i].left : eight[i].right).convertTo(wide, CV_16UC1, 1 << shift);
+        if (shift > 0) wide += 7;
+        cv::imwrite(dir_ + "/image_" + std::to_string(cam) + "/" + FrameNameOf(i), wide);
+      }
+    KittiReader wide_reader;
+    ASSERT_TRUE(wide_reader.Open(dir_, &error)) << error;
+    for (int i = 0; i < kNumFrames; ++i) {
+      DatasetFrame f;
+      ASSERT_TRUE(wide_reader.ReadFrame(i, &f, &error)) << error;
+      EXPECT_TRUE(SameBytes(f.left, eight[i].left)) << "shift " << shift << " frame " << i;
+      EXPECT_TRUE(SameBytes(f.right, eight[i].right)) << "shift " << shift << " frame " << i;
+    }
+  }
+  // A later frame beyond the sequence's 12 bits is refused with the reason.
+  cv::Mat bright(48, 64, CV_16UC1, cv::Scalar(5000));
+  cv::imwrite(dir_ + "/image_1/" + FrameNameOf(2), bright);
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/image_1/000002.png: pixel value 5000 exceeds "
+                                                 "the 12-bit range of the sequence"));
+}
+
 TEST(KittiCalibTest, ReadsKittiOdometryCalibration) {
   const fs::path path = fs::path(::testing::TempDir()) /
                         ("vobench_kitti_calib_" + std::to_string(::getpid()) + ".txt");
@@ -697,6 +770,39 @@ TEST_F(EurocMalformedTest, MissingKeyAndBrokenYaml) {
   EXPECT_THAT(OpenAndReadAll(), HasSubstr(": key 'resolution': required: [width, height]"));
   WriteAll(dir_ + "/mav0/cam0/sensor.yaml", "T_BS: [1, 2\nintrinsics: {\n");
   EXPECT_THAT(OpenAndReadAll(), HasSubstr(dir_ + "/mav0/cam0/sensor.yaml:"));
+}
+
+// Issue #31, item 4: EuRoC calibration was not checked: a focal length of 5 px on 320x240 (a
+// 176 deg field of view) ran to exit 0 with 98 % error; a 10 m baseline failed later as "black,
+// textureless". The KITTI and TUM readers refused both; now every layout does.
+TEST_F(EurocMalformedTest, ImplausibleCalibrationIsRefusedAtItsLine) {
+  const std::string path = dir_ + "/mav0/cam0/sensor.yaml";
+  const std::string good = ReadAll(path);
+  std::string yaml = good;
+  yaml.replace(yaml.find("intrinsics: [52.25"), std::string("intrinsics: [52.25").size(),
+               "intrinsics: [2");
+  WriteAll(path, yaml);
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(path + ":"));
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(": key 'intrinsics': fx 2 px gives a horizontal field "
+                                          "of view of"));
+  yaml = good;
+  yaml.replace(yaml.find(", 31.5, 23.5]"), std::string(", 31.5, 23.5]").size(), ", 3000, 23.5]");
+  WriteAll(path, yaml);
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(": key 'intrinsics': principal point (3000, 23.5) px "
+                                          "lies outside the 64x48 image"));
+  WriteAll(path, good);
+  // cam1 10 m beside cam0.
+  const std::string path1 = dir_ + "/mav0/cam1/sensor.yaml";
+  yaml = ReadAll(path1);
+  const size_t data = yaml.find("data: [");
+  ASSERT_NE(data, std::string::npos);
+  const size_t first_comma = yaml.find(',', yaml.find(',', yaml.find(',', data) + 1) + 1);
+  const size_t fourth = yaml.find(',', first_comma + 1);
+  yaml.replace(first_comma + 1, fourth - first_comma - 1, " 10.0");
+  WriteAll(path1, yaml);
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(path1 + ":"));
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr(": key 'T_BS': the baseline between cam0 and cam1 is "));
+  EXPECT_THAT(OpenAndReadAll(), HasSubstr("outside the plausible range 0.001 .. 5 m"));
 }
 
 TEST_F(EurocMalformedTest, MissingImageFile) {

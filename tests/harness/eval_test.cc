@@ -369,8 +369,9 @@ class EvalBadInputTest : public ::testing::Test {
   std::string Out() const { return (dir_ / "out").string(); }
 
   // Runs `vobench eval ARGS --out Out() -q --no-plots`; expects failure with a message holding
-  // `message` and no run folder (nor a partial one) left behind.
-  void ExpectCliFailure(const std::string& args, const std::string& message, int exit_code = 1) {
+  // `message` and no run folder (nor a partial one) left behind. A dataset its reader refuses
+  // is bad input: exit 2 (issue #31); a frame that fails during the run: 1.
+  void ExpectCliFailure(const std::string& args, const std::string& message, int exit_code = 2) {
     const CommandResult r = RunVobench("eval " + args + " --out " + Out() + " -q --no-plots");
     EXPECT_EQ(r.exit_code, exit_code) << r.output;
     EXPECT_THAT(r.output, HasSubstr(message));
@@ -511,7 +512,7 @@ TEST_F(EvalBadInputTest, UnreadableImageInTheMiddleLeavesNoRunFolder) {
   const std::string data = Data(DatasetFormat::kTum);
   WriteText(data + "/image_1/000005.png", "not a png");
   ExpectCliFailure("--dataset " + data + " --format kitti",
-                   data + "/image_1/000005.png: cannot decode the image");
+                   data + "/image_1/000005.png: cannot decode the image", 1);
 }
 
 TEST_F(EvalBadInputTest, EurocMissingOrBadCalibration) {

@@ -51,8 +51,8 @@ std::string HostName() {
   return name;
 }
 
-// A marker as vobench writes it, for process `pid` of this host.
-void WriteMarker(const std::string& dir, const std::string& kind, long pid) {
+// A marker as vobench writes it, for process `pid` of this host (`work`: of its work folder).
+void WriteMarker(const std::string& dir, const std::string& kind, long pid, bool work = false) {
   nlohmann::json j;
   j["vobench_folder"] = harness::kFolderMarkerFormat;
   j["kind"] = kind;
@@ -61,6 +61,7 @@ void WriteMarker(const std::string& dir, const std::string& kind, long pid) {
   j["created_utc"] = "2026-01-01T00:00:00Z";
   j["pid"] = pid;
   j["host"] = HostName();
+  if (work) j[harness::kWorkFolderKey] = pid;
   WriteText(dir + "/" + harness::kFolderMarkerFile, j.dump(2) + "\n");
 }
 
@@ -79,8 +80,11 @@ TEST(OutputFolderTest, WritesTheMarkerFirstAndPublishesUnderALock) {
   for (const auto& e : fs::directory_iterator(folder.path()))
     files.push_back(e.path().filename().string());
   EXPECT_EQ(files, std::vector<std::string>{".vobench.json"});
-  EXPECT_TRUE(fs::exists(out + ".lock"));
-  EXPECT_EQ(ReadAll(out + ".lock"), std::to_string(getpid()) + "\n");
+  FolderMarker work;
+  ASSERT_TRUE(harness::ReadFolderMarker(folder.path(), &work, &error)) << error;
+  EXPECT_EQ(work.work_folder_of_pid, getpid());  // "work folder of pid P"
+  EXPECT_EQ(ReadAll(out + ".vobench-lock"),
+            "vobench-lock pid=" + std::to_string(getpid()) + " host=" + HostName() + "\n");
   EXPECT_FALSE(fs::exists(out));
   WriteText(folder.path() + "/metrics.json", "{}");
   ASSERT_TRUE(folder.Publish(&error)) << error;
@@ -97,6 +101,8 @@ TEST(OutputFolderTest, WritesTheMarkerFirstAndPublishesUnderALock) {
               ::testing::MatchesRegex("[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9]{2}:[0-9]{2}:[0-9]{2}Z"));
   EXPECT_EQ(marker.pid, getpid());
   EXPECT_EQ(marker.host, HostName());
+  EXPECT_EQ(marker.work_folder_of_pid, 0);  // published: no longer a work folder
+  EXPECT_THAT(ReadAll(out + "/.vobench.json"), ::testing::Not(HasSubstr("work_folder_of_pid")));
   EXPECT_TRUE(fs::exists(out + "/metrics.json"));
   // Nothing else is left beside it: no work folder, no lock file.
   EXPECT_EQ(EntriesStartingWith(dir / "sub", "run"), std::vector<std::string>{"run"});
@@ -202,12 +208,14 @@ TEST(OutputFolderTest, SecondWriterOfTheSameFolderFailsAtOnce) {
 TEST(OutputFolderTest, AFileNamedLikeTheLockThatIsNotOneIsKept) {
   TempDir dir("of_lockfile");
   const std::string out = dir / "run";
-  WriteText(out + ".lock", "my notes\n");
-  OutputFolder folder;
-  std::string error;
-  EXPECT_FALSE(folder.Create(out, "run", &error));
-  EXPECT_THAT(error, HasSubstr(out + ".lock: exists and is not a vobench lock file"));
-  EXPECT_EQ(ReadAll(out + ".lock"), "my notes\n");
+  for (const std::string text : {"my notes\n", "", "4242\n"}) {  // empty, a bare pid: not ours
+    WriteText(out + ".vobench-lock", text);
+    OutputFolder folder;
+    std::string error;
+    EXPECT_FALSE(folder.Create(out, "run", &error));
+    EXPECT_THAT(error, HasSubstr(out + ".vobench-lock: exists and is not a vobench lock file"));
+    EXPECT_EQ(ReadAll(out + ".vobench-lock"), text);
+  }
 }
 
 TEST(OutputFolderTest, LockOfAKilledWriterIsTakenOver) {
@@ -219,7 +227,7 @@ TEST(OutputFolderTest, LockOfAKilledWriterIsTakenOver) {
   if (child == 0) {
     harness::FolderLock lock;
     std::string error;
-    const char ok = lock.Acquire(out + ".lock", out, &error) ? '1' : '0';
+    const char ok = lock.Acquire(out + ".vobench-lock", out, &error) ? '1' : '0';
     (void)!write(ready[1], &ok, 1);
     pause();  // until SIGKILL: no destructor runs
     _exit(0);
@@ -234,11 +242,11 @@ TEST(OutputFolderTest, LockOfAKilledWriterIsTakenOver) {
   kill(child, SIGKILL);
   int status = 0;
   waitpid(child, &status, 0);
-  EXPECT_TRUE(fs::exists(out + ".lock"));  // left behind, but no longer locked
+  EXPECT_TRUE(fs::exists(out + ".vobench-lock"));  // left behind, but no longer locked
   OutputFolder folder;
   ASSERT_TRUE(folder.Create(out, "run", &error)) << error;
   ASSERT_TRUE(folder.Publish(&error)) << error;
-  EXPECT_FALSE(fs::exists(out + ".lock"));
+  EXPECT_FALSE(fs::exists(out + ".vobench-lock"));
   close(ready[0]);
   close(ready[1]);
 }
@@ -248,17 +256,29 @@ TEST(OutputFolderTest, StaleWorkFoldersAreRemovedOnlyWhenMarked) {
   const std::string out = dir / "run";
   const pid_t dead = DeadPid();
   // A vobench killed outright left its marked work folder: removed.
-  const std::string stale = out + ".partial-" + std::to_string(dead) + "-x";
+  const std::string stale = out + ".partial-" + std::to_string(dead) + "-xAbC12";
   fs::create_directories(stale + "/sub");
-  WriteMarker(stale, "run", dead);
+  WriteMarker(stale, "run", dead, /*work=*/true);
   // A folder of the same pattern without a marker: not vobench's to remove.
-  const std::string foreign = out + ".partial-" + std::to_string(dead) + "-y";
+  const std::string foreign = out + ".partial-" + std::to_string(dead) + "-yAbC12";
   fs::create_directories(foreign);
   WriteText(foreign + "/notes.txt", "keep");
   // A marked work folder of a process that still runs (this one): left alone.
-  const std::string live = out + ".partial-" + std::to_string(getpid()) + "-z";
+  const std::string live = out + ".partial-" + std::to_string(getpid()) + "-zAbC12";
   fs::create_directories(live);
-  WriteMarker(live, "run", getpid());
+  WriteMarker(live, "run", getpid(), /*work=*/true);
+  // A finished folder of that dead process renamed to the pattern (a user's backup): kept.
+  const std::string backup = out + ".partial-" + std::to_string(dead) + "-bAcKuP";
+  fs::create_directories(backup);
+  WriteMarker(backup, "run", dead);
+  // A work marker whose pid is not the one in the name, and a name that is not exactly the
+  // pattern: kept.
+  const std::string other_pid = out + ".partial-1-qAbC12";
+  fs::create_directories(other_pid);
+  WriteMarker(other_pid, "run", dead, /*work=*/true);
+  const std::string inexact = out + ".partial-" + std::to_string(dead) + "-x";
+  fs::create_directories(inexact);
+  WriteMarker(inexact, "run", dead, /*work=*/true);
 
   OutputFolder folder;
   std::string error;
@@ -266,6 +286,9 @@ TEST(OutputFolderTest, StaleWorkFoldersAreRemovedOnlyWhenMarked) {
   EXPECT_FALSE(fs::exists(stale));
   EXPECT_EQ(ReadAll(foreign + "/notes.txt"), "keep");
   EXPECT_TRUE(fs::exists(live));
+  EXPECT_TRUE(fs::exists(backup));
+  EXPECT_TRUE(fs::exists(other_pid));
+  EXPECT_TRUE(fs::exists(inexact));
   ASSERT_TRUE(folder.Publish(&error)) << error;
 }
 
@@ -436,10 +459,10 @@ TEST(OwnershipCliTest, RunCleansOnlyMarkedStaleWorkFolders) {
   TempDir dir("own_stale");
   const std::string out = dir / "o";
   const pid_t dead = DeadPid();
-  const std::string stale = out + ".partial-" + std::to_string(dead) + "-x";
+  const std::string stale = out + ".partial-" + std::to_string(dead) + "-xAbC12";
   fs::create_directories(stale);
-  WriteMarker(stale, "run", dead);
-  const std::string foreign = out + ".partial-" + std::to_string(dead) + "-y";
+  WriteMarker(stale, "run", dead, /*work=*/true);
+  const std::string foreign = out + ".partial-" + std::to_string(dead) + "-yAbC12";
   fs::create_directories(foreign);
   WriteText(foreign + "/data.bin", "mine");
   const auto r =
