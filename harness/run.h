@@ -32,6 +32,9 @@ struct RunOptions {
   int max_frames = 0;         // stop after this many frames of the source (0 = all)
   int frame_stride = 1;       // the VO sees every k-th source frame (0, k, 2k, ...; less overlap
                               // between its frames), >= 1; metrics are on those frames
+  std::string ground_truth_not_gravity_aligned;  // why the ground truth's world is not
+                                                 // gravity-aligned ("" = it is): no
+                                                 // initial-orientation error then
 };
 
 // The whole pipeline: runs the VO over `source` (RunFrames), summarises (Summarize) and
