@@ -97,9 +97,9 @@ void PrintRunTable(const RunSummary& s, const std::string& out) {
       std::printf("end-pose error  %.4f m (%.2f %% of the path), rotation %.3f deg\n",
                   m.end_pose_error_m, m.end_pose_error_pct, m.end_rotation_error_deg);
     else
-      std::printf("end-pose error  %.4f m (%% of the path n/a (%s)), rotation %.3f deg\n",
-                  m.end_pose_error_m, m.end_pose_error_pct_reason.c_str(),
-                  m.end_rotation_error_deg);
+      std::printf("end-pose error  %.4f m, rotation %.3f deg; %% of the path n/a (%s)\n",
+                  m.end_pose_error_m, m.end_rotation_error_deg,
+                  m.end_pose_error_pct_reason.c_str());
     std::printf("ATE RMSE        %.4f m (SE(3)-aligned), %.4f m (from the start)\n", m.ate_rmse_m,
                 m.ate_rmse_unaligned_m);
     if (std::isfinite(m.drift_pct))
