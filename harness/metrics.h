@@ -77,7 +77,9 @@ std::vector<double> KittiSegmentLengths(double path_length_m);
 // 10th frame, for each length L the first frame whose ground-truth distance is more than L
 // further (strictly), the error inv(Δest)·Δgt, its translation norm / L and rotation angle / L;
 // the mean over every (frame, L) segment. Sets kitti_drift_pct (×100), kitti_drift_deg_per_m
-// and kitti_drift_segments; both NaN (with kitti_drift_reason) when no segment fits.
+// and kitti_drift_segments; both NaN (with kitti_drift_reason) when no segment fits. In double
+// precision (the devkit: float), the angle by RotationAngle (the devkit: acos of the trace, the
+// same angle without acos's loss near 0); rotation in deg/m (the devkit's stats: rad/m).
 void KittiDrift(const std::vector<Eigen::Isometry3d>& est, const std::vector<Eigen::Isometry3d>& gt,
                 const std::vector<double>& lengths, TrajectoryMetrics* m);
 

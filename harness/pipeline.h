@@ -48,8 +48,8 @@ struct StereoSequence {
   // first frame shows no floor or ceiling (vo::ResolvePlatform).
   double camera_pitch_deg = std::numeric_limits<double>::quiet_NaN();
   // Why the ground truth's world is not gravity-aligned ("" when it is: simulated runs, the
-  // KITTI layout with T_world_cam0first.txt, EuRoC). Then a run reports no initial-orientation
-  // error (RunSummary::initial_orientation_error_reason).
+  // KITTI layout with T_world_cam0first.txt, EuRoC's and TUM's motion-capture worlds). Then a
+  // run reports no initial-orientation error (RunSummary::initial_orientation_error_reason).
   std::string ground_truth_not_gravity_aligned;
 };
 
