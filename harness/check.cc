@@ -277,6 +277,24 @@ CheckReport CompareToBaseline(const Baseline& baseline, const SuiteResult& resul
       } else if (!std::isfinite(c.now) || worsening > c.tolerance) {
         c.verdict = "WORSE";
         ++report.worse;
+        if (!std::isfinite(c.now)) {  // null (not applicable) or absent in the run
+          std::string why = "no value in the run's metrics.json";
+          const MetricInfo* info = FindMetric(m.name);
+          if (v.is_null() && info != nullptr) {
+            why = "null (not applicable) in the run's metrics.json";
+            const auto& reg = RunMetrics();
+            for (auto it = std::find_if(reg.begin(), reg.end(),
+                                        [&](const MetricInfo& r) { return r.key == m.name; });
+                 it != reg.end(); ++it) {
+              if (!it->reason) continue;
+              if (const nlohmann::json* r = FindMetricValue(row->metrics, it->key);
+                  r != nullptr && r->is_string())
+                why += ": " + r->get<std::string>();
+              break;
+            }
+          }
+          c.note = "(now " + why + "; the baseline has a number)";
+        }
       } else if (-worsening > c.tolerance) {
         c.verdict = "BETTER";
         ++report.better;
@@ -321,7 +339,7 @@ std::string CheckTableText(const CheckReport& report, bool only_moved) {
       std::snprintf(buf, sizeof(buf), "%-*s %-22s %10s %10s %10s %10s  %s\n", static_cast<int>(w),
                     r.run.c_str(), r.metric.c_str(), Num(r.baseline).c_str(), Num(r.now).c_str(),
                     Signed(r.now - r.baseline).c_str(), Num(r.tolerance).c_str(),
-                    r.verdict.c_str());
+                    (r.verdict + (r.note.empty() ? "" : " " + r.note)).c_str());
     }
     t << buf;
   }

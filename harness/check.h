@@ -69,6 +69,8 @@ struct CheckRow {
   double now = 0.0;
   double tolerance = 0.0;
   std::string verdict;  // OK | BETTER | WORSE | FAILED | MISSING | NEW
+  std::string note;     // why `now` is null when the baseline has a number (the run's
+                        // *_reason text), printed after the verdict
 };
 
 struct CheckReport {

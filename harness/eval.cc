@@ -70,6 +70,13 @@ bool OpenKitti(const std::string& dir, const EvalOptions& options, StereoSequenc
     info->ground_truth_path = (fs::path(dir) / "poses.txt").string();
     info->ground_truth_frames = reader->size();
   }
+  // poses.txt (or --gt in the KITTI format) is relative to the first camera unless
+  // T_world_cam0first.txt places that camera in a gravity-aligned world.
+  if (!info->ground_truth_path.empty() && gt_index->empty() &&
+      !fs::exists(fs::path(dir) / "T_world_cam0first.txt"))
+    sequence->ground_truth_not_gravity_aligned =
+        "ground truth not gravity-aligned (KITTI layout without T_world_cam0first.txt: world = "
+        "first camera)";
   sequence->camera = reader->camera();
   sequence->expected_frames = static_cast<int>(reader->size());
   sequence->next = [reader, external, gt_index, next = size_t{0}](DatasetFrame* frame,

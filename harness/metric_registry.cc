@@ -1,6 +1,7 @@
 #include "harness/metric_registry.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace harness {
 namespace {
@@ -20,13 +21,25 @@ MetricInfo Metric(std::string key, std::string unit, Better better, MetricGroup 
   return m;
 }
 
+// A figure that may not apply: NaN is null in metrics.json.
+json NumberOrNull(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+// The reason entry `key` (a text, written only when not empty) of the figures before it.
+MetricInfo Reason(std::string key, MetricGroup group, std::string meaning,
+                  std::function<std::string(const RunSummary&)> text) {
+  MetricInfo m = Metric(std::move(key), "", Better::kNeither, group, std::move(meaning),
+                        [text](const RunSummary& s) { return json(text(s)); });
+  m.reason = true;
+  return m;
+}
+
 // An accuracy metric (needs ground truth, lower is better): may be tune's objective; checked
 // by `check` when `tolerance` >= 0.
 MetricInfo Accuracy(std::string key, std::string unit, std::string meaning,
                     double TrajectoryMetrics::*field, double tolerance = -1.0) {
-  MetricInfo m =
-      Metric(std::move(key), std::move(unit), Better::kLower, MetricGroup::kAccuracy,
-             std::move(meaning), [field](const RunSummary& s) { return json(s.metrics.*field); });
+  MetricInfo m = Metric(std::move(key), std::move(unit), Better::kLower, MetricGroup::kAccuracy,
+                        std::move(meaning),
+                        [field](const RunSummary& s) { return NumberOrNull(s.metrics.*field); });
   m.tune_objective = true;
   m.check_tolerance = tolerance;
   return m;
@@ -65,13 +78,17 @@ std::vector<MetricInfo> MakeRegistry() {
       Metric("ground_truth_frames", "frames", kNeither, kRun,
              "frames with a ground-truth pose; the accuracy metrics use these only",
              [](const RunSummary& s) { return json(s.ground_truth_frames); }),
-      Metric("path_length_m", "m", kNeither, kAcc, "length of the ground-truth camera path",
+      Metric("path_length_m", "m", kNeither, kAcc,
+             "length of the ground-truth camera path (3-D, the evaluated frames)",
              [](const RunSummary& s) { return json(s.metrics.path_length_m); }),
       Accuracy("end_pose_error_m", "m",
                "position error at the last frame, both trajectories from their first pose",
                &M::end_pose_error_m, 0.01),
-      Accuracy("end_pose_error_pct", "%", "end_pose_error_m in % of the path length",
+      Accuracy("end_pose_error_pct", "%",
+               "end_pose_error_m in % of the path length (null: path shorter than 1 m)",
                &M::end_pose_error_pct),
+      Reason("end_pose_error_pct_reason", kAcc, "why end_pose_error_pct is null",
+             [](const RunSummary& s) { return s.metrics.end_pose_error_pct_reason; }),
       Accuracy("end_rotation_error_deg", "deg", "rotation error at the last frame",
                &M::end_rotation_error_deg, 0.25),
       Accuracy("ate_rmse_m", "m", "RMSE of the positions after SE(3) (Umeyama) alignment",
@@ -86,20 +103,36 @@ std::vector<MetricInfo> MakeRegistry() {
              "distance step of the rpe_distance_* metrics",
              [](const RunSummary& s) { return json(s.metrics.rpe_distance_step_m); }),
       Accuracy("rpe_distance_trans_rmse_m", "m",
-               "relative pose error over rpe_distance_step_m of path: translation RMSE",
+               "relative pose error over rpe_distance_step_m of path (evo_rpe --delta_unit m "
+               "--all_pairs): translation RMSE",
                &M::rpe_distance_trans_rmse_m),
       Accuracy("rpe_distance_rot_rmse_deg", "deg",
                "relative pose error over rpe_distance_step_m of path: rotation RMSE",
                &M::rpe_distance_rot_rmse_deg),
-      Metric(
-          "rpe_distance_pairs", "", kNeither, kAcc,
-          "frame pairs the rpe_distance_* metrics averaged (0: the path is shorter than the step)",
-          [](const RunSummary& s) { return json(s.metrics.rpe_distance_pairs); }),
+      Metric("rpe_distance_pairs", "", kNeither, kAcc,
+             "frame pairs the rpe_distance_* metrics averaged (0: none, they are null)",
+             [](const RunSummary& s) { return json(s.metrics.rpe_distance_pairs); }),
+      Reason("rpe_distance_reason", kAcc, "why the rpe_distance_* RMSEs are null",
+             [](const RunSummary& s) { return s.metrics.rpe_distance_reason; }),
       Accuracy("drift_pct", "%",
-               "KITTI-style translation drift, sub-paths of 1/8 ... 8/8 of the path, averaged",
+               "vobench's drift: sub-paths of at least 1/8 ... 8/8 of the path from every 10th "
+               "frame, translation error / actual sub-path length, averaged",
                &M::drift_pct, 0.25),
-      Accuracy("drift_deg_per_m", "deg/m", "KITTI-style rotation drift, the same sub-paths",
+      Accuracy("drift_deg_per_m", "deg/m", "vobench's rotation drift, the same sub-paths",
                &M::drift_deg_per_m),
+      Reason("drift_reason", kAcc, "why drift_pct and drift_deg_per_m are null",
+             [](const RunSummary& s) { return s.metrics.drift_reason; }),
+      Accuracy("kitti_drift_pct", "%",
+               "the KITTI devkit's translation error: segments of 100..800 m (k x path/10 below "
+               "1000 m of path) from every 10th frame to the first frame past L, error / L",
+               &M::kitti_drift_pct),
+      Accuracy("kitti_drift_deg_per_m", "deg/m",
+               "the KITTI devkit's rotation error, the same segments", &M::kitti_drift_deg_per_m),
+      Metric("kitti_drift_segments", "", kNeither, kAcc,
+             "segments the kitti_drift_* metrics averaged (0: none, they are null)",
+             [](const RunSummary& s) { return json(s.metrics.kitti_drift_segments); }),
+      Reason("kitti_drift_reason", kAcc, "why the kitti_drift_* metrics are null",
+             [](const RunSummary& s) { return s.metrics.kitti_drift_reason; }),
       Metric("matches_evaluated", "", kNeither, MetricGroup::kMatches,
              "VO matches checked against the ground-truth depth and poses",
              [](const RunSummary& s) { return json(s.match_stats.matches); }),
@@ -152,8 +185,10 @@ std::vector<MetricInfo> MakeRegistry() {
              "the first frame's orientation was found from the hallway's planes",
              [](const RunSummary& s) { return json(s.initial_orientation_ok); }),
       Metric("initial_orientation_error_deg", "deg", Better::kLower, kRun,
-             "error of that orientation vs the ground truth (< 0: not known)",
-             [](const RunSummary& s) { return json(s.initial_orientation_error_deg); }),
+             "error of that orientation vs the gravity-aligned ground truth (null: not known)",
+             [](const RunSummary& s) { return NumberOrNull(s.initial_orientation_error_deg); }),
+      Reason("initial_orientation_error_reason", kRun, "why initial_orientation_error_deg is null",
+             [](const RunSummary& s) { return s.initial_orientation_error_reason; }),
       Metric("initial_floor_refined", "", kNeither, kRun,
              "the first frame's floor was refined on the images (orientation_floor_refinement)",
              [](const RunSummary& s) { return json(s.initial_floor_refined); }),
@@ -161,12 +196,7 @@ std::vector<MetricInfo> MakeRegistry() {
              "what the VO ran as: free (6-DoF) or ground_vehicle (platform auto on a known rig)",
              [](const RunSummary& s) { return json(s.platform); }),
   };
-  // Not columns of summary.csv: the flags (the suite's status says enough) and the stride.
   for (MetricInfo& m : r) {
-    if (m.key == "has_ground_truth" || m.key == "initial_orientation_ok" ||
-        m.key == "initial_floor_refined" || m.key == "platform" ||
-        m.key == "frame_stride")  // the suite's own stride column
-      m.csv = false;
     if (m.key == "end_pose_error_pct") m.label = "end-pose error (% of path)";
     if (m.key == "ate_rmse_m") m.label = "ATE RMSE (m)";
   }
@@ -174,6 +204,7 @@ std::vector<MetricInfo> MakeRegistry() {
 }
 
 bool Written(const MetricInfo& m, const RunSummary& s) {
+  if (m.reason && m.value(s).get<std::string>().empty()) return false;  // the figure applies
   switch (m.group) {
     case MetricGroup::kAccuracy:
       return s.has_ground_truth;  // without ground truth there is nothing to compare with
@@ -223,11 +254,26 @@ std::vector<std::string> TuneObjectiveMetrics() {
   return keys;
 }
 
-bool ObjectiveValue(const RunSummary& summary, const std::string& key, double* value) {
+bool ObjectiveValue(const RunSummary& summary, const std::string& key, double* value,
+                    std::string* not_applicable) {
   const MetricInfo* m = FindMetric(key);
   if (m == nullptr || !m->tune_objective) return false;
-  *value = m->value(summary).get<double>();
+  const json v = m->value(summary);
+  *value = v.is_number() ? v.get<double>() : std::nan("");
+  if (not_applicable != nullptr)
+    *not_applicable = v.is_number() ? "" : NotApplicableReason(*m, summary);
   return true;
+}
+
+std::string NotApplicableReason(const MetricInfo& m, const RunSummary& summary) {
+  const auto& r = RunMetrics();
+  for (size_t i = 0; i < r.size(); ++i) {
+    if (r[i].key != m.key) continue;
+    for (size_t k = i + 1; k < r.size(); ++k)
+      if (r[k].reason) return r[k].value(summary).get<std::string>();
+    break;
+  }
+  return "";
 }
 
 std::vector<std::string> CheckedMetrics() {

@@ -1,6 +1,6 @@
 // The metric registry: every number a run reports, named once. It drives metrics.json (keys,
-// order, when a key is written), the suite's summary.csv columns, the metrics `tune` may
-// minimise, the metrics `check` compares with their tolerance floors, and the labels of the
+// order, when a key is written), the suite's summary.csv columns (every key), the metrics `tune`
+// may minimise, the metrics `check` compares with their tolerance floors, and the labels of the
 // suite's plot. Adding a metric is one entry in metric_registry.cc.
 #pragma once
 
@@ -34,7 +34,8 @@ struct MetricInfo {
   MetricGroup group = MetricGroup::kRun;
   std::string meaning;            // how to read it, one line (messages, the README)
   std::string label;              // short axis label of plots ("" = key and unit, see PlotLabel)
-  bool csv = true;                // a column of the suite's summary.csv
+  bool reason = false;            // a "*_reason" text: why the figures before it are null (not
+                                  // applicable to the run); written only when it is not empty
   bool tune_objective = false;    // may be `tune`'s objective.metric
   double check_tolerance = -1.0;  // >= 0: compared by `vobench check`, with this absolute
                                   // tolerance floor (in the metric's unit)
@@ -68,8 +69,14 @@ std::string PlotLabel(const MetricInfo& m);
 
 // The metrics `tune` may minimise (accuracy metrics where lower is better), in order.
 std::vector<std::string> TuneObjectiveMetrics();
-// The value of an objective metric of a summary; false for a name that is not one.
-bool ObjectiveValue(const RunSummary& summary, const std::string& key, double* value);
+// The value of an objective metric of a summary; false for a name that is not one. A metric
+// that does not apply to the run (null in metrics.json) is NaN, its reason in *not_applicable.
+bool ObjectiveValue(const RunSummary& summary, const std::string& key, double* value,
+                    std::string* not_applicable = nullptr);
+
+// Why `m` is null for `summary`: the text of the reason entry that follows it in the registry
+// ("" when it applies or has no reason entry).
+std::string NotApplicableReason(const MetricInfo& m, const RunSummary& summary);
 
 // The metrics `vobench check` compares (never timing), in order, and their tolerance floors.
 std::vector<std::string> CheckedMetrics();

@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 
 namespace harness {
 
@@ -48,7 +50,77 @@ Eigen::Isometry3d RelativeError(const std::vector<Eigen::Isometry3d>& est,
   return d_gt.inverse() * d_est;
 }
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string Metres(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.3f m", v);
+  return buf;
+}
+
 }  // namespace
+
+std::vector<std::pair<size_t, size_t>> RpeDistancePairs(const std::vector<double>& dist,
+                                                        double delta) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  const double tol = 0.1 * delta;  // evo_rpe: --delta_tol 0.1 (relative), the default
+  for (size_t i = 0; i + 1 < dist.size(); ++i) {
+    // |(dist[j] - dist[i]) - delta| falls, then rises along j (dist does not decrease): the
+    // first minimum is found before the distance passes delta by more than the best so far.
+    size_t best = i + 1;
+    double best_diff = std::fabs((dist[i + 1] - dist[i]) - delta);
+    for (size_t j = i + 2; j < dist.size(); ++j) {
+      const double diff = std::fabs((dist[j] - dist[i]) - delta);
+      if (diff < best_diff) {
+        best = j;
+        best_diff = diff;
+      } else if (dist[j] - dist[i] > delta) {
+        break;
+      }
+    }
+    if (best_diff <= tol) pairs.emplace_back(i, best);
+  }
+  return pairs;
+}
+
+std::vector<double> KittiSegmentLengths(double path_length_m) {
+  const double unit = path_length_m >= 1000.0 ? 100.0 : path_length_m / 10.0;
+  std::vector<double> lengths;
+  for (int k = 1; k <= 8; ++k) lengths.push_back(k * unit);
+  return lengths;
+}
+
+void KittiDrift(const std::vector<Eigen::Isometry3d>& est, const std::vector<Eigen::Isometry3d>& gt,
+                const std::vector<double>& lengths, TrajectoryMetrics* m) {
+  const size_t n = std::min(est.size(), gt.size());
+  const std::vector<double> dist =
+      CumulativeDistance(std::vector<Eigen::Isometry3d>(gt.begin(), gt.begin() + n));
+  constexpr size_t kStepFrames = 10;  // the devkit's step_size
+  double t_sum = 0.0, r_sum = 0.0;
+  int count = 0;
+  for (size_t first = 0; first < n; first += kStepFrames) {
+    for (const double len : lengths) {
+      size_t last = first;  // the devkit's lastFrameFromSegmentLength: first frame past len
+      while (last < n && !(dist[last] > dist[first] + len)) ++last;
+      if (last >= n) continue;
+      const Eigen::Isometry3d d_gt = gt[first].inverse() * gt[last];
+      const Eigen::Isometry3d d_est = est[first].inverse() * est[last];
+      const Eigen::Isometry3d error = d_est.inverse() * d_gt;
+      t_sum += error.translation().norm() / len;
+      r_sum += RotationAngle(Eigen::Matrix3d::Identity(), error.linear()) / len;
+      ++count;
+    }
+  }
+  m->kitti_drift_segments = count;
+  if (count == 0) {
+    m->kitti_drift_pct = m->kitti_drift_deg_per_m = kNaN;
+    m->kitti_drift_reason = "no segment of the KITTI lengths fits in the path";
+    return;
+  }
+  m->kitti_drift_pct = 100.0 * t_sum / count;
+  m->kitti_drift_deg_per_m = r_sum / count * 180.0 / M_PI;
+  m->kitti_drift_reason.clear();
+}
 
 TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>& estimate,
                                            const std::vector<Eigen::Isometry3d>& ground_truth,
@@ -66,7 +138,16 @@ TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>&
 
   // End pose.
   m.end_pose_error_m = (est.back().translation() - gt.back().translation()).norm();
-  m.end_pose_error_pct = m.path_length_m > 0 ? 100.0 * m.end_pose_error_m / m.path_length_m : 0.0;
+  const bool short_path = !(m.path_length_m >= kMinPathForRatiosM);
+  const std::string short_reason = "ground-truth path " + Metres(m.path_length_m) +
+                                   " shorter than " + Metres(kMinPathForRatiosM) +
+                                   ": no figures relative to the path length";
+  if (short_path) {
+    m.end_pose_error_pct = kNaN;
+    m.end_pose_error_pct_reason = short_reason;
+  } else {
+    m.end_pose_error_pct = 100.0 * m.end_pose_error_m / m.path_length_m;
+  }
   m.end_rotation_error_deg = RotationAngle(est.back().linear(), gt.back().linear()) * 180.0 / M_PI;
 
   // ATE: unaligned (common start) and after SE(3) Umeyama alignment of the positions.
@@ -92,36 +173,43 @@ TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>&
   m.rpe_trans_rmse_m = std::sqrt(st / (n - 1));
   m.rpe_rot_rmse_deg = std::sqrt(sr / (n - 1)) * 180.0 / M_PI;
 
-  // RPE over a distance step: from every frame to the first frame at least the step further
-  // along the ground-truth path (frames are discrete, so the pair spans >= the step).
+  // RPE over a distance step: evo_rpe's pairs (--delta step --delta_unit m --all_pairs).
   m.rpe_distance_step_m = rpe_distance_step_m;
+  double dt = 0.0, dr = 0.0;
   if (rpe_distance_step_m > 0.0) {
-    double dt = 0.0, dr = 0.0;
-    size_t j = 0;
-    for (size_t i = 0; i < n; ++i) {
-      j = std::max(j, i + 1);
-      while (j < n && dist[j] - dist[i] < rpe_distance_step_m) ++j;
-      if (j >= n) break;
+    for (const auto& [i, j] : RpeDistancePairs(dist, rpe_distance_step_m)) {
       const Eigen::Isometry3d e = RelativeError(est, gt, i, j);
       dt += e.translation().squaredNorm();
       const double r = RotationAngle(Eigen::Matrix3d::Identity(), e.linear());
       dr += r * r;
       ++m.rpe_distance_pairs;
     }
-    if (m.rpe_distance_pairs > 0) {
-      m.rpe_distance_trans_rmse_m = std::sqrt(dt / m.rpe_distance_pairs);
-      m.rpe_distance_rot_rmse_deg = std::sqrt(dr / m.rpe_distance_pairs) * 180.0 / M_PI;
-    }
+  }
+  if (m.rpe_distance_pairs > 0) {
+    m.rpe_distance_trans_rmse_m = std::sqrt(dt / m.rpe_distance_pairs);
+    m.rpe_distance_rot_rmse_deg = std::sqrt(dr / m.rpe_distance_pairs) * 180.0 / M_PI;
+  } else {
+    m.rpe_distance_trans_rmse_m = m.rpe_distance_rot_rmse_deg = kNaN;
+    m.rpe_distance_reason = "no frame pair " + Metres(rpe_distance_step_m) +
+                            " (+-10 %) apart along the ground-truth path of " +
+                            Metres(m.path_length_m);
   }
 
-  // KITTI-style drift: for sub-path lengths L = k/8 of the path (k = 1..8), from every
-  // 10th start frame, the relative pose error at the first frame at least L further along,
+  if (short_path) {
+    m.drift_pct = m.drift_deg_per_m = kNaN;
+    m.drift_reason = short_reason;
+    m.kitti_drift_pct = m.kitti_drift_deg_per_m = kNaN;
+    m.kitti_drift_reason = short_reason;
+    return m;
+  }
+
+  // vobench's drift: for sub-path lengths L = k/8 of the path (k = 1..8), from every 10th
+  // start frame, the relative pose error at the first frame at least L further along,
   // divided by the length of that sub-path.
   double t_sum = 0.0, r_sum = 0.0;
   int count = 0;
   for (int k = 1; k <= 8; ++k) {
     const double L = m.path_length_m * k / 8.0;
-    if (L <= 0.0) continue;
     for (size_t first = 0; first < n; first += 10) {
       size_t last = first;
       while (last < n && dist[last] - dist[first] < L) ++last;
@@ -137,7 +225,13 @@ TrajectoryMetrics ComputeTrajectoryMetrics(const std::vector<Eigen::Isometry3d>&
   if (count > 0) {
     m.drift_pct = 100.0 * t_sum / count;
     m.drift_deg_per_m = r_sum / count;
+  } else {
+    m.drift_pct = m.drift_deg_per_m = kNaN;
+    m.drift_reason = "no sub-path fits in the path";
   }
+
+  // The KITTI devkit's drift.
+  KittiDrift(est, gt, KittiSegmentLengths(m.path_length_m), &m);
   return m;
 }
 

@@ -200,7 +200,14 @@ bool Summarize(const RunRecords& records, RunSummary* summary, std::string* erro
   s.initial_orientation_ok = first_frame.result.initial_orientation_ok;
   s.initial_floor_refined = first_frame.result.floor_refined;
   s.initial_floor_message = first_frame.result.floor_refinement_message;
-  if (s.has_ground_truth && first_frame.has_gt && s.initial_orientation_ok) {
+  if (!s.has_ground_truth) {
+    s.initial_orientation_error_reason = "no ground truth";
+  } else if (!first_frame.has_gt) {
+    s.initial_orientation_error_reason = "no ground truth at the first initialised frame";
+  } else if (!s.initial_orientation_ok) {
+    s.initial_orientation_error_reason =
+        "the first frame's orientation was not found from the hallway's planes";
+  } else {
     s.initial_orientation_error_deg = RotationAngle(first_frame.result.T_world_cam0.linear(),
                                                     first_frame.T_world_cam0_gt.linear()) *
                                       180.0 / M_PI;

@@ -47,6 +47,10 @@ struct StereoSequence {
   // camera.pitch_deg, rig.yaml); NaN = unknown. A ground vehicle takes its up from it when the
   // first frame shows no floor or ceiling (vo::ResolvePlatform).
   double camera_pitch_deg = std::numeric_limits<double>::quiet_NaN();
+  // Why the ground truth's world is not gravity-aligned ("" when it is: simulated runs, the
+  // KITTI layout with T_world_cam0first.txt, EuRoC's and TUM's motion-capture worlds). Then a
+  // run reports no initial-orientation error (RunSummary::initial_orientation_error_reason).
+  std::string ground_truth_not_gravity_aligned;
 };
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).
@@ -120,9 +124,11 @@ struct RunSummary {
   double features_median = 0.0;
   double inliers_median = 0.0;
   bool initial_orientation_ok = false;
-  double initial_orientation_error_deg = -1.0;  // vs ground truth; < 0 when not known
-  bool initial_floor_refined = false;           // its floor was refined on the images
-  std::string initial_floor_message;            // what that refinement did, or why not
+  double initial_orientation_error_deg =  // vs the gravity-aligned ground truth; NaN when not
+      std::numeric_limits<double>::quiet_NaN();  // known (the reason below)
+  std::string initial_orientation_error_reason;  // why it is NaN ("" when it is known)
+  bool initial_floor_refined = false;            // its floor was refined on the images
+  std::string initial_floor_message;             // what that refinement did, or why not
   bool has_ground_truth = false;  // at least 2 frames with ground truth: the metrics are set
   int ground_truth_frames = 0;    // frames with a ground-truth pose; the metrics use these only
   VoMatchStats match_stats;       // the VO's matches against the ground truth (simulated runs and

@@ -30,7 +30,11 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
   Progress progress("render " + scenario.name, simulator->EstimatedFrames(), options.progress);
   sim::StereoFrame frame;
   int n = 0;
+  double camera_path_m = 0.0;  // the camera's 3-D path, as `run` measures it on the ground truth
+  Eigen::Vector3d last_camera = Eigen::Vector3d::Zero();
   while (simulator->Next(&frame, error)) {
+    if (n > 0) camera_path_m += (frame.T_world_cam0.translation() - last_camera).norm();
+    last_camera = frame.T_world_cam0.translation();
     if (!writer.Add(ToDatasetFrame(frame), error)) return false;
     progress.Update(++n);
     summary->sim_time_s = frame.time_s;
@@ -50,9 +54,10 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
   summary->frames = n;
   summary->gl_renderer = simulator->gl_renderer();
   const auto& track = simulator->body_track();
-  summary->path_length_m = 0.0;
+  summary->path_length_m = camera_path_m;
+  summary->base_path_length_m = 0.0;
   for (size_t i = 1; i < track.size(); ++i)
-    summary->path_length_m += (track[i] - track[i - 1]).head<2>().norm();
+    summary->base_path_length_m += (track[i] - track[i - 1]).head<2>().norm();
   summary->wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary->frames_per_s = summary->wall_time_s > 0 ? n / summary->wall_time_s : 0.0;

@@ -13,10 +13,12 @@ namespace harness {
 
 struct RenderSummary {
   int frames = 0;
-  double sim_time_s = 0.0;     // time of the last frame (s)
-  double path_length_m = 0.0;  // length of the robot base's track (m)
-  double wall_time_s = 0.0;    // rendering + writing wall time (s)
-  double frames_per_s = 0.0;   // stereo frames (with depth) rendered and written per second
+  double sim_time_s = 0.0;          // time of the last frame (s)
+  double path_length_m = 0.0;       // length of the left camera's 3-D path over the frames (m):
+                                    // `run`'s path_length_m for the same frames
+  double base_path_length_m = 0.0;  // length of the robot base's 2-D track (m)
+  double wall_time_s = 0.0;         // rendering + writing wall time (s)
+  double frames_per_s = 0.0;        // stereo frames (with depth) rendered and written per second
   std::string gl_renderer;
 };
 

@@ -1,5 +1,7 @@
 #include "harness/run.h"
 
+#include <limits>
+
 #include "harness/eval.h"
 #include "harness/vo_config.h"
 
@@ -28,6 +30,11 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
       !Summarize(records, summary, error))
     return false;
   summary->platform = vo::ToString(odometry->options().platform);
+  if (!options.ground_truth_not_gravity_aligned.empty() &&
+      summary->initial_orientation_error_reason.empty()) {
+    summary->initial_orientation_error_deg = std::numeric_limits<double>::quiet_NaN();
+    summary->initial_orientation_error_reason = options.ground_truth_not_gravity_aligned;
+  }
   RunFolderContents contents;
   contents.options_yaml = VoConfigToYaml(odometry->options());
   contents.scenario_yaml = scenario_yaml;
@@ -40,6 +47,7 @@ bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_o
                  const RunOptions& options, RunSummary* summary, std::string* error) {
   RunOptions o = options;
   if (o.outline_scene.empty()) o.outline_scene = sequence.outline_scene;
+  o.ground_truth_not_gravity_aligned = sequence.ground_truth_not_gravity_aligned;
   return RunOdometry(
       sequence.name, sequence.camera, sequence.next, sequence.expected_frames,
       vo::ResolvePlatform(vo_options, sequence.axle_behind_camera_m, sequence.camera_pitch_deg), o,

@@ -9,7 +9,8 @@
 //   groundtruth_tum.txt / groundtruth_kitti.txt  ground truth T_world_cam0 (simulator world)
 //   per_frame.csv      status, counts, per-stage ms, errors per frame
 //   metrics.json       summary (frames, path_length_m, end_pose_error_m, end_pose_error_pct,
-//                      ate_rmse_m, lost_frames, vo_ms_median, vo_ms_p95, ...)
+//                      ate_rmse_m, lost_frames, vo_ms_median, vo_ms_p95, ...; the
+//                      metric registry's keys; null + *_reason where not applicable)
 //   vo_options.yaml    effective VO options (accepted by --config)
 //   scenario.yaml      effective scenario (simulated runs)
 //   trajectory.png, errors.png, timing.png, report.md
@@ -32,6 +33,9 @@ struct RunOptions {
   int max_frames = 0;         // stop after this many frames of the source (0 = all)
   int frame_stride = 1;       // the VO sees every k-th source frame (0, k, 2k, ...; less overlap
                               // between its frames), >= 1; metrics are on those frames
+  std::string ground_truth_not_gravity_aligned;  // why the ground truth's world is not
+                                                 // gravity-aligned ("" = it is): no
+                                                 // initial-orientation error then
 };
 
 // The whole pipeline: runs the VO over `source` (RunFrames), summarises (Summarize) and

@@ -39,7 +39,14 @@ std::string CsvQuoted(const std::string& text) {
   return out + "\"";
 }
 
-std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml) {
+// A figure, or "n/a (why)" when it does not apply (NaN).
+std::string FmtOrNa(double v, int prec, const std::string& unit, const std::string& why) {
+  return std::isfinite(v) ? Fmt(v, prec) + unit : "n/a (" + why + ")";
+}
+
+// `folder`: the run folder being written; the report links only the plots that are in it.
+std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml,
+                           const fs::path& folder) {
   const TrajectoryMetrics& m = s.metrics;
   std::ostringstream r;
   r << "# vobench run: " << s.name << "\n\n";
@@ -48,9 +55,9 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
   r << "| frames with ground truth | " << s.ground_truth_frames
     << (s.has_ground_truth ? " (the metrics below use these)" : " (no accuracy metrics)") << " |\n";
   if (s.has_ground_truth) {
-    r << "| path length (ground truth) | " << Fmt(m.path_length_m, 3) << " m |\n";
-    r << "| end-pose error | " << Fmt(m.end_pose_error_m) << " m (" << Fmt(m.end_pose_error_pct, 2)
-      << " % of the path) |\n";
+    r << "| path length (ground-truth camera, 3-D) | " << Fmt(m.path_length_m, 3) << " m |\n";
+    r << "| end-pose error | " << Fmt(m.end_pose_error_m) << " m ("
+      << FmtOrNa(m.end_pose_error_pct, 2, " % of the path", m.end_pose_error_pct_reason) << ") |\n";
     r << "| end rotation error | " << Fmt(m.end_rotation_error_deg, 3) << " deg |\n";
     r << "| ATE RMSE (SE(3)-aligned) | " << Fmt(m.ate_rmse_m) << " m |\n";
     r << "| ATE RMSE (from the common start) | " << Fmt(m.ate_rmse_unaligned_m) << " m |\n";
@@ -61,16 +68,27 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
         << Fmt(100.0 * s.match_stats.precision(), 2) << " % / "
         << Fmt(100.0 * s.match_stats.inlier_precision(), 2) << " % of " << s.match_stats.matches
         << " |\n";
-    r << "| RPE per " << Fmt(m.rpe_distance_step_m, 1) << " m (translation / rotation) | "
-      << Fmt(m.rpe_distance_trans_rmse_m * 1000, 1) << " mm / "
-      << Fmt(m.rpe_distance_rot_rmse_deg, 3) << " deg |\n";
-    r << "| drift (KITTI-style, 1/8..8/8 of the path) | " << Fmt(m.drift_pct, 3) << " % / "
-      << Fmt(m.drift_deg_per_m, 4) << " deg/m |\n";
-    if (s.initial_orientation_error_deg >= 0)
-      r << "| initial orientation from planes (error vs GT) | "
-        << (s.initial_orientation_ok ? "found" : "not found") << ", "
-        << Fmt(s.initial_orientation_error_deg, 2) << " deg"
-        << (s.initial_floor_message.empty() ? "" : "; " + s.initial_floor_message) << " |\n";
+    r << "| RPE per " << Fmt(m.rpe_distance_step_m, 1)
+      << " m (evo_rpe --all_pairs; translation / rotation) | "
+      << (m.rpe_distance_pairs > 0 ? Fmt(m.rpe_distance_trans_rmse_m * 1000, 1) + " mm / " +
+                                         Fmt(m.rpe_distance_rot_rmse_deg, 3) + " deg"
+                                   : "n/a (" + m.rpe_distance_reason + ")")
+      << " |\n";
+    r << "| drift (vobench: sub-paths of >= 1/8..8/8 of the path / their length) | "
+      << (std::isfinite(m.drift_pct)
+              ? Fmt(m.drift_pct, 3) + " % / " + Fmt(m.drift_deg_per_m, 4) + " deg/m"
+              : "n/a (" + m.drift_reason + ")")
+      << " |\n";
+    r << "| drift (KITTI devkit: segments past L / L) | "
+      << (std::isfinite(m.kitti_drift_pct)
+              ? Fmt(m.kitti_drift_pct, 3) + " % / " + Fmt(m.kitti_drift_deg_per_m, 4) +
+                    " deg/m over " + std::to_string(m.kitti_drift_segments) + " segments"
+              : "n/a (" + m.kitti_drift_reason + ")")
+      << " |\n";
+    r << "| initial orientation from planes (error vs GT) | "
+      << (s.initial_orientation_ok ? "found" : "not found") << ", "
+      << FmtOrNa(s.initial_orientation_error_deg, 2, " deg", s.initial_orientation_error_reason)
+      << (s.initial_floor_message.empty() ? "" : "; " + s.initial_floor_message) << " |\n";
   }
   r << "| lost frames (no measured motion) / re-initialisations | " << s.lost_frames << " / "
     << s.reinitialisations << " |\n";
@@ -91,7 +109,10 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml)
     << Fmt(s.vo_ms_p95, 2) << " ms |\n";
   for (const auto& [k, v] : s.stage_ms_median)
     r << "| stage median: " << k << " | " << Fmt(v, 2) << " ms |\n";
-  r << "\n![trajectory](trajectory.png)\n\n![errors](errors.png)\n\n![timing](timing.png)\n\n";
+  r << "\n";
+  for (const char* plot : {"trajectory", "errors", "timing"})  // only the plots made
+    if (fs::exists(folder / (std::string(plot) + ".png")))
+      r << "![" << plot << "](" << plot << ".png)\n\n";
   r << "Effective VO options (`vobench run --config` accepts this file as "
        "`vo_options.yaml`):\n\n```yaml\n"
     << options_yaml << "```\n";
@@ -256,7 +277,8 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s,
       return false;
   }
   if (contents.plots) MakePlots(p.string(), s.has_ground_truth, contents.outline_scene);
-  if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(s, contents.options_yaml), error))
+  if (!WriteTextFile((p / "report.md").string(), ReportMarkdown(s, contents.options_yaml, p),
+                     error))
     return false;
   const int frames = static_cast<int>(t.times.size());
   if (InterruptSignal() != 0) {  // during the plots or the files: still nothing published

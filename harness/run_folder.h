@@ -7,10 +7,11 @@
 //   groundtruth_tum.txt / groundtruth_kitti.txt  ground truth T_world_cam0 (simulator world)
 //   per_frame.csv      status, counts, per-stage ms, errors per frame
 //   metrics.json       summary (frames, path_length_m, end_pose_error_m, end_pose_error_pct,
-//                      ate_rmse_m, lost_frames, vo_ms_median, vo_ms_p95, ...)
+//                      ate_rmse_m, lost_frames, vo_ms_median, vo_ms_p95, ...; the
+//                      metric registry's keys; null + *_reason where not applicable)
 //   vo_options.yaml    effective VO options (accepted by --config)
 //   scenario.yaml      effective scenario (simulated runs)
-//   trajectory.png, errors.png, timing.png, report.md
+//   trajectory.png, errors.png, timing.png, report.md (links the plots that were made)
 //
 // The folder is written as a marked work folder beside DIR and moved into place only when
 // complete (OutputFolder: the ownership rules, the lock), so a half-written folder never looks

@@ -643,8 +643,15 @@ bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& opti
   RunSummary summary;
   if (!Summarize(records, &summary, error)) return false;
   s.metrics = summary.metrics;
-  if (!ObjectiveValue(summary, objective.metric, &s.metric)) {
+  std::string not_applicable;
+  if (!ObjectiveValue(summary, objective.metric, &s.metric, &not_applicable)) {
     *error = "unknown metric '" + objective.metric + "'";
+    return false;
+  }
+  if (!std::isfinite(s.metric)) {  // null in metrics.json: the objective does not apply
+    *error = "objective.metric " + objective.metric + " is null (not applicable) on " +
+             records.name + ": " + (not_applicable.empty() ? "no value" : not_applicable) +
+             "; choose another objective metric";
     return false;
   }
   s.score = s.metric + objective.lost_frame_penalty * s.lost_frames;

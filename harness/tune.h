@@ -26,7 +26,9 @@
 //     metric: ate_rmse_m        # a trajectory metric (metrics.h, default ate_rmse_m): ate_rmse_m,
 //                               # ate_rmse_unaligned_m, end_pose_error_m, end_pose_error_pct,
 //                               # end_rotation_error_deg, rpe_trans_rmse_m, rpe_rot_rmse_deg,
-//                               # drift_pct, drift_deg_per_m
+//                               # drift_pct, drift_deg_per_m, kitti_drift_pct,
+//                               # kitti_drift_deg_per_m, rpe_distance_*; null on a
+//                               # sequence (e.g. % on a path < 1 m): an error
 //     lost_frame_penalty: 0.05  # added per lost frame, in the metric's unit (default 0.05), >= 0
 //     aggregate: mean           # mean | max over the scenarios (default mean)
 //   optimizer:

@@ -43,7 +43,8 @@ int RunRender(const std::string& scenario_arg, const std::string& out, const std
   std::printf("frames          %d (%.1f s at %.1f Hz)\n", s.frames, s.sim_time_s, scenario.rate_hz);
   std::printf("image size      %dx%d, baseline %.3f m\n", scenario.camera.width,
               scenario.camera.height, scenario.camera.baseline_m);
-  std::printf("path length     %.3f m\n", s.path_length_m);
+  std::printf("path length     %.3f m (camera, 3-D)\n", s.path_length_m);
+  std::printf("base path       %.3f m (robot base, 2-D)\n", s.base_path_length_m);
   std::printf("render speed    %.1f stereo frames/s (with depth, incl. physics and writing)\n",
               s.frames_per_s);
   std::printf("GL renderer     %s\n", s.gl_renderer.c_str());

@@ -1,5 +1,6 @@
 #include "harness/cli/run_command.h"
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -97,16 +98,31 @@ void PrintRunTable(const RunSummary& s, const std::string& out) {
                     ? " (the rig's wheel axle known; platform: free in --config for 6-DoF)"
                     : "");
   if (s.has_ground_truth) {
-    std::printf("path length     %.3f m\n", m.path_length_m);
-    std::printf("end-pose error  %.4f m (%.2f %% of the path), rotation %.3f deg\n",
-                m.end_pose_error_m, m.end_pose_error_pct, m.end_rotation_error_deg);
+    std::printf("path length     %.3f m (camera, 3-D)\n", m.path_length_m);
+    if (std::isfinite(m.end_pose_error_pct))
+      std::printf("end-pose error  %.4f m (%.2f %% of the path), rotation %.3f deg\n",
+                  m.end_pose_error_m, m.end_pose_error_pct, m.end_rotation_error_deg);
+    else
+      std::printf("end-pose error  %.4f m, rotation %.3f deg; %% of the path n/a (%s)\n",
+                  m.end_pose_error_m, m.end_rotation_error_deg,
+                  m.end_pose_error_pct_reason.c_str());
     std::printf("ATE RMSE        %.4f m (SE(3)-aligned), %.4f m (from the start)\n", m.ate_rmse_m,
                 m.ate_rmse_unaligned_m);
-    std::printf("drift           %.3f %%, %.4f deg/m\n", m.drift_pct, m.drift_deg_per_m);
-    if (s.initial_orientation_error_deg >= 0)
+    if (std::isfinite(m.drift_pct))
+      std::printf("drift           %.3f %%, %.4f deg/m\n", m.drift_pct, m.drift_deg_per_m);
+    else
+      std::printf("drift           n/a (%s)\n", m.drift_reason.c_str());
+    if (std::isfinite(m.kitti_drift_pct))
+      std::printf("KITTI drift     %.3f %%, %.4f deg/m (devkit, %d segments)\n", m.kitti_drift_pct,
+                  m.kitti_drift_deg_per_m, m.kitti_drift_segments);
+    else
+      std::printf("KITTI drift     n/a (%s)\n", m.kitti_drift_reason.c_str());
+    if (std::isfinite(s.initial_orientation_error_deg))
       std::printf("initial orient. %.2f deg from ground truth (plane-based%s)\n",
                   s.initial_orientation_error_deg,
                   s.initial_floor_refined ? ", floor or ceiling refined on the images" : "");
+    else
+      std::printf("initial orient. n/a (%s)\n", s.initial_orientation_error_reason.c_str());
     if (!s.initial_floor_message.empty() && !s.initial_floor_refined)
       std::printf("                %s\n", s.initial_floor_message.c_str());
   }

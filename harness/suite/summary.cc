@@ -28,7 +28,13 @@ std::string CsvCell(const json& v) {
   if (v.is_boolean()) return v.get<bool>() ? "1" : "0";
   if (v.is_number_integer() || v.is_number_unsigned()) return v.dump();
   if (v.is_number()) return FormatDouble(v.get<double>());
-  if (v.is_string()) return v.get<std::string>();
+  if (v.is_string()) {  // RFC 4180: quoted when it holds a comma, a quote or a line break
+    const std::string text = v.get<std::string>();
+    if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return quoted + "\"";
+  }
   return v.dump();
 }
 
@@ -38,7 +44,7 @@ double Number(const json& metrics, const std::string& key) {
 }
 
 std::string Fixed(double v, int prec) {
-  if (!std::isfinite(v)) return "nan";
+  if (!std::isfinite(v)) return "n/a";  // null or missing: not applicable to the run
   char buf[64];
   std::snprintf(buf, sizeof(buf), "%.*f", prec, v);
   return buf;
@@ -253,7 +259,7 @@ const std::vector<std::string>& SuiteTimingColumns() {
   static const std::vector<std::string> kColumns = [] {
     std::vector<std::string> c;
     for (const MetricInfo& m : RunMetrics())
-      if (m.csv && m.group == MetricGroup::kTiming) c.push_back(m.key);
+      if (m.group == MetricGroup::kTiming) c.push_back(m.key);
     c.push_back("wall_s");
     return c;
   }();
@@ -265,7 +271,7 @@ const std::vector<std::string>& SuiteSummaryColumns() {
     std::vector<std::string> c = {"id",     "scenario",   "config", "seed",
                                   "stride", "max_frames", "status"};
     for (const MetricInfo& m : RunMetrics())
-      if (m.csv && m.group != MetricGroup::kTiming) c.push_back(m.key);
+      if (m.group != MetricGroup::kTiming) c.push_back(m.key);
     for (const std::string& t : SuiteTimingColumns()) c.push_back(t);
     return c;
   }();

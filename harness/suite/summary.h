@@ -31,8 +31,9 @@ struct SuiteResult {
   bool ok() const { return failed == 0 && missing == 0; }
 };
 
-// The summary's columns: axes and status, then the metric registry's metrics (csv ones, in
-// metrics.json order; dotted keys as they are); the timing columns (SuiteTimingColumns: the
+// The summary's columns: axes and status, then every key of the metric registry (in
+// metrics.json order; dotted keys as they are; a key a run's metrics.json does not have, or
+// null, is an empty cell or "nan"); the timing columns (SuiteTimingColumns: the
 // registry's timing metrics and the run's wall_s) are the last ones and the only ones that
 // vary between identical runs.
 const std::vector<std::string>& SuiteSummaryColumns();

@@ -76,6 +76,28 @@ TEST(CheckCompareTest, WorseOnlyBeyondTheTolerance) {
   EXPECT_EQ(Find(harness::CompareToBaseline(b, result), "a", "end_pose_error_m")->verdict, "WORSE");
 }
 
+// A metric that is null now (not applicable: metrics.json's null with its *_reason) where the
+// baseline has a number fails, and the table says why.
+TEST(CheckCompareTest, NullWhereTheBaselineHasANumberFailsWithTheReason) {
+  harness::Baseline b = harness::DefaultBaselineRule();
+  b.suite = "suite.yaml";
+  b.runs.push_back({"a", {{"drift_pct", 1.0, 0.25, true}}});
+  harness::SuiteResult result;
+  result.rows.push_back(OkRow("a", 0.1));
+  result.rows[0].metrics["drift_pct"] = nullptr;
+  result.rows[0].metrics["drift_reason"] = "ground-truth path 0.500 m shorter than 1.000 m";
+  const harness::CheckReport report = harness::CompareToBaseline(b, result);
+  const harness::CheckRow* row = Find(report, "a", "drift_pct");
+  ASSERT_NE(row, nullptr);
+  EXPECT_EQ(row->verdict, "WORSE");
+  EXPECT_FALSE(report.passed());
+  EXPECT_EQ(row->note,
+            "(now null (not applicable) in the run's metrics.json: ground-truth path 0.500 m "
+            "shorter than 1.000 m; the baseline has a number)");
+  const std::string table = harness::CheckTableText(report, false);
+  EXPECT_NE(table.find("WORSE (now null"), std::string::npos) << table;
+}
+
 TEST(CheckCompareTest, FailedMissingAndNewRunsFail) {
   harness::Baseline b = OneRunBaseline(0.10, 0.02);
   b.runs.push_back({"b", {{"end_pose_error_m", 0.1, 0.02, true}}});

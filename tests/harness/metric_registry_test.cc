@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -28,6 +29,8 @@ harness::RunSummary FullSummary() {
   s.metrics.ate_rmse_m = 0.125;
   s.match_stats.matches = 100;
   s.lost_frames = 3;
+  s.initial_orientation_ok = true;
+  s.initial_orientation_error_deg = 1.5;
   for (const char* stage :
        {"ba", "depth", "detect", "disparity", "guided", "match", "motion", "predict"})
     s.stage_ms_median[stage] = 1.5;
@@ -44,8 +47,10 @@ TEST(MetricRegistryTest, MetricsJsonHoldsExactlyTheRegistrysKeysInOrder) {
       keys.push_back(k);
     }
   }
+  // Every figure applies: no *_reason entry is written.
   std::vector<std::string> expected = {"name"};
-  for (const harness::MetricInfo& m : RunMetrics()) expected.push_back(m.key);
+  for (const harness::MetricInfo& m : RunMetrics())
+    if (!m.reason) expected.push_back(m.key);
   EXPECT_EQ(keys, expected);
   EXPECT_DOUBLE_EQ(j["end_pose_error_m"].get<double>(), 0.25);
   EXPECT_EQ(j["lost_frames"].get<int>(), 3);
@@ -62,9 +67,52 @@ TEST(MetricRegistryTest, GroupsDecideWhatARunWithoutGroundTruthWrites) {
   const json j = json::parse(harness::MetricsJson(s));
   for (const harness::MetricInfo& m : RunMetrics()) {
     const bool written = harness::FindMetricValue(j, m.key) != nullptr;
-    EXPECT_EQ(written, m.group != MetricGroup::kAccuracy && m.group != MetricGroup::kMatches)
+    EXPECT_EQ(written,
+              m.group != MetricGroup::kAccuracy && m.group != MetricGroup::kMatches && !m.reason)
         << m.key;
   }
+}
+
+// A figure that does not apply is null with its reason right after it (no sentinel numbers);
+// tune's objective reads it as NaN with the reason.
+TEST(MetricRegistryTest, NotApplicableFiguresAreNullWithTheirReason) {
+  harness::RunSummary s = FullSummary();
+  const double nan = std::nan("");
+  s.metrics.end_pose_error_pct = s.metrics.drift_pct = s.metrics.drift_deg_per_m = nan;
+  s.metrics.kitti_drift_pct = s.metrics.kitti_drift_deg_per_m = nan;
+  s.metrics.rpe_distance_trans_rmse_m = s.metrics.rpe_distance_rot_rmse_deg = nan;
+  s.metrics.end_pose_error_pct_reason = s.metrics.drift_reason = s.metrics.kitti_drift_reason =
+      "too short";
+  s.metrics.rpe_distance_reason = "no pair";
+  s.initial_orientation_error_deg = nan;
+  s.initial_orientation_error_reason = "ground truth not gravity-aligned";
+  const std::string text = harness::MetricsJson(s);
+  const json j = json::parse(text);
+  EXPECT_TRUE(j["initial_orientation_error_deg"].is_null());
+  EXPECT_EQ(j["initial_orientation_error_reason"], "ground truth not gravity-aligned");
+  for (const char* k : {"end_pose_error_pct", "drift_pct", "drift_deg_per_m", "kitti_drift_pct",
+                        "kitti_drift_deg_per_m", "rpe_distance_trans_rmse_m"})
+    EXPECT_TRUE(j[k].is_null()) << k;
+  EXPECT_EQ(j["end_pose_error_pct_reason"], "too short");
+  EXPECT_EQ(j["drift_reason"], "too short");
+  EXPECT_EQ(j["kitti_drift_reason"], "too short");
+  EXPECT_EQ(j["rpe_distance_reason"], "no pair");
+  EXPECT_EQ(text.find("-1"), std::string::npos) << text;  // no sentinel
+  // Now every key of the registry is there, in its order.
+  std::vector<std::string> keys, expected = {"name"};
+  for (const auto& [k, v] : j.items())
+    if (!v.is_object()) keys.push_back(k);
+  for (const harness::MetricInfo& m : RunMetrics())
+    if (m.key.find('.') == std::string::npos) expected.push_back(m.key);
+  EXPECT_EQ(keys, expected);
+  double v = 0.0;
+  std::string why;
+  EXPECT_TRUE(harness::ObjectiveValue(s, "drift_pct", &v, &why));
+  EXPECT_TRUE(std::isnan(v));
+  EXPECT_EQ(why, "too short");
+  EXPECT_TRUE(harness::ObjectiveValue(s, "ate_rmse_m", &v, &why));
+  EXPECT_EQ(v, 0.125);
+  EXPECT_EQ(why, "");
 }
 
 TEST(MetricRegistryTest, EveryEntryIsComplete) {
@@ -93,12 +141,20 @@ TEST(MetricRegistryTest, EveryEntryIsComplete) {
 TEST(MetricRegistryTest, SummaryCsvColumnsAreTheRegistrysWithTimingLast) {
   const std::vector<std::string>& cols = harness::SuiteSummaryColumns();
   const std::vector<std::string>& timing = harness::SuiteTimingColumns();
+  // Every key of metrics.json is a column: the column set is the axes and status, the
+  // registry's keys and wall_s, nothing else.
+  std::set<std::string> expected = {"id",     "scenario",   "config", "seed",
+                                    "stride", "max_frames", "status", "wall_s"};
   for (const harness::MetricInfo& m : RunMetrics()) {
-    const bool column = std::find(cols.begin(), cols.end(), m.key) != cols.end();
-    EXPECT_EQ(column, m.csv) << m.key;
+    expected.insert(m.key);
     const bool timed = std::find(timing.begin(), timing.end(), m.key) != timing.end();
-    EXPECT_EQ(timed, m.csv && m.group == MetricGroup::kTiming) << m.key;
+    EXPECT_EQ(timed, m.group == MetricGroup::kTiming) << m.key;
   }
+  EXPECT_EQ(std::set<std::string>(cols.begin(), cols.end()), expected);
+  EXPECT_EQ(cols.size(), expected.size());  // no column twice
+  for (const char* k : {"platform", "has_ground_truth", "initial_orientation_ok",
+                        "initial_floor_refined", "frame_stride", "kitti_drift_pct"})
+    EXPECT_NE(std::find(cols.begin(), cols.end(), k), cols.end()) << k;
   ASSERT_GE(cols.size(), timing.size());
   EXPECT_TRUE(
       std::equal(timing.begin(), timing.end(), cols.end() - static_cast<long>(timing.size())));

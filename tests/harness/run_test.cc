@@ -91,6 +91,62 @@ TEST(RunTest, SameScenarioGivesIdenticalAccuracyMetricsAndTrajectory) {
     EXPECT_EQ(metrics[0][key], metrics[1][key]) << key;
 }
 
+// A clip shorter than 1 m, rendered and run from its KITTI-layout folder without plots:
+// `render` and `run` report the same camera path length; the figures relative to the path are
+// null with their reason; report.md links no plot (none was made); without
+// T_world_cam0first.txt the ground truth's world is the first camera (not gravity-aligned):
+// no initial-orientation error, null with the reason.
+TEST(RunTest, ShortClipHasNullFiguresWithReasonsAndNoDanglingLinks) {
+  TempDir dir("run_short");
+  sim::Scenario scenario;
+  std::string error;
+  ASSERT_TRUE(harness::ResolveScenario("l_hallway", &scenario, &error)) << error;
+  scenario.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.4, 0)};
+  harness::RenderOptions render_options;
+  render_options.progress = false;
+  harness::RenderSummary rendered;
+  ASSERT_TRUE(harness::RenderScenario(scenario, dir / "data", render_options, &rendered, &error))
+      << error;
+  EXPECT_GT(rendered.path_length_m, 0.2);
+  EXPECT_LT(rendered.path_length_m, 1.0);
+  EXPECT_GT(rendered.base_path_length_m, 0.2);
+  harness::RunOptions options;
+  options.progress = false;
+  options.plots = false;
+  for (const bool world_file : {true, false}) {
+    if (!world_file) fs::remove(dir / "data/T_world_cam0first.txt");
+    options.out_dir = dir / (world_file ? "run_world" : "run_first_camera");
+    harness::RunSummary s;
+    ASSERT_TRUE(harness::RunKittiDataset(dir / "data", vo::OdometryOptions(), options, &s, &error))
+        << error;
+    ASSERT_EQ(s.frames_not_initialised, 0);
+    EXPECT_NEAR(s.metrics.path_length_m, rendered.path_length_m, 1e-6);
+    const nlohmann::json j = ReadJson(options.out_dir + "/metrics.json");
+    for (const char* k : {"end_pose_error_pct", "drift_pct", "drift_deg_per_m", "kitti_drift_pct",
+                          "kitti_drift_deg_per_m"})
+      EXPECT_TRUE(j[k].is_null()) << k;
+    const std::string too_short = j["end_pose_error_pct_reason"].get<std::string>();
+    EXPECT_NE(too_short.find("shorter than 1.000 m"), std::string::npos) << too_short;
+    EXPECT_EQ(j["drift_reason"], too_short);
+    EXPECT_EQ(j["kitti_drift_reason"], too_short);
+    EXPECT_TRUE(j["end_pose_error_m"].is_number());
+    if (world_file && s.initial_orientation_ok) {
+      EXPECT_TRUE(j["initial_orientation_error_deg"].is_number());
+      EXPECT_FALSE(j.contains("initial_orientation_error_reason"));
+    } else if (!world_file) {
+      EXPECT_TRUE(j["initial_orientation_error_deg"].is_null());
+      EXPECT_EQ(j["initial_orientation_error_reason"],
+                "ground truth not gravity-aligned (KITTI layout without T_world_cam0first.txt: "
+                "world = first camera)");
+    }
+    std::ifstream in(options.out_dir + "/report.md");
+    const std::string report(std::istreambuf_iterator<char>(in), {});
+    EXPECT_EQ(report.find("!["), std::string::npos) << report;
+    EXPECT_EQ(report.find(".png"), std::string::npos) << report;
+    EXPECT_NE(report.find("n/a (ground-truth path"), std::string::npos) << report;
+  }
+}
+
 TEST(RunTest, RefusesToReplaceAFolderThatIsNotARun) {
   TempDir dir("run_refuse");
   fs::create_directories(dir / "mine");

@@ -433,6 +433,27 @@ TEST(TuneCommandTest, BadTuneFilesFailWithTheirMessageAndWriteNothing) {
   EXPECT_TRUE(fs::exists(dir / "taken/keep.txt"));
 }
 
+// An objective that does not apply to a sequence (null in metrics.json: a percentage of a path
+// shorter than 1 m) is an error naming the metric, the sequence and the reason, not a crash;
+// nothing is published.
+TEST(TuneCommandTest, ANullObjectiveIsAnErrorWithItsReason) {
+  if (!fs::exists(VOBENCH_BINARY)) GTEST_SKIP() << "vobench not built: " << VOBENCH_BINARY;
+  TempDir dir("tune_null");
+  std::string text = TuneFileText("4");
+  const std::string from = "metric: ate_rmse_m";
+  text.replace(text.find(from), from.size(), "metric: end_pose_error_pct");
+  const std::string file = dir / "tune.yaml";
+  WriteText(file, text);
+  const CommandResult r = RunVobench("tune " + file + " -q --no-plots --out " + (dir / "out"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("objective.metric end_pose_error_pct is null (not applicable) on tr_a: "
+                          "ground-truth path"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("shorter than 1.000 m"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
