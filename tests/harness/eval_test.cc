@@ -86,6 +86,7 @@ class EvalTest : public ::testing::Test {
       options.format = format;
       options.T_body_cam0 = simulator->calibration().T_body_cam0;
       options.rate_hz = scenario_->rate_hz;
+      options.stamp_offset_ns = kSimulationEpochNs;
       options.write_rig = true;  // the mounting, so a run on the export knows the ground vehicle
       options.rig.forward_m = scenario_->camera.forward_m;
       options.rig.height_m = scenario_->camera.height_m;
