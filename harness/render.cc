@@ -20,6 +20,7 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
   wopt.overwrite = options.overwrite;
   wopt.T_body_cam0 = simulator->calibration().T_body_cam0;
   wopt.rate_hz = scenario.rate_hz;
+  wopt.stamp_offset_ns = kSimulationEpochNs;  // EuRoC/TUM stamps: 19 digits from 2026-01-01
   wopt.write_rig = true;
   wopt.rig.forward_m = scenario.camera.forward_m;
   wopt.rig.height_m = scenario.camera.height_m;

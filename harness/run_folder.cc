@@ -147,6 +147,16 @@ std::vector<Eigen::Isometry3d> AnchoredEstimate(const Trajectories& t) {
   return anchored;
 }
 
+// The poses relative to the first (the first exactly the identity): KITTI's convention for a
+// trajectory file, which has no stamps and no world of its own (evo's kitti mode and the devkit
+// compare such files without alignment).
+std::vector<Eigen::Isometry3d> KittiRelativeToFirst(const std::vector<Eigen::Isometry3d>& poses) {
+  std::vector<Eigen::Isometry3d> relative;
+  for (size_t i = 0; i < poses.size(); ++i)
+    relative.push_back(i == 0 ? Eigen::Isometry3d::Identity() : poses[0].inverse() * poses[i]);
+  return relative;
+}
+
 }  // namespace
 
 namespace {
@@ -253,7 +263,7 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s,
   const Trajectories t =
       InitialisedTrajectories(records, static_cast<size_t>(s.frames_not_initialised));
   if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(t.times, t.est), error) ||
-      !WriteKittiPoses((p / "trajectory_kitti.txt").string(), t.est, error) ||
+      !WriteKittiPoses((p / "trajectory_kitti.txt").string(), KittiRelativeToFirst(t.est), error) ||
       !WriteTextFile((p / "per_frame.csv").string(), PerFrameCsv(records, s, t), error) ||
       !WriteTextFile((p / "vo_options.yaml").string(), contents.options_yaml, error) ||
       !WriteTextFile((p / "metrics.json").string(), MetricsJson(s), error))
@@ -271,7 +281,8 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s,
     // groundtruth_kitti.txt has no stamps: written only when it lines up with the estimate.
     const bool all_gt = t.gt_frames.size() == t.times.size();
     if (!WriteTum((p / "groundtruth_tum.txt").string(), Stamped(times_at_gt, gt_at_gt), error) ||
-        (all_gt && !WriteKittiPoses((p / "groundtruth_kitti.txt").string(), t.gt, error)) ||
+        (all_gt && !WriteKittiPoses((p / "groundtruth_kitti.txt").string(),
+                                    KittiRelativeToFirst(t.gt), error)) ||
         !WriteTum((p / "estimate_in_gt_world_tum.txt").string(),
                   Stamped(t.times, AnchoredEstimate(t)), error))
       return false;

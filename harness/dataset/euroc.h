@@ -5,7 +5,9 @@
 //   mav0/cam0/sensor.yaml (T_BS, intrinsics [fu, fv, cu, cv], zero radial-tangential distortion,
 //   resolution, rate_hz, camera_model pinhole); the same for cam1 (T_BS = T_body_cam0 *
 //   T_cam0_cam1); mav0/state_groundtruth_estimate0/data.csv [ground truth only]: the body pose
-//   T_world_body in the world, finite-differenced velocity, zero biases.
+//   T_world_body in the world, finite-differenced velocity, zero biases, and its sensor.yaml
+//   (T_BS identity). Every yaml starts with "%YAML:1.0" (cv::FileStorage needs it); stamps have
+//   one number of digits (writer.h: stamp_offset_ns), so names sort in time order.
 #pragma once
 
 #include <cstddef>

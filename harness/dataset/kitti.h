@@ -3,7 +3,10 @@
 //   image_0/%06d.png        left (cam0) images, 8-bit grayscale PNG
 //   image_1/%06d.png        right (cam1) images
 //   calib.txt               "P0: <12 numbers>" and "P1: <12 numbers>", row-major 3x4 projection
-//                           matrices of the rectified pair; P1 has -fx * baseline_m in column 4
+//                           matrices of the rectified pair; P1 has -fx * baseline_m in column 4;
+//                           the writer adds P2 (= P0), P3 (= P1) and Tr (identity 3x4), the
+//                           keys KITTI's odometry calib.txt has (pykitti needs them; the reader
+//                           reads P0/P1 only)
 //   times.txt               one time stamp per frame (seconds)
 //   poses.txt               [ground truth only] T_cam0first_cam0k, 12 numbers per frame
 //                           (the left camera's pose in the FIRST left camera's frame, KITTI style)

@@ -25,7 +25,8 @@ bool RigMounting::IsValid(std::string* error) const {
 std::string RigYaml(const RigMounting& rig) {
   std::ostringstream out;
   out.precision(17);
-  out << "# The stereo camera's mounting on the vehicle (vobench render; metres, degrees).\n"
+  out << "%YAML:1.0\n"  // OpenCV's cv::FileStorage needs it first; ReadRigYaml skips it
+      << "# The stereo camera's mounting on the vehicle (vobench render; metres, degrees).\n"
       << "camera_forward_m: " << rig.forward_m << "  # optical centre ahead of the wheel axle\n"
       << "camera_height_m: " << rig.height_m << "  # optical centre above the floor\n"
       << "camera_pitch_deg: " << rig.pitch_deg << "  # downward tilt of the optical axis\n";
@@ -34,7 +35,15 @@ std::string RigYaml(const RigMounting& rig) {
 
 bool ReadRigYaml(const std::string& path, RigMounting* rig, std::string* error) {
   sim::YamlReader r(path);
-  if (!r.ParseFile(path, "rig file")) return r.Report(error);
+  std::string text, why;
+  if (!sim::ReadInputFile(path, "rig file", &text, &why)) {
+    if (error != nullptr) *error = why;
+    return false;
+  }
+  // OpenCV-style files start with "%YAML:1.0", which yaml-cpp rejects: blank that line (so
+  // the line numbers of messages stay the file's).
+  if (text.rfind("%YAML:", 0) == 0) text.erase(0, text.find('\n'));
+  if (!r.Parse(text)) return r.Report(error);
   YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
   const std::vector<std::string> keys = {"camera_forward_m", "camera_height_m", "camera_pitch_deg"};
   if (!r.ExpectMap(root, "", "a mapping of camera_forward_m, camera_height_m, camera_pitch_deg") ||

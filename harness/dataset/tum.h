@@ -5,7 +5,8 @@
 //                           "timestamp filename" per line (seconds; file name relative to DIR,
 //                           e.g. "left/1305031102.175304000.png"). Left and right are paired by
 //                           time stamp as associate.py pairs streams (TumReader::Options)
-//   left/<t>.png, right/<t>.png   the images (<t> = the stamp with 9 decimals)
+//   left/<t>.png, right/<t>.png   the images (<t> = the stamp with 9 decimals; the writer's
+//                           stamps have one width, so names sort in time order)
 //   calib.txt               the KITTI calib.txt (kitti.h: P0/P1 of the rectified pair)
 //   groundtruth.txt         [ground truth only] TUM trajectory "t tx ty tz qx qy qz qw" of the
 //                           LEFT camera in the world (T_world_cam0); any rate: readers associate

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -23,6 +25,8 @@ using dataset_internal::SizeText;
 
 // Tolerance for "is this a rotation" on the options.
 constexpr double kRotationTolerance = 1e-6;  // max |R^T R - I| entry
+// Largest stamp offset: with |t| < 4e9 s (ExactNs) a stamp stays below 9.2e18 (int64).
+constexpr int64_t kMaxStampOffsetNs = 5000000000000000000LL;
 
 constexpr const char* kEurocGroundTruthHeader =
     "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
@@ -63,15 +67,15 @@ std::string CalibRow(const char* key, const double p[12]) {
   return row + '\n';
 }
 
-std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d& T_body_cam,
-                            const vo::StereoCamera& camera, double rate_hz) {
-  const Eigen::Matrix4d& T = T_body_cam.matrix();
-  std::string s;
-  s += "# General sensor definitions.\n";
-  s += "sensor_type: camera\n";
-  s += "comment: " + comment + "\n\n";
-  s += "# Sensor extrinsics wrt. the body-frame.\n";
-  s += "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
+// The first line of every YAML file written: OpenCV's cv::FileStorage refuses a file without
+// it ("Input file is invalid"); EuRoC's files carry it; the yaml-cpp readers skip it.
+constexpr const char* kOpenCvYamlHeader = "%YAML:1.0\n";
+
+// "T_BS:" as EuRoC writes it: a 4x4 row-major map (OpenCV reads it as a map of cols, rows,
+// data; yaml-cpp as well).
+std::string EurocTransformYaml(const Eigen::Isometry3d& T_body_sensor) {
+  const Eigen::Matrix4d& T = T_body_sensor.matrix();
+  std::string s = "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
   for (int r = 0; r < 4; ++r) {
     if (r > 0) s += "         ";
     for (int c = 0; c < 4; ++c) {
@@ -79,6 +83,17 @@ std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d&
       s += (c < 3) ? ", " : (r < 3 ? ",\n" : "]\n");
     }
   }
+  return s;
+}
+
+std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d& T_body_cam,
+                            const vo::StereoCamera& camera, double rate_hz) {
+  std::string s = kOpenCvYamlHeader;
+  s += "# General sensor definitions.\n";
+  s += "sensor_type: camera\n";
+  s += "comment: " + comment + "\n\n";
+  s += "# Sensor extrinsics wrt. the body-frame.\n";
+  s += EurocTransformYaml(T_body_cam);
   s += "\n# Camera specific definitions.\n";
   s += "rate_hz: " + FormatDouble(rate_hz) + "\n";
   s +=
@@ -91,12 +106,39 @@ std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d&
   return s;
 }
 
-// File name stem of a TUM-style image: the stamp with 9 decimals (the decimal value of the
-// double, correctly rounded; t_ns = llround(t * 1e9) is off by ~100 ns at 1.3e9 s).
-std::string TumStampName(double time_s) {
-  char name[64];
-  std::snprintf(name, sizeof(name), "%.9f", time_s);
-  return name;
+// state_groundtruth_estimate0/sensor.yaml as EuRoC's: the estimate is of the body itself.
+std::string EurocGroundTruthYaml() {
+  std::string s = kOpenCvYamlHeader;
+  s += "# General sensor definitions.\n";
+  s += "sensor_type: visual-inertial\n";
+  s += "comment: vobench simulator ground truth, exact: the body pose in the world at every camera "
+       "stamp; velocity by central differences (one-sided at the ends); biases 0\n\n";
+  s += "# Sensor extrinsics wrt. the body-frame.\n";
+  s += EurocTransformYaml(Eigen::Isometry3d::Identity());
+  return s;
+}
+
+// The frame time in whole nanoseconds from its correctly rounded decimal ("%.9f"), so an
+// absolute time keeps its digits (llround(t * 1e9) is off by up to ~100 ns at 1.3e9 s). false
+// when |t| >= 4e9 s (the stamp would not fit an int64 beside any offset).
+bool ExactNs(double time_s, int64_t* t_ns) {
+  if (!(std::abs(time_s) < 4e9)) return false;
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.9f", std::abs(time_s));
+  const char* dot = std::strchr(text, '.');
+  const int64_t ns =
+      std::strtoll(text, nullptr, 10) * 1000000000LL + std::strtoll(dot + 1, nullptr, 10);
+  *t_ns = time_s < 0.0 ? -ns : ns;
+  return true;
+}
+
+// A TUM stamp (seconds, 9 decimals) of a nanosecond stamp >= 0: the text of left.txt,
+// right.txt, groundtruth.txt and the image names, e.g. "1767225600.033333333".
+std::string TumStampText(int64_t stamp_ns) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%lld.%09lld", static_cast<long long>(stamp_ns / 1000000000LL),
+                static_cast<long long>(stamp_ns % 1000000000LL));
+  return text;
 }
 
 }  // namespace
@@ -111,6 +153,9 @@ bool DatasetWriter::Options::IsValid(std::string* error) const {
     return Fail(error, "T_body_cam0 must be finite with a rotation in its linear part");
   if (!std::isfinite(rate_hz) || rate_hz < 0.0)
     return Fail(error, "rate_hz must be finite and >= 0, got " + FormatDouble(rate_hz));
+  if (stamp_offset_ns < 0 || stamp_offset_ns > kMaxStampOffsetNs)
+    return Fail(error, "stamp_offset_ns must be in [0, " + std::to_string(kMaxStampOffsetNs) +
+                           "], got " + std::to_string(stamp_offset_ns));
   std::string why;
   if (write_rig && !rig.IsValid(&why)) return Fail(error, "rig: " + why);
   return true;
@@ -168,15 +213,34 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
   const std::string what = dir_ + ": frame " + std::to_string(index) + ": ";
   const cv::Size size(camera_.width, camera_.height);
   if (!std::isfinite(frame.time_s)) return Fail(error, what + "time is not finite");
-  const int64_t t_ns = TimeToNs(frame.time_s);
-  if (index > 0 && t_ns <= times_ns_.back())
+  int64_t t_ns = 0;
+  if (!ExactNs(frame.time_s, &t_ns))
+    return Fail(error,
+                what + "time " + FormatDouble(frame.time_s) + " s is out of range (|t| < 4e9 s)");
+  const int64_t stamp_ns = options_.stamp_offset_ns + t_ns;
+  if (index > 0 && stamp_ns <= stamps_ns_.back())
     return Fail(error, what + "time " + FormatDouble(frame.time_s) +
                            " s is not after the previous frame's (need strictly increasing ns)");
-  if (options_.format == DatasetFormat::kTum && index > 0 &&
-      TumStampName(frame.time_s) == TumStampName(times_s_.back()))
-    return Fail(error,
-                what + "time " + FormatDouble(frame.time_s) +
-                    " s gives the previous frame's TUM image name (stamps closer than 1 ns)");
+  if (options_.format == DatasetFormat::kEuroc || options_.format == DatasetFormat::kTum) {
+    // Names that sort in time order: one number of digits for the whole sequence.
+    const std::string stamp = std::to_string(stamp_ns);
+    if (stamp_ns < 0)
+      return Fail(error, what + "stamp " + stamp +
+                             " ns is negative (EuRoC/TUM stamps are >= 0; raise stamp_offset_ns)");
+    if (index > 0 && stamp.size() != std::to_string(stamps_ns_.front()).size())
+      return Fail(error, what + "stamp " + stamp +
+                             " ns has another number of digits than frame 0's " +
+                             std::to_string(stamps_ns_.front()) +
+                             " (file names would not sort in time order)");
+  }
+  if (options_.format == DatasetFormat::kTum && index > 0) {
+    double t = 0.0, previous = 0.0;  // the TUM lists hold seconds, read as doubles
+    if (!ParseDouble(TumStampText(stamp_ns), &t) ||
+        !ParseDouble(TumStampText(stamps_ns_.back()), &previous) || !(t > previous))
+      return Fail(error, what + "stamp " + TumStampText(stamp_ns) +
+                             " s reads as the same number of seconds as the previous frame's " +
+                             TumStampText(stamps_ns_.back()) + " (closer than a double resolves)");
+  }
   if (frame.left.type() != CV_8UC1 || frame.left.size() != size)
     return Fail(error, what + "left image must be CV_8UC1 " + std::to_string(size.width) + "x" +
                            std::to_string(size.height) + ", got type " +
@@ -205,7 +269,7 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
     return Fail(error, what + "ground-truth pose is not finite");
 
   // Images: encode once, write the same bytes to every layout.
-  const std::string png_ns = std::to_string(t_ns) + ".png";
+  const std::string png_ns = std::to_string(stamp_ns) + ".png";
   for (int cam = 0; cam < 2; ++cam) {
     std::vector<uchar> png;
     if (!cv::imencode(".png", cam == 0 ? frame.left : frame.right, png, compression_params_))
@@ -218,9 +282,9 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
         !WriteBytes(Join(partial_dir_, "mav0/cam" + cam_name + "/data/" + png_ns), png, error))
       return false;
     if (options_.format == DatasetFormat::kTum &&
-        !WriteBytes(Join(partial_dir_,
-                         (cam == 0 ? "left/" : "right/") + TumStampName(frame.time_s) + ".png"),
-                    png, error))
+        !WriteBytes(
+            Join(partial_dir_, (cam == 0 ? "left/" : "right/") + TumStampText(stamp_ns) + ".png"),
+            png, error))
       return false;
   }
   if (has_depth_) {
@@ -231,12 +295,12 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
       return false;
   }
   times_s_.push_back(frame.time_s);
-  times_ns_.push_back(t_ns);
+  stamps_ns_.push_back(stamp_ns);
   if (has_gt_) T_world_cam0_.push_back(frame.T_world_cam0);
   return true;
 }
 
-bool DatasetWriter::WriteEurocText(std::string* error) const {
+bool DatasetWriter::WriteEurocSensorFolders(std::string* error) const {
   const size_t n = times_s_.size();
   double rate_hz = options_.rate_hz;
   if (rate_hz == 0.0 && n >= 2) {
@@ -245,24 +309,30 @@ bool DatasetWriter::WriteEurocText(std::string* error) const {
     std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
     rate_hz = std::round(1e3 / dt[dt.size() / 2]) / 1e3;  // to 1 mHz: 30, not 29.99999999997
   }
+  for (int cam = 0; cam < 2; ++cam)
+    if (!WriteEurocCamera(cam, rate_hz, error)) return false;
+  return !has_gt_ || WriteEurocGroundTruth(error);
+}
+
+bool DatasetWriter::WriteEurocCamera(int cam, double rate_hz, std::string* error) const {
   Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
   T_cam0_cam1.translation() = Eigen::Vector3d(camera_.baseline_m, 0.0, 0.0);
-  const Eigen::Isometry3d T_body_cam[2] = {options_.T_body_cam0,
-                                           options_.T_body_cam0 * T_cam0_cam1};
-  const char* comments[2] = {"vobench cam0 (left)", "vobench cam1 (right)"};
-  for (int cam = 0; cam < 2; ++cam) {
-    const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));
-    std::string csv = "#timestamp [ns],filename\n";
-    for (int64_t t_ns : times_ns_)
-      csv += std::to_string(t_ns) + "," + std::to_string(t_ns) + ".png\n";
-    if (!WriteTextFile(Join(base, "data.csv"), csv, error)) return false;
-    if (!WriteTextFile(Join(base, "sensor.yaml"),
-                       EurocSensorYaml(comments[cam], T_body_cam[cam], camera_, rate_hz), error))
-      return false;
-  }
-  if (!has_gt_) return true;
+  const Eigen::Isometry3d T_body_cam =
+      cam == 0 ? options_.T_body_cam0 : options_.T_body_cam0 * T_cam0_cam1;
+  const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));
+  std::string csv = "#timestamp [ns],filename\n";
+  for (int64_t t_ns : stamps_ns_)
+    csv += std::to_string(t_ns) + "," + std::to_string(t_ns) + ".png\n";
+  return WriteTextFile(Join(base, "data.csv"), csv, error) &&
+         WriteTextFile(Join(base, "sensor.yaml"),
+                       EurocSensorYaml(cam == 0 ? "vobench cam0 (left)" : "vobench cam1 (right)",
+                                       T_body_cam, camera_, rate_hz),
+                       error);
+}
 
+bool DatasetWriter::WriteEurocGroundTruth(std::string* error) const {
   // Ground truth: body pose in the world, velocity by finite differences, zero biases.
+  const size_t n = times_s_.size();
   const std::string gt_dir = Join(partial_dir_, "mav0/state_groundtruth_estimate0");
   if (!MakeDir(gt_dir, error)) return false;
   const Eigen::Isometry3d T_cam0_body = options_.T_body_cam0.inverse();
@@ -278,12 +348,13 @@ bool DatasetWriter::WriteEurocText(std::string* error) const {
     }
     const Eigen::Vector3d p = T_world_body[i].translation();
     const Eigen::Quaterniond q = CanonicalQuaternion(T_world_body[i].linear());
-    csv += std::to_string(times_ns_[i]);
+    csv += std::to_string(stamps_ns_[i]);
     for (double x : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z()})
       csv += "," + FormatDouble(x);
     csv += ",0,0,0,0,0,0\n";
   }
-  return WriteTextFile(Join(gt_dir, "data.csv"), csv, error);
+  return WriteTextFile(Join(gt_dir, "data.csv"), csv, error) &&
+         WriteTextFile(Join(gt_dir, "sensor.yaml"), EurocGroundTruthYaml(), error);
 }
 
 bool DatasetWriter::WriteTumText(std::string* error) const {
@@ -291,29 +362,43 @@ bool DatasetWriter::WriteTumText(std::string* error) const {
   for (int cam = 0; cam < 2; ++cam) {
     std::string list = std::string("# ") + names[cam] +
                        " images (vobench TUM-style stereo layout)\n# timestamp filename\n";
-    for (size_t i = 0; i < times_s_.size(); ++i)
-      list +=
-          FormatDouble(times_s_[i]) + " " + names[cam] + "/" + TumStampName(times_s_[i]) + ".png\n";
+    for (int64_t stamp_ns : stamps_ns_) {
+      const std::string stamp = TumStampText(stamp_ns);
+      list += stamp + " " + names[cam] + "/" + stamp + ".png\n";
+    }
     if (!WriteTextFile(Join(partial_dir_, std::string(names[cam]) + ".txt"), list, error))
       return false;
   }
   if (!has_gt_) return true;
-  std::vector<StampedPose> gt;
-  for (size_t i = 0; i < times_s_.size(); ++i) gt.push_back({times_s_[i], T_world_cam0_[i]});
-  return WriteTum(Join(partial_dir_, "groundtruth.txt"), gt, error);
+  // "t tx ty tz qx qy qz qw" (WriteTum's numbers) with the stamps' own text.
+  std::string gt = "# ground truth: left camera in the world (vobench TUM-style stereo layout)\n";
+  gt += "# timestamp tx ty tz qx qy qz qw\n";
+  for (size_t i = 0; i < stamps_ns_.size(); ++i) {
+    const Eigen::Vector3d t = T_world_cam0_[i].translation();
+    const Eigen::Quaterniond q = CanonicalQuaternion(T_world_cam0_[i].linear());
+    gt += TumStampText(stamps_ns_[i]);
+    for (double x : {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}) gt += ' ' + FormatDouble(x);
+    gt += '\n';
+  }
+  return WriteTextFile(Join(partial_dir_, "groundtruth.txt"), gt, error);
 }
 
 bool DatasetWriter::Finish(std::string* error) {
   if (!is_open()) return Fail(error, "DatasetWriter::Finish: writer is not open");
   if (times_s_.empty()) return Fail(error, dir_ + ": no frames were added");
 
-  // calib.txt: rectified projection matrices, P1 = K [I | (-baseline_m, 0, 0)].
+  // calib.txt as KITTI odometry's: rectified projection matrices, P1 = K [I | (-fx baseline_m, 0,
+  // 0)]; P2/P3 (KITTI's colour pair) repeat P0/P1, Tr (velodyne to cam0) is the identity: the
+  // tools read all five (pykitti: P_rect_20, T_cam0_velo; cv::datasets::SLAM_kitti).
   const double P0[12] = {
       camera_.fx_px, 0, camera_.cx_px, 0, 0, camera_.fy_px, camera_.cy_px, 0, 0, 0, 1, 0};
   double P1[12];
   std::copy(P0, P0 + 12, P1);
   P1[3] = -(camera_.fx_px * camera_.baseline_m);
-  if (!WriteTextFile(Join(partial_dir_, "calib.txt"), CalibRow("P0:", P0) + CalibRow("P1:", P1),
+  const double Tr[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  if (!WriteTextFile(Join(partial_dir_, "calib.txt"),
+                     CalibRow("P0:", P0) + CalibRow("P1:", P1) + CalibRow("P2:", P0) +
+                         CalibRow("P3:", P1) + CalibRow("Tr:", Tr),
                      error) ||
       !WriteKittiTimes(Join(partial_dir_, "times.txt"), times_s_, error))
     return false;
@@ -337,7 +422,7 @@ bool DatasetWriter::Finish(std::string* error) {
                          error))
       return false;
   }
-  if (options_.format == DatasetFormat::kEuroc && !WriteEurocText(error)) return false;
+  if (options_.format == DatasetFormat::kEuroc && !WriteEurocSensorFolders(error)) return false;
   if (options_.format == DatasetFormat::kTum && !WriteTumText(error)) return false;
 
   // Publish: rename the partial folder to DIR (replacing an old vobench dataset when allowed).

@@ -1,6 +1,14 @@
 // DatasetWriter: a stereo sequence onto disk in the KITTI odometry layout (kitti.h), and when
 // asked also in the EuRoC/ASL layout (euroc.h) or the TUM-style stereo layout (tum.h), so
-// simulated sequences (`vobench render`) run through the same readers as real ones.
+// simulated sequences (`vobench render`) run through the same readers as real ones, and other
+// systems' readers take them as they are:
+//   - every YAML file starts with OpenCV's "%YAML:1.0" line (cv::FileStorage needs it; EuRoC's
+//     own files have it; vobench's yaml-cpp readers skip it);
+//   - calib.txt holds P0..P3 (P2 = P0, P3 = P1: the grey pair stands in for the colour pair) and
+//     an identity Tr, as pykitti and cv::datasets::SLAM_kitti expect of the odometry calib.txt;
+//   - the EuRoC and TUM stamps are Options::stamp_offset_ns + the frame time in nanoseconds;
+//     all stamps of a sequence have the same number of digits, so the file names sort in time
+//     order (`vobench render` starts the simulator's clock at kSimulationEpochNs: 19 digits).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -16,6 +24,11 @@
 #include "vo/camera.h"
 
 namespace harness {
+
+// Where `vobench render` puts the simulator's time 0 on the EuRoC/TUM stamps:
+// 2026-01-01T00:00:00Z in nanoseconds since the Unix epoch. Fixed (never the wall clock), so
+// the same scenario gives the same bytes; 19 digits, like EuRoC's 1403636579763555584.
+constexpr int64_t kSimulationEpochNs = 1767225600000000000;
 
 // Writes a sequence atomically: everything goes into a marked, locked work folder
 // "DIR.partial-<pid>-<random>" (an OutputFolder of kind "dataset", output_folder.h) that is
@@ -45,6 +58,11 @@ class DatasetWriter {
                              // frame interval, rounded to 1 mHz
     bool write_rig = false;  // write rig.yaml (the camera's mounting, harness/dataset/rig.h)
     RigMounting rig;         // with write_rig
+    // Added to every frame time (as whole nanoseconds) for the EuRoC and TUM stamps, >= 0. 0 =
+    // the frame times are the stamps already (a recorded sequence); the simulator's clock starts
+    // at 0, so render gives kSimulationEpochNs. times.txt and the KITTI-side files keep the frame
+    // times.
+    int64_t stamp_offset_ns = 0;
 
     bool IsValid(std::string* error) const;
   };
@@ -61,6 +79,8 @@ class DatasetWriter {
   bool Open(const std::string& dir, const vo::StereoCamera& camera, std::string* error);
   // Writes the frame's images at once. Frames must come in strictly increasing time (distinct
   // t_ns); images must be CV_8UC1 of the camera's size, depth empty or CV_32FC1 of that size.
+  // EuRoC and TUM: every stamp (stamp_offset_ns + t_ns) >= 0 with as many digits as the first
+  // frame's (names that sort), and for TUM distinct as the seconds its lists hold (doubles).
   // Ground truth and depth are all-or-nothing: the first frame decides for the sequence.
   bool Add(const DatasetFrame& frame, std::string* error);
   // Writes the text files and renames the partial folder to DIR. At least one frame needed.
@@ -73,7 +93,11 @@ class DatasetWriter {
 
  private:
   void RemovePartial();
-  bool WriteEurocText(std::string* error) const;
+  // The mav0/ text files: WriteEurocSensorFolders writes each sensor's folder (data.csv,
+  // sensor.yaml) by the functions below it; a new sensor (imu0/) and body.yaml go there.
+  bool WriteEurocSensorFolders(std::string* error) const;
+  bool WriteEurocCamera(int cam, double rate_hz, std::string* error) const;
+  bool WriteEurocGroundTruth(std::string* error) const;
   bool WriteTumText(std::string* error) const;
 
   Options options_;
@@ -85,7 +109,7 @@ class DatasetWriter {
   bool has_gt_ = false;
   bool has_depth_ = false;
   std::vector<double> times_s_;
-  std::vector<int64_t> times_ns_;
+  std::vector<int64_t> stamps_ns_;               // the EuRoC/TUM stamps: stamp_offset_ns + t_ns
   std::vector<Eigen::Isometry3d> T_world_cam0_;  // one per frame when has_gt_
   std::vector<int> compression_params_;
 };

@@ -176,7 +176,10 @@ TEST_F(DatasetTest, KittiRoundTrip) {
   EXPECT_FALSE(fs::exists(fs::path(dir) / "mav0"));
   EXPECT_EQ(ReadAll(fs::path(dir) / "calib.txt"),
             "P0: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1 0\n"
-            "P1: 52.25 0 31.5 -6.53125 0 51.75 23.5 0 0 0 1 0\n");
+            "P1: 52.25 0 31.5 -6.53125 0 51.75 23.5 0 0 0 1 0\n"
+            "P2: 52.25 0 31.5 0 0 51.75 23.5 0 0 0 1 0\n"
+            "P3: 52.25 0 31.5 -6.53125 0 51.75 23.5 0 0 0 1 0\n"
+            "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n");  // KITTI odometry's five keys (pykitti needs them)
   EXPECT_THAT(ReadAll(fs::path(dir) / "poses.txt"),
               ::testing::StartsWith("1 0 0 0 0 1 0 0 0 0 1 0\n"));
 

@@ -86,6 +86,7 @@ class EvalTest : public ::testing::Test {
       options.format = format;
       options.T_body_cam0 = simulator->calibration().T_body_cam0;
       options.rate_hz = scenario_->rate_hz;
+      options.stamp_offset_ns = kSimulationEpochNs;
       options.write_rig = true;  // the mounting, so a run on the export knows the ground vehicle
       options.rig.forward_m = scenario_->camera.forward_m;
       options.rig.height_m = scenario_->camera.height_m;
@@ -243,7 +244,8 @@ TEST_F(EvalTest, GroundTruthAtAnotherRateCoveringPartOfTheFrames) {
   for (size_t i = 0; i < covered; ++i) {
     for (int k = 0; k < 3; ++k) {
       StampedPose p = gt[i];
-      p.time_s = gt[i].time_s + 0.004 + k * period_s / 3.0;
+      // On the export's clock: the simulator's time on the render's epoch (writer.h).
+      p.time_s = kSimulationEpochNs * 1e-9 + gt[i].time_s + 0.004 + k * period_s / 3.0;
       if (k > 0) p.T_world_cam.translation() += Eigen::Vector3d(100.0, 0, 0);  // never used
       fast.push_back(p);
     }
@@ -285,13 +287,19 @@ TEST_F(EvalTest, KittiWithAGroundTruthFileInTumOrKittiFormat) {
   const std::string data = Copy(DatasetFormat::kTum);
   EvalOptions options;
   options.format = DatasetFormat::kKitti;
-  options.gt_path = data + "/groundtruth.txt";  // the left camera in the world, TUM format
+  // The left camera in the world, TUM format, on times.txt's clock (the TUM layout's
+  // groundtruth.txt less the render's epoch).
+  std::vector<StampedPose> gt;
+  std::string error;
+  ASSERT_TRUE(ReadTum(data + "/groundtruth.txt", &gt, &error)) << error;
+  for (StampedPose& p : gt) p.time_s -= kSimulationEpochNs * 1e-9;
+  options.gt_path = data + "/groundtruth_from_0.txt";
+  ASSERT_TRUE(WriteTum(options.gt_path, gt, &error)) << error;
   RunSummary s;
   EvalInfo info;
-  std::string error;
   ASSERT_TRUE(EvalDataset(data, options, vo::OdometryOptions(), QuietRun(Out()), &s, &info, &error))
       << error;
-  EXPECT_EQ(info.ground_truth_path, data + "/groundtruth.txt");
+  EXPECT_EQ(info.ground_truth_path, data + "/groundtruth_from_0.txt");
   ExpectSameAccuracy(ReadJson(Out() + "/metrics.json"), ReadJson(RunDir() + "/metrics.json"), "gt");
   // The KITTI benchmark's way: poses in a file of their own (poses/NN.txt), told by 12 fields.
   fs::create_directories(data + "/poses");
@@ -345,6 +353,7 @@ class EvalBadInputTest : public ::testing::Test {
     for (DatasetFormat format : {DatasetFormat::kEuroc, DatasetFormat::kTum}) {
       DatasetWriter::Options options;
       options.format = format;
+      options.stamp_offset_ns = kSimulationEpochNs;  // as render: stamps of one width
       DatasetWriter writer(options);
       std::string error;
       ASSERT_TRUE(writer.Open(Data(format), camera, &error)) << error;
@@ -536,7 +545,7 @@ TEST_F(EvalBadInputTest, EurocMissingOrBadCalibration) {
 
 TEST_F(EvalBadInputTest, TumImagesOfDifferentSizesOrMissingList) {
   const std::string data = Data(DatasetFormat::kTum);
-  const std::string right0 = data + "/right/0.000000000.png";
+  const std::string right0 = data + "/right/1767225600.000000000.png";
   ASSERT_TRUE(fs::exists(right0));
   cv::imwrite(right0, cv::Mat::zeros(100, 160, CV_8UC1));
   ExpectCliFailure("--dataset " + data + " --format tum",
