@@ -273,7 +273,10 @@ CheckReport CompareToBaseline(const Baseline& baseline, const SuiteResult& resul
         // null in the baseline: the run is expected to give no value either (a metric that
         // does not apply). A value now is a change the baseline must record, not a pass.
         c.verdict = std::isfinite(c.now) ? "WORSE" : "OK";
-        if (std::isfinite(c.now)) ++report.worse;
+        if (std::isfinite(c.now)) {
+          ++report.worse;
+          c.note = "(the baseline has null: no value expected; record it with --update)";
+        }
       } else if (!std::isfinite(c.now) || worsening > c.tolerance) {
         c.verdict = "WORSE";
         ++report.worse;
