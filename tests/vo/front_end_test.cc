@@ -6,11 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "tests/vo/texture_util.h"
 #include "tests/vo/vo_test_util.h"
-#include "vo/ransac.h"  // vo::SplitMix64
 
 namespace vo {
 namespace {
@@ -22,17 +21,6 @@ Feature WithDisparity(double u, double v, double d) {
   f.uv_px = Eigen::Vector2d(u, v);
   f.disparity_px = d;
   return f;
-}
-
-// A random texture, blurred so that block matching and corners find it.
-cv::Mat Texture(int width, int height, uint64_t seed) {
-  SplitMix64 rng(seed);
-  cv::Mat t(height, width, CV_8UC1);
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) t.at<uint8_t>(v, u) = static_cast<uint8_t>(255 * rng.Uniform());
-  }
-  cv::GaussianBlur(t, t, cv::Size(3, 3), 0.8);
-  return t;
 }
 
 TEST(FrontEndTest, SceneRangeCoversTheLargestDisparityWithItsMargins) {
@@ -86,7 +74,7 @@ TEST(FrontEndTest, TheSeamKeepsFeaturesWithDepthAndReindexesTheMatches) {
 TEST(FrontEndTest, FeaturesReadTheDisparityOfAShiftedPairInBothModes) {
   const StereoCamera cam = test::TestCamera();
   const int d = 8;  // the right view is the left one shifted by 8 px: a plane at fx·b/8
-  const cv::Mat texture = Texture(cam.width + d, cam.height, 3);
+  const cv::Mat texture = test::BlurredNoise(cam.width + d, cam.height, 3, 3, 0.8);
   const cv::Mat left = texture(cv::Rect(0, 0, cam.width, cam.height)).clone();
   const cv::Mat right = texture(cv::Rect(d, 0, cam.width, cam.height)).clone();
   for (const DisparityMode mode : {DisparityMode::kDense, DisparityMode::kAtFeatures}) {

@@ -4,12 +4,11 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "tests/test_util.h"
+#include "tests/vo/texture_util.h"
 #include "tests/vo/vo_test_util.h"
-#include "vo/ransac.h"  // vo::SplitMix64
 
 namespace vo {
 namespace {
@@ -25,17 +24,6 @@ Eigen::Isometry3d Pose(double yaw_deg, double roll_deg, const Eigen::Vector3d& t
                    .toRotationMatrix();
   T.translation() = t;
   return T;
-}
-
-// A blurred random texture (distinct at every shift).
-cv::Mat Texture(int width, int height, uint64_t seed) {
-  SplitMix64 rng(seed);
-  cv::Mat t(height, width, CV_8UC1);
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) t.at<uint8_t>(v, u) = static_cast<uint8_t>(255 * rng.Uniform());
-  }
-  cv::GaussianBlur(t, t, cv::Size(5, 5), 1.2);
-  return t;
 }
 
 struct Fixture {
@@ -104,7 +92,7 @@ TEST(RecoveryTest, ALostFrameFollowsAPanByTheImageShift) {
   Fixture f;
   Recovery recovery(f.camera, OdometryOptions());
   const int shift = 12;  // the view pans: the content moves 12 px to the left
-  const cv::Mat texture = Texture(f.camera.width + shift, f.camera.height, 5);
+  const cv::Mat texture = test::BlurredNoise(f.camera.width + shift, f.camera.height, 5, 5, 1.2);
   const cv::Mat previous = texture(cv::Rect(0, 0, f.camera.width, f.camera.height)).clone();
   const cv::Mat current = texture(cv::Rect(shift, 0, f.camera.width, f.camera.height)).clone();
   f.velocity.Move(Eigen::Isometry3d::Identity(), 1.0);  // the prior: standing still

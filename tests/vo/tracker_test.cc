@@ -3,12 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "tests/test_util.h"
+#include "tests/vo/texture_util.h"
 #include "tests/vo/vo_test_util.h"
-#include "vo/ransac.h"  // vo::SplitMix64
 
 namespace vo {
 namespace {
@@ -30,14 +29,7 @@ struct Scene {
 
   Scene() {
     T_ref_curr.translation().x() = -kShiftPx * kDepthM / camera.fx_px;
-    SplitMix64 rng(9);
-    cv::Mat texture(camera.height, camera.width + kShiftPx, CV_8UC1);
-    for (int v = 0; v < texture.rows; ++v) {
-      for (int u = 0; u < texture.cols; ++u) {
-        texture.at<uint8_t>(v, u) = static_cast<uint8_t>(255 * rng.Uniform());
-      }
-    }
-    cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
+    const cv::Mat texture = test::BlurredNoise(camera.width + kShiftPx, camera.height, 9, 5, 1.2);
     ref.image = texture(cv::Rect(kShiftPx, 0, camera.width, camera.height)).clone();
     curr.image = texture(cv::Rect(0, 0, camera.width, camera.height)).clone();
     ref.frame_id = 0;
