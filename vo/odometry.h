@@ -1,21 +1,26 @@
 // The stereo visual-odometry pipeline: one call per stereo pair, the camera's pose back.
-// Kwolek, docs/PAPER.md (the whole table), sections IV–V of the paper:
+// Kwolek, docs/PAPER.md (the whole table), sections IV–V of the paper. StereoOdometry
+// orchestrates the stages, each in its own unit that receives only the data it needs:
 //
-//   frame 0      dense disparity → features (left image) → depth → [plane-based initial
-//                orientation]
-//   frame k > 0  disparity prepared (area-based; search range from the scene)  disparity.h
-//                → features (Harris | SIFT, bucketed)                           features.h
-//                → AttachDepth: the disparity evaluated at the pixels the features read
-//                  (texture filter, uniqueness, left-right check; disparity_mode dense = the
-//                  whole map), features without depth dropped                   disparity.h
-//                → match to the reference frame (SVD · NCC · Gabor by default)  matcher.h
-//                → RANSAC + Horn (T_ref_curr), seeded by track ages             ransac.h
-//                → initial pose = blend of the RANSAC estimate and the constant-velocity
-//                  prediction (slerp on the rotation, linear on the translation)
-//                → tracks (inlier matches only) and the window's poses          sliding_window.h
-//                → windowed bundle adjustment, oldest pose fixed, divergence
-//                  guard                                  sliding_window.h, bundle_adjustment.h
-//                → T_world_cam0
+//   front end     disparity prepared (area-based; search range from the scene)
+//                 → features (Harris | SIFT, bucketed) → depth at the features'
+//                 pixels, features without depth dropped                      front_end.h
+//   frame 0       plane-based initial orientation (the hallway frame)         initial_orientation.h
+//   frame k > 0   match to the reference frame with the prediction passes
+//                 (motion prior, coarse-to-fine shift, last motion, guided)   tracker.h
+//                 → RANSAC + Horn (T_ref_curr), seeded by track ages; the
+//                 few-point motion with the prior where RANSAC has no
+//                 consensus                                                   motion_estimation.h
+//                 → initial pose = blend of that motion and the constant-velocity
+//                 prediction (slerp on the rotation, linear on the translation)
+//                 → tracks (inlier matches only), windowed bundle adjustment,
+//                 oldest pose fixed, divergence guard                         sliding_window.h
+//                 → T_world_cam0
+//   no motion     the pose bridged (prior, image shift, lost-frame chain, a
+//                 ground vehicle's bridge and direct alignment)               recovery.h
+//   shared        the constant-velocity prior, predictions, pose algebra      motion_model.h
+//   options       OdometryOptions (vo_options.yaml)                          odometry_options.h
+//   result        OdometryResult, FrameDiagnostics, MotionPrior               odometry_result.h
 //
 // The reference frame is the last frame that was tracked (or initialised): normally the
 // previous frame; after lost frames, the last good one.
@@ -35,81 +40,21 @@
 // the consensus weakens (w <= prior_weight). Without bundle adjustment this blend is the
 // output; with it, the blend is where the solver starts.
 //
-// Predicted matching (matcher.prediction = kMotionPrior, the default; kNone = the paper's
-// unpredicted form, every position gate centred on the previous position). Beyond the paper,
-// whose proximity term exp(−d²/2σ²) with σ = 10 px stops at ~28 px of image motion:
-//   1. prior pass: each reference feature's 3D point is moved by the motion prior (the
-//      constant-velocity motion from the last RELIABLE frame, or the caller's MotionPrior) and
-//      projected (PredictFeaturePositions); every matcher centres its position gate there
-//      (MatchPrediction), then RANSAC.
-//   2. coarse-to-fine pass, when the prior is weak (no motion known yet, after a lost frame)
-//      or contradicted (fewer inliers than tracking.confident_min_inliers or
-//      confident_inlier_fraction of the features): the dominant image shift from the reference
-//      to this frame on an image pyramid (image_motion.h, the paper's "multi-scale analysis"),
-//      matching around uv + shift with gates widened by shift_radius_scale, then RANSAC; the
-//      pass with more inliers is kept.
-//   2b. last-motion pass, when still not confident and the reference (the previous frame)
-//      measured its own motion: matching around that motion as measured
-//      (tracking.last_motion_pass). The prior takes a weak motion in only in part, so it lags
-//      a turn that starts; the pass with more inliers is kept.
-//   3. guided pass: every reference feature predicted with the motion just estimated, matched
-//      in a tight window (guided_radius_scale), RANSAC; kept when it has at least as many
-//      inliers, so more correct matches reach the bundle adjustment.
-// The stateful Kalman tracker runs pass 1 only. OdometryResult::prediction says which pass
-// the used matches came from; StageTimes::predict_ms / guided_ms time the new steps.
-//
-// Lost tracking and recovery. A frame is "lost" (TrackingStatus::kLost, with a message) when
-// its input is invalid (empty, not CV_8UC1, sizes differ from each other or from the camera),
-// its disparity fails, it has fewer than min_features features with depth (black or
-// textureless frame), or the motion fails (RANSAC without consensus, fewer than min_inliers
-// inliers; but see "Few points" below). Its pose is the prior's prediction from the previous
-// output, never NaN — corrected,
-// when the image shift from the previous frame is found (tracking.rotation_from_shift), by the
-// rotation that explains that shift (CorrectPriorWithImageShift): a turn in front of a plain
-// wall is followed, not extrapolated. The reference frame, the tracks and the window are kept.
-// The next frames are matched against that reference (the last good frame) with the
-// coarse-to-fine pass, so the motion across the gap is measured; success gives kRecovered.
-// A lost frame that the reference cannot measure is matched against the previous lost frame
-// with features (tracking.chain_lost_frames): a turn in front of a plain wall leaves the
-// reference's view behind, but the frames of the gap overlap each other, so their motion is
-// measured link by link (the frame stays lost; OdometryResult::chained_to_frame).
-// When the motion still fails after reinit_after_lost_frames lost frames, or the current frame
-// is rich (at least 2 · min_features features) yet cannot be matched after a loss, the pipeline
+// Lost tracking. A frame is "lost" (TrackingStatus::kLost, with a message) when its input is
+// invalid (empty, not CV_8UC1, sizes differ from each other or from the camera), its disparity
+// fails, it has fewer than min_features features with depth (black or textureless frame), or
+// the motion fails (RANSAC without consensus, fewer than min_inliers inliers; but see "Few
+// points" in motion_estimation.h). Its pose is bridged (recovery.h); the reference frame, the
+// tracks and the window are kept, and the next frames are matched against that reference with
+// the coarse-to-fine pass, so the motion across the gap is measured (kRecovered). When the
+// motion still fails after reinit_after_lost_frames lost frames, or the current frame is rich
+// (at least 2 · min_features features) yet cannot be matched after a loss, the pipeline
 // re-initialises on the current frame at its bridged pose (kRecovered, reinitialised = true):
 // tracks and window restart, the constant velocity is kept. Each measured motion moves the
 // prior in proportion to its support (tracking.reliable_min_inliers; not at all when the BA was
-// rejected), so one weak estimate just before a loss is not extrapolated over the gap, while a
-// long weakly textured stretch still updates it. Frames without a measured motion (lost and
-// re-initialised ones, unless the direct image alignment measured them: "Ground vehicle") are
-// what IsLostFrame() counts. The frame after a kRecovered frame is
-// kTracking again.
-//
-// Few points (tracking.few_point_motion, beyond the paper; off on the free platform, on for a
-// ground vehicle: OdometryOptions::platform, see the option).
-// While tracking normally (the
-// previous frame's motion measured, no loss since), a frame with too few matches for RANSAC
-// (fewer correspondences than min_inliers), with fewer than min_features features with
-// depth (down to tracking.few_point_min_features; such a frame takes no RANSAC motion, only
-// this one), or — a ground vehicle — whose weak RANSAC motion tilts or lifts the vehicle
-// (tracking.vehicle_max_weak_tilt_deg), takes the few-point motion of prior_motion.h on the same
-// matches:
-// the prior corrected by the few matches (inliers >= few_point.min_inliers and >=
-// few_point.min_inlier_fraction of them), unless the frame's coarse-to-fine image shift
-// contradicts it (few_point_max_shift_disagreement_px). That frame is not bundle-adjusted
-// (OdometryResult::few_point_motion). A plain end wall with two or three specks in front of a
-// robot that stops and turns (l_hallway's texture seeds) is followed that way, not bridged.
-// After a loss the prior is a bridge, not a measurement, and the solver is not used. When
-// neither matching pass reaches a RANSAC consensus, the pass whose matches support more of the
-// few-point motion is kept (a prior that lags a turn would otherwise win the tie).
-//
-// Ground vehicle (tracking.ground_vehicle; off on the free platform, on for a ground vehicle, see
-// the option and Platform): where the images
-// cannot measure the motion (few-point frames, lost frames) it is a wheeled vehicle's, planar
-// about the world's up, and in the few-point fit without sideways slip. A lost frame's forward
-// step and yaw are then measured against the previous frame's features without matching them
-// (tracking.vehicle_bridge_alignment, bridge_alignment.h), and then by aligning the previous
-// left image with this one on the planes of the last features (tracking.vehicle_direct_alignment,
-// direct_alignment.h): when that converges the frame's motion is measured (not a lost frame).
+// rejected). Frames without a measured motion (lost and re-initialised ones, unless the direct
+// image alignment measured them) are what IsLostFrame() counts. The frame after a kRecovered
+// frame is kTracking again.
 //
 // Determinism: every random choice is seeded (RANSAC, plane extraction), the bundle
 // adjustment is single-threaded; the same inputs give bit-identical outputs. Global OpenCV
@@ -121,595 +66,28 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <chrono>
-#include <limits>
-#include <map>
+#include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
-#include "vo/bridge_alignment.h"
-#include "vo/bundle_adjustment.h"
 #include "vo/camera.h"
-#include "vo/direct_alignment.h"
-#include "vo/disparity.h"
-#include "vo/features.h"
-#include "vo/image_motion.h"
+#include "vo/front_end.h"
 #include "vo/matcher.h"
+#include "vo/motion_estimation.h"
+#include "vo/motion_model.h"
+#include "vo/odometry_options.h"
+#include "vo/odometry_result.h"
+#include "vo/planar_motion_prior.h"
 #include "vo/plane_orientation.h"
-#include "vo/plane_refinement.h"
-#include "vo/prior_motion.h"
-#include "vo/ransac.h"
+#include "vo/recovery.h"
 #include "vo/sliding_window.h"
+#include "vo/tracker.h"
 #include "vo/tracks.h"
 #include "vo/types.h"
 
 namespace vo {
-
-// Bundle-adjustment defaults for the pipeline: points seen in a single frame of the window
-// carry no pose information, so they are left out (min_frames_per_point = 2); 10 LM
-// iterations suffice from the blended initial pose; a window of 3–10 poses makes the reduced
-// camera system tiny, so the hand-written Schur-complement solver (BaSolver::kSchurLm) is
-// ~5× faster than Ceres there, and for the Ceres reference DENSE_SCHUR beats the sparse
-// factorisation.
-BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions();
-// Detector defaults for the pipeline: Harris, at most 300 features, bucketed on an 8 × 6 grid
-// (at most 10 per cell) so they spread over the image, Harris quality_level 0.001.
-DetectorOptions DefaultOdometryDetectorOptions();
-// Disparity defaults for the pipeline: block matching with the left-right check, both views
-// from one cost volume (kBlockMatchingOneVolume; the same disparities as cv::StereoBM run
-// twice, in about half the time).
-DisparityOptions DefaultOdometryDisparityOptions();
-
-// Image-shift defaults for the pipeline's coarse-to-fine pass: min_score 0.1 instead of 0.3. A
-// wrong shift only costs one matching pass that loses to the other on inliers, while a turn
-// past nearby walls (perspective, parallax) scores ZNCC ~0.3 at the right shift; the pose
-// bridge of a lost frame asks for more (RobustTrackingOptions::rotation_min_shift_score).
-ImageShiftOptions DefaultTrackingImageShiftOptions();
-
-// Robust tracking (beyond the paper's unpredicted matcher; used when matcher.prediction is
-// kMotionPrior). See the header comment, "Predicted matching".
-struct RobustTrackingOptions {
-  bool coarse_to_fine = true;  // when the prior is weak (no reliable motion yet, after a lost
-                               // frame) or contradicted (the first pass is not confident),
-                               // estimate the dominant image shift coarse-to-fine
-                               // (image_motion.h) and match again around it
-  ImageShiftOptions image_shift = DefaultTrackingImageShiftOptions();  // the coarse-to-fine
-                                                                       // estimate
-  bool last_motion_pass = true;     // still not confident after that: when the reference (the
-                                    // previous frame) measured its own motion and it predicts
-                                    // otherwise than the prior (which blends a weak motion in only
-                                    // in part), match again around that motion; the pass with more
-                                    // inliers wins
-  double prior_radius_scale = 0.5;  // the matcher's position gates around the motion prior's
-                                    // prediction are scaled by this, in [0.05, 20]: the
-                                    // prediction leaves a few pixels (SVD σ 10 → 5 px), and
-                                    // a contradicted prior falls to the coarse-to-fine pass
-  double shift_radius_scale = 2.0;  // the matcher's position gates are widened by this around
-                                    // a shift estimate (a global shift ignores parallax),
-                                    // in [0.05, 20]
-  int confident_min_inliers = 30;   // a first pass with fewer RANSAC inliers than this ...
-  double confident_inlier_fraction = 0.2;  // ... or than this fraction of the smaller feature
-                                           // count of the two frames, in [0, 1], is not
-                                           // confident: the coarse-to-fine pass is tried too
-                                           // and the one with more inliers is kept
-  bool guided_rematch = true;              // after RANSAC, predict every reference feature with the
-                               // estimated motion and match again in a tight window; the
-                               // second pass is kept when it has at least as many inliers
-  double guided_radius_scale = 0.3;  // gate scale of that pass (σ 10 px → 3 px), [0.05, 20]
-  bool rotation_from_shift = true;   // a frame without a measured motion (too few features, no
-                                     // consensus) takes the prior's motion corrected by the
-                                     // image shift from the previous frame (the rotation that
-                                     // explains the shift left after the prior, see
-                                     // CorrectPriorWithImageShift), when that shift is found;
-                                     // the measured rotation then becomes the prior's
-  double rotation_min_shift_score = 0.85;  // ... with at least this ZNCC, in [-1, 1]: real
-                                           // structure scores 0.9-0.99 between successive
-                                           // frames, false peaks on plain, smoothly shaded
-                                           // walls ~0.7 (measured on the plain corridor)
-  double rotation_min_peak_ratio = 1.05;   // ... and an unambiguous peak: best / second-best
-                                           // peak score (ImageShiftResult::second_best_ratio)
-                                           // at least this, >= 1
-  double rotation_min_residual_px = 3.0;   // ... and only when the shift differs from the one
-                                           // the prior predicts by more than this (pixels),
-                                           // >= 0: smaller residuals are within what a global
-                                           // shift cannot tell from parallax and zoom (forward
-                                           // motion past plain walls), so the prior stands
-  int reliable_min_inliers = 30;           // a motion with at least this many inliers replaces the
-                                           // constant-velocity prior; one with fewer moves it only
-                                           // part of the way (slerp), one whose bundle
-                                           // adjustment was rejected not at all; >= 3. 30 =
-                                           // confident_min_inliers: a motion the matcher trusts is
-                                           // one the prior may repeat
-  double prior_update_exponent = 2.0;      // ... namely (inliers / reliable_min_inliers) to
-                                           // this power of the way, >= 1: a weak motion is
-                                           // also more often grossly wrong (12 inliers at the edge
-                                           // of a plain wall: 1-4 deg of yaw where the robot drove
-                                           // straight), not only noisier, so half the support
-                                           // moves the prior a quarter of the way. Measured on
-                                           // l_hallway texture seeds 1-10 x strides 1/2/3/5 (40
-                                           // runs, defaults): exponent 1 / 1.5 / 2 / 3 gave mean
-                                           // end-pose error 0.442 / 0.419 / 0.398 / 0.393 m,
-                                           // median 0.182 / 0.157 / 0.141 / 0.143 m; 3 took
-                                           // camera.pitch_deg 10 to 1.40 % (2: 0.73 %)
-  bool few_point_motion = false;  // off unless platform ground_vehicle (measured, l_hallway texture
-                                  // seeds 1-10: stride 1 lost frames 113 -> 38, median end-pose
-                                  // error 0.347 -> 0.152 m, but strides 2 and 3 worse on seeds 2,
-                                  // 5, 10: median 0.256 -> 0.331 m at stride 2). On: when RANSAC
-                                  // finds no consensus (too few features or
-                                  // matches, or fewer than min_inliers of them agree: a plain
-                                  // wall in front of the camera), the motion is
-                                  // estimated from the few matches and the motion prior
-                                  // (prior_motion.h: 1-point rotation hypotheses, then a
-                                  // Gauss-Newton fit regularised by the prior) instead of losing
-                                  // the frame; needs a prior (not on the first tracked frame)
-  int few_point_min_features = 3;  // a frame with fewer than min_features features with depth,
-                                   // but at least this many, is still matched against the
-                                   // reference (few_point_motion), >= 1
-  // Off unless platform ground_vehicle (measured below). The camera rides a wheeled ground vehicle:
-  // where the images cannot measure the motion, it is a wheeled vehicle's. The few-point motion is
-  // a yaw about the world's up and a forward distance of the axle, without sideways slip
-  // (prior_motion.h, "Ground vehicle"; few_point.no_sideways_slip, few_point.axle_behind_camera_m);
-  // its prior, the constant-velocity bridge of a lost frame, loses roll, pitch and lift; a lost
-  // frame's rotation from the image shift is a yaw only (the shift's vertical part is zoom and
-  // parallax). Needs the up direction from the first frame's orientation (the floor found);
-  // without it, 6-DoF. Measured on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs,
-  // results/robustness/, with the lost-frame chain, prior_update_exponent 2 and the vehicle_*
-  // options below): with few_point_motion, mean end-pose error 0.375 -> 0.306 m, median 0.136 ->
-  // 0.131 m, runs <= 0.29 m 26 -> 30, frames without motion 256 -> 171 against the defaults, max
-  // 1.498 -> 2.723 m (texture seed 3, stride 5); with the rig's axle (0.15 m) mean 0.294 m and at
-  // stride 1 max 1.129 -> 0.588 m; but camera.pitch_deg 10 goes 0.73 -> 1.13 % (drift on the
-  // straight approach that the 6-DoF window BA keeps; 0.33 % with vehicle_planar_ba and the
-  // axle), so not the default yet. On its own (few_point_motion off) the mean goes 0.375 ->
-  // 0.347 m, pitch 10 0.73 -> 0.47 %.
-  bool ground_vehicle = false;
-  // With ground_vehicle: a weak tracked motion (fewer than reliable_min_inliers RANSAC inliers)
-  // that tilts the camera (rotation about an axis across up, the swing of its twist
-  // decomposition) by more than vehicle_max_weak_tilt_deg, or lifts it along up by more than
-  // vehicle_max_weak_lift_m, is no wheeled vehicle's motion and is rejected (the frame goes on
-  // as one whose RANSAC failed: few-point motion, chain or bridge). On a plain wall a few
-  // coplanar points let a pitch trade against a vertical step that shows the same image shift:
-  // texture seed 3, stride 2, frame 100: 20 inliers, 9.0° of pitch and 0.19 m down while the
-  // robot drove straight. Both > 0. Measured with few_point_motion and the rig's axle (0.15 m)
-  // on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs): mean end-pose error 0.320 ->
-  // 0.304 m; plain_corridor strides 2/3/5 0.168 / 0.415 / 0.379 -> 0.102 / 0.313 / 0.094 m.
-  double vehicle_max_weak_tilt_deg = 2.0;
-  double vehicle_max_weak_lift_m = 0.03;
-  // With ground_vehicle, a lost frame's rotation from the image shift (rotation_from_shift) is
-  // a vehicle's: the yaw whose motion, with the camera's swing about the axle
-  // (few_point.axle_behind_camera_m), predicts the shift (VehicleMotionFromImageShift). A peak
-  // with at least vehicle_rotation_min_shift_score ([-1, 1]) and a best / second-best ratio of
-  // at least vehicle_rotation_min_peak_ratio (>= 1) is used too (a turn past a plain wall
-  // scores low over the whole overlap but has one clear peak); a shift whose vertical residual
-  // (after the prior) exceeds max(rotation_min_residual_px, vehicle_max_vertical_shift_ratio ·
-  // its horizontal residual) (>= 0) is zoom and parallax of forward motion, not a turn (the
-  // prior stands).
-  double vehicle_rotation_min_shift_score = 0.7;
-  double vehicle_rotation_min_peak_ratio = 3.0;
-  double vehicle_max_vertical_shift_ratio = 0.25;
-  // With ground_vehicle (the up known, matcher.prediction motion_prior, no caller's prior), the
-  // bridged motion of a lost frame (the prior, its rotation corrected by the image shift) is
-  // measured against the previous frame's features without matching them (bridge_alignment.h):
-  // the forward step from their depth change, then the yaw that lays the previous features onto
-  // this frame's; each where at least vehicle_bridge.min_pairs features pair up. The result
-  // becomes the constant velocity (the braking and the turn go on through the next lost frames).
-  // The constant velocity otherwise keeps the cruise speed into a robot that stops and turns in
-  // front of a plain end wall (texture seed 3, stride 1: 4.2 cm a frame where it moved 0.6 cm)
-  // and reads the image shift of off-centre texture as too much yaw (2.8 deg a frame for 2.2).
-  // Measured on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs) with few_point_motion,
-  // vehicle_planar_ba and the rig's axle (0.15 m): mean end-pose error 0.270 -> 0.219 m, runs
-  // <= 0.29 m 31 -> 35, stride 1 max 0.507 -> 0.267 m (every seed under the paper's 0.29 m);
-  // without vehicle_planar_ba mean 0.294 -> 0.249 m; ground_vehicle and the axle alone 0.334 ->
-  // 0.253 m. It needs the rig's axle: with axle_behind_camera_m 0 on that rig (0.15 m off) the
-  // swing is misread and runs <= 0.29 m go 30 -> 26; and without vehicle_planar_ba the pitched
-  // camera goes 0.85 -> 1.30 % (ground_vehicle and the axle). Not for the 6-DoF default: without
-  // the axle's swing in the model a near wall's sideways flow reads as yaw (mean 0.375 -> 0.405 m).
-  bool vehicle_bridge_alignment = true;
-  BridgeAlignmentOptions vehicle_bridge;
-  // With vehicle_bridge_alignment, a lost (or re-initialised) frame's bridged motion is then
-  // measured by aligning the previous left image with this one directly (direct_alignment.h):
-  // the previous image's pixels with a gradient on the planes of the features (fitted in each
-  // frame with enough of them, carried by the measured or bridged motion through at most 30
-  // frames without), the vehicle's yaw and forward step by robust
-  // Gauss-Newton on the grey levels, coarse to fine. When it converges with enough pixels and a
-  // small enough covariance (vehicle_direct), the frame's motion counts as measured
-  // (motion_measured, direct_motion; it is not a lost frame) and becomes the constant velocity.
-  // A turn in front of a plain wall whose features are too few for any matcher (texture seed 3,
-  // stride 1: 1-14 a frame for 21 frames) is measured from its edges, shadows and specks.
-  bool vehicle_direct_alignment = true;
-  DirectAlignmentOptions vehicle_direct;
-  // With ground_vehicle and vehicle_planar_ba, the window's bundle adjustment links
-  // consecutive poses by a planar motion prior (planar_motion_prior.h): no change of roll or
-  // pitch (σ vehicle_ba_tilt_sigma_deg), no step along up (σ vehicle_ba_lift_sigma_m), no
-  // sideways slip of the axle (few_point.axle_behind_camera_m; σ vehicle_ba_slip_sigma_m), all
-  // > 0, each σ weighing the prior against one pixel of reprojection error. The up in the
-  // camera frame is the vehicle's: the first frame's floor fit (σ 1°) refined by every reliable
-  // tracked RANSAC motion (its translation lies across up, σ 1 cm; its rotation axis along up,
-  // σ 0.3°), so a floor fit that is off does not tilt every turn. Off by default: it needs the
-  // rig's axle; with the axle at 0 for a camera 0.15 m ahead of it, the no-slip residual fights
-  // every turn's swing (texture seed 7, stride 1: 0.31 -> 4.3 %). Measured with few_point_motion
-  // and the rig's axle (0.15 m) on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs): mean
-  // end-pose error 0.294 -> 0.270 m, median 0.139 -> 0.133 m, stride-1 max 0.588 -> 0.507 m;
-  // camera.pitch_deg 10: 1.13 -> 0.33 %; 640x480: 0.51 -> 0.03 %; but seed 7 stride 1 0.31 -> 0.61
-  // %. The 6-DoF window BA lets each weak step trade yaw against a sideways step (the pitched
-  // camera's drift); the no-slip residual removes that trade, the tilt and lift ones the pitch
-  // against a vertical step.
-  bool vehicle_planar_ba = false;
-  double vehicle_ba_tilt_sigma_deg = 0.1;
-  double vehicle_ba_lift_sigma_m = 0.002;
-  double vehicle_ba_slip_sigma_m = 0.002;
-  // With vehicle_planar_ba: the floor is flat (one plane), so every pose of the window keeps
-  // the first pose's vehicle up (as refined so far; σ vehicle_floor_tilt_sigma_deg) and the
-  // first camera's height (σ vehicle_floor_height_sigma_m), both > 0 (planar_motion_prior.h,
-  // "Flat floor"; the σ are an indoor floor's and a vehicle's suspension's, not tuned). The
-  // planar prior links only neighbours, so the tilt and the height wander a little with every
-  // window. Only when the first frame found a floor (an up from a ceiling is 1-1.5° off). Off on
-  // the free platform (a library cannot assume a flat floor); platform ground_vehicle says so.
-  // Measured with few_point_motion, the axle and vehicle_planar_ba on l_hallway texture seeds 1-10
-  // x strides 1/2/3/5 (40 runs), against vehicle_planar_ba alone: with the first frame's floor
-  // refined on the images (orientation_floor_refinement) and the vehicle's up starting from it at σ
-  // 0.15°, median end-pose error 0.108 -> 0.097 m, stride 1 median 0.108 -> 0.079 m, seed 7 stride
-  // 1 0.60 -> 0.46 %, mean 0.211 -> 0.211 m, plain_corridor (no floor found: off) unchanged. Before
-  // that refinement, on the block matcher's floor fit (up to 0.8° off in pitch), it was worse:
-  // median 0.108 -> 0.132 m, corridor 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 % (README, "Flat
-  // floor" and "The first frame's floor refined").
-  bool vehicle_flat_floor = false;
-  double vehicle_floor_tilt_sigma_deg = 0.3;
-  double vehicle_floor_height_sigma_m = 0.01;
-  // A lost frame with at least min_features features is matched against the previous lost
-  // frame that had them (the chain), when matching against the reference failed: a turn in
-  // front of a plain wall takes the camera past the reference's view, and the frames of the
-  // gap, which do overlap each other, then measure the motion through it (rotation and
-  // translation, RANSAC with at least min_inliers inliers) instead of extrapolating the prior.
-  // The frame stays lost (no link to the window; it counts in lost_frames), its pose is the
-  // chain's pose times that motion, and the motion moves the constant-velocity prior as a
-  // tracked one does. Not with matcher.prediction none (the paper's form), the Kalman matcher
-  // (stateful), or a caller's MotionPrior (it bridges a lost frame as given). Measured on l_hallway
-  // texture seeds 1-10 x strides 1/2/3/5 (40 runs, results/robustness/, linear prior update):
-  // defaults' median end-pose error 0.206 -> 0.182 m, max 1.958 -> 1.663 m, mean 0.431 -> 0.442 m;
-  // plain_corridor better at every stride (0.268-0.569 -> 0.222-0.492 m); with few_point_motion and
-  // ground_vehicle mean 0.393 -> 0.328 m.
-  bool chain_lost_frames = true;
-  PriorMotionOptions few_point;  // that solver (fewer inliers than its min_inliers and
-                                 // min_inlier_fraction: lost)
-  double few_point_max_shift_disagreement_px =
-      3.0;                              // a few-point motion is rejected when
-                                        // the image shift it predicts (the image centre at the
-                                        // reference's median depth) is farther from the
-                                        // coarse-to-fine shift measured for the frame than the
-                                        // prior's prediction is, by more than this (pixels), >= 0:
-                                        // two wrong matches that agree must not turn the camera by
-                                        // degrees that the image does not show, while the global
-                                        // shift's own error (parallax and zoom of forward motion)
-                                        // is what the prior shows too. No check without a shift.
-                                        // A few-point frame is never bundle-adjusted: a BA over a
-                                        // few points has no prior and is weaker than the solver
-  double few_point_prior_update = 1.0;  // weight of a few-point motion in the constant-velocity
-                                        // prior, in [0, 1] (the solver's estimate already
-                                        // contains the prior)
-
-  bool IsValid(std::string* error) const;
-};
-
-// An external motion prior for one frame (wheel odometry, a gyro, an IMU preintegration): the
-// camera's motion since the previous Process call, p_prev = T_prev_curr * p_curr (cam0 frames).
-// It replaces the constant-velocity prediction for that frame: it centres the matcher's search,
-// it is the pose of a lost frame, and it is what the RANSAC motion is blended with.
-struct MotionPrior {
-  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
-};
-
-// Where the pipeline evaluates the disparity.
-enum class DisparityMode {
-  kDense,       // the whole map of every frame (any disparity.algorithm; the speckle filter)
-  kAtFeatures,  // only the pixels the features' depth sampling reads, and the right-view
-                // pixels of their left-right check (DisparityEstimator::PrepareAtPixels):
-                // the same values as the dense map there without its speckle filter, bit for
-                // bit; needs disparity.algorithm block_matching_one_volume. The first frame's
-                // plane-based orientation still reads a dense map (that one frame)
-};
-// "dense", "at_features".
-const char* ToString(DisparityMode mode);
-
-// What the camera is mounted on (OdometryOptions::platform).
-enum class Platform {
-  kAuto,           // the caller's rig decides (ResolvePlatform): a rig known to be a ground
-                   // vehicle (a wheeled robot on a floor, its axle known) is kGroundVehicle,
-                   // anything else kFree. StereoOdometry alone knows no rig: kFree
-  kFree,           // 6-DoF: the options as given (the paper's form; a drone, a hand-held rig)
-  kGroundVehicle,  // a wheeled robot on one flat floor: the ground-vehicle options on
-                   // (tracking.few_point_motion, ground_vehicle, vehicle_planar_ba,
-                   // vehicle_flat_floor; the axle from the rig when the options leave it at 0)
-};
-// "auto", "free", "ground_vehicle".
-const char* ToString(Platform platform);
-
-struct OdometryOptions {
-  Platform platform = Platform::kAuto;  // see Platform and ResolvePlatform. Measured on the
-                                        // simulated differential-drive robot (l_hallway texture
-                                        // seeds 1-10 x strides 1/2/3/5, 40 runs): the ground
-                                        // vehicle's median / mean end-pose error 0.097 / 0.211 m
-                                        // against free's 0.136 / 0.375 m, stride 1 lost frames 31
-                                        // against 113 (results/robustness/summary.md)
-  DetectorOptions detector = DefaultOdometryDetectorOptions();  // feature detection (left)
-  DisparityOptions disparity =
-      DefaultOdometryDisparityOptions();  // the block matcher and its post-filters;
-                                          // num_disparities is replaced by the value
-                                          // derived from the camera when derive_num_disparities
-  DisparityMode disparity_mode = DisparityMode::kAtFeatures;  // see DisparityMode
-  bool disparity_range_from_scene = true;  // search range per frame from the depths seen:
-                                           // the previous frame's largest feature disparity
-                                           // · (1 + disparity_range_margin) +
-                                           // disparity_range_margin_px, rounded up to 16 and
-                                           // at most the camera-derived range; the full range
-                                           // on the first frame and after a lost frame
-  double disparity_range_margin = 0.25;    // relative margin of that range, >= 0
-  double disparity_range_margin_px = 8.0;  // absolute margin (pixels), >= 0
-  bool derive_num_disparities = true;      // search range from the camera: the smallest multiple
-                                       // of 16 >= fx · baseline / disparity_min_depth_m, clamped
-                                       // to [16, max_num_disparities] (and < image width)
-  double disparity_min_depth_m = 0.7;  // nearest depth the derived search range covers (metres),
-                                       // > 0. Hallway rig (fx 230 px, 0.09 m): 29.6 px → 32
-                                       // disparities, depth >= 0.67 m (the L-path's nearest
-                                       // surface, at the corner turn, is 0.735 m from the camera
-                                       // in the simulator's depth); KITTI (718 px, 0.54 m):
-                                       // clamped to 256 (≈ 1.5 m)
-  int max_num_disparities = 256;       // upper clamp of the derived range (pixels), multiple
-                                       // of 16, >= 16
-  DepthSamplingOptions depth;          // how features read the disparity map
-  MatcherOptions matcher;              // inter-frame matcher (default: SVD · NCC · Gabor)
-  RansacOptions ransac;                // robust frame-to-frame motion
-  BundleAdjustmentOptions ba = DefaultOdometryBundleAdjustmentOptions();  // windowed BA
-
-  bool use_bundle_adjustment = true;  // refine with the windowed BA; false = the blended
-                                      // RANSAC/Horn estimate is the output
-  int ba_max_points = 100;  // at most this many points in the BA (those seen in the most frames
-                            // of the window, then the oldest tracks), >= 0; 0 = every point
-                            // seen in at least ba.min_frames_per_point frames. 100 costs
-                            // ~0.4 ms at 5 frames (~2 ms with ba.solver = ceres) and loses no
-                            // accuracy on the synthetic corridor
-  double ba_max_correction_m = 0.25;   // a BA result that moves the newest pose farther than
-                                       // this from its initial value (metres) is rejected
-                                       // (divergence guard; the blend is kept), > 0
-  double ba_max_correction_deg = 5.0;  // the same for the rotation (degrees), > 0
-  bool ransac_refine_with_ba = false;  // keep RANSAC's nonlinear refinement
-                                       // (ransac.refine_nonlinear) when the BA runs after it;
-                                       // false = skip it then (the BA refines anyway; saves
-                                       // ~3 ms at 300 features). Without BA it always runs
-                                       // as ransac.refine_nonlinear says
-  int ba_window_frames = 5;            // frames in the BA window (and kept by the track
-                                       // manager), 3..10 (paper: 3–5, 10 wished for)
-  double prior_weight = 0.5;  // weight of the constant-velocity prediction in the initial pose
-                              // is prior_weight · (1 − inlier_ratio), in [0, 1]; 0 = the
-                              // RANSAC/Horn estimate alone (see the header comment)
-  bool estimate_initial_orientation = true;  // hallway frame from the first frame's planes
-                                             // (floor/walls); false = world is the first camera
-  PlaneOrientationOptions orientation;       // plane extraction for the initial orientation
-  int orientation_sample_step_px = 4;  // the first frame's dense disparity map is sampled every
-                                       // this many pixels (both axes) for the plane extraction
-                                       // (pixels), >= 1. ProcessFeatures uses the features' 3D
-  // The first frame's floor (when the plane extraction found one) refined on the images
-  // themselves (plane_refinement.h) over the dense map's pixels on the geometric fit: the up and
-  // the camera's height then come from it (the yaw stays the walls'). The block matcher's map
-  // at a grazing floor is biased: the fit's pitch was off by +0.2..+0.8° on l_hallway texture
-  // seeds 1-10 and +1.5° on plain_corridor. Needs the dense map (the first frame of Process;
-  // ProcessFeatures has none and skips it).
-  bool orientation_floor_refinement = true;
-  PlaneRefinementOptions floor_refinement;
-  bool orientation_requires_wall = false;  // true: kNoWall (up known, yaw not) also counts as a
-                                           // failure (world = first camera); false: the yaw is
-                                           // then the camera's heading (zero)
-  // When the first frame's planes give no up (neither floor nor ceiling: kNoFloor, e.g. a plain
-  // floor without disparity and no ceiling in view), take orientation.expected_up_cam0 as the up
-  // — the camera's mounting on a vehicle standing on a level floor — and the camera's heading
-  // as the yaw (as with kNoWall), instead of the first camera as the world, which leaves a
-  // ground vehicle without its up (no planar motion, no planar BA prior). Off by default; on for
-  // a ground vehicle whose rig's pitch is known (ResolvePlatform, which then also sets
-  // expected_up_cam0 from that pitch). Measured on plain_corridor texture seeds 3 and 5 at
-  // stride 1 (no floor or ceiling found in the first frame): end rotation error 5.1 / 13.9° ->
-  // 2.2 / 2.7°, end-pose error 6.9 / 7.0 % -> 4.4 / 5.6 %.
-  bool orientation_up_from_mounting = false;
-  int adaptive_min_features = 0;  // a Harris detection with fewer features than this is
-                                  // repeated with quality_level adaptive_quality_level and the
-                                  // larger set kept (weakly textured views: one bright light
-                                  // otherwise sets the bar for the whole image), >= 0; 0 = off.
-                                  // Off by default: 100 took the L-hallway's texture seeds 1-10
-                                  // from a 0.44 to a 0.28 m median end-pose error (114 to 73
-                                  // frames without motion), but seed 7 from 0.44 to 0.61 % and
-                                  // the plain corridor from 0.26 to 0.69 m (noise-level corners)
-  double adaptive_quality_level = 1e-4;  // that second, lower relative threshold, in [0, 1)
-  int min_features = 15;  // fewer features with depth than this → lost (black, textureless or
-                          // overexposed frame), >= 3
-  int min_inliers = 12;   // fewer RANSAC inliers than this → lost, >= 3 (RANSAC's own
-                          // min_inliers is raised to this when lower)
-  int reinit_after_lost_frames = 10;  // while this many consecutive frames (or more) have been
-                                      // lost, a frame whose motion fails against the reference
-                                      // re-initialises the pipeline on itself, >= 1. Before
-                                      // that, each new frame is matched against the last good
-                                      // frame (wide, coarse-to-fine search), so the motion
-                                      // across the gap is measured, not extrapolated
-  RobustTrackingOptions tracking;     // predicted matching, coarse-to-fine search, guided pass
-
-  bool IsValid(std::string* error) const;
-};
-
-// The options a run on a rig uses: `platform` resolved (never kAuto in the result). kAuto is
-// kGroundVehicle when rig_axle_behind_camera_m >= 0 (the caller knows the rig is a ground
-// vehicle and where its wheel axle is: a simulated robot, a dataset with the rig's
-// description), kFree otherwise. kGroundVehicle switches tracking.few_point_motion,
-// ground_vehicle, vehicle_planar_ba and vehicle_flat_floor on (so on that platform they cannot
-// be switched off one by one: use kFree and set them). With ground_vehicle on (either way),
-// tracking.few_point.axle_behind_camera_m left at 0 takes the rig's axle when it is known.
-// On kGroundVehicle with the rig's camera pitch known (rig_pitch_deg finite: the optical axis's
-// downward tilt, degrees), orientation_up_from_mounting is switched on and
-// orientation.expected_up_cam0, when left at its default (−y: an upright, level camera), becomes
-// the up that pitch gives, (0, −cos p, −sin p).
-OdometryOptions ResolvePlatform(const OdometryOptions& options, double rig_axle_behind_camera_m,
-                                double rig_pitch_deg = std::numeric_limits<double>::quiet_NaN());
-
-enum class TrackingStatus {
-  kInitializing,  // first frame (or a frame before the first usable one): pose = initial
-  kTracking,      // motion estimated against the previous frame
-  kLost,          // not tracked: pose = constant-velocity prediction, or the direct image
-                  // alignment's measurement (OdometryResult::direct_motion); see `message`
-  kRecovered,     // first frame estimated (or re-initialised) after one or more lost frames
-};
-
-// "initializing", "tracking", "lost", "recovered".
-const char* ToString(TrackingStatus status);
-
-// Wall-clock time of each stage of one frame (milliseconds, std::chrono::steady_clock);
-// 0 for stages that did not run.
-struct StageTimes {
-  double disparity_ms = 0.0;    // disparity (dense map, or the features' pixels)
-  double detect_ms = 0.0;       // feature detection
-  double depth_ms = 0.0;        // AttachDepth + dropping features without depth
-  double match_ms = 0.0;        // inter-frame matching (cue computation included)
-  double motion_ms = 0.0;       // correspondences + RANSAC + tracks + initial-pose blend
-  double ba_ms = 0.0;           // window problem + bundle adjustment
-  double orientation_ms = 0.0;  // first frame only: plane-based initial orientation
-  double predict_ms = 0.0;      // predicted positions + coarse-to-fine image shift (when run);
-                                // a lost frame: its bridge and direct image alignment
-  double guided_ms = 0.0;       // guided second pass: re-match + RANSAC
-  double total_ms = 0.0;        // the whole Process / ProcessFeatures call
-};
-
-// What centred the matcher's search for the matches that were used.
-enum class PredictionSource {
-  kNone,         // previous positions (matcher.prediction: none, or no motion known yet)
-  kMotionPrior,  // the motion prior (constant velocity or the caller's MotionPrior)
-  kImageShift,   // previous positions + the coarse-to-fine image shift
-  kGuided,       // the estimated motion of this frame (guided second pass)
-  kLastMotion,   // the previous frame's own measured motion (not blended into the prior)
-};
-// "none", "motion_prior", "image_shift", "guided", "last_motion".
-const char* ToString(PredictionSource source);
-
-struct OdometryResult {
-  TrackingStatus status = TrackingStatus::kLost;
-  std::string message;       // empty when tracking normally; says why when lost or re-initialised
-  int64_t frame_index = -1;  // 0-based count of Process/ProcessFeatures calls since Reset
-  double time_s = 0.0;       // the time stamp given (seconds)
-  Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();  // p_world = T * p_cam0;
-                                                                   // always finite
-  Eigen::Isometry3d T_prev_curr =
-      Eigen::Isometry3d::Identity();  // motion since the previous
-                                      // call's output pose: p_prev = T_prev_curr * p_curr, i.e.
-                                      // T_world_cam0(prev)⁻¹ · T_world_cam0(curr); identity for the
-                                      // first frame
-  int num_features = 0;              // features detected (or given) in the left image
-  int num_features_with_depth = 0;   // of those, with a valid disparity (kept)
-  int num_matches = 0;               // matches to the reference frame
-  int num_inliers = 0;               // RANSAC inliers among them
-  double rms_reprojection_px = 0.0;  // BA inlier rms when BA ran, else RANSAC's rms (pixels)
-  bool ba_ran = false;               // the bundle adjustment ran and its result was used
-  int ba_num_frames = 0;             // poses in the BA window (when ba_ran)
-  int ba_num_points = 0;             // points optimised (when ba_ran)
-  int reference_frame_index = -1;    // frame_index of the frame matched against; -1 = none
-  bool motion_measured = false;      // T_prev_curr was measured by matching (kTracking or a
-                                     // kRecovered frame matched across the gap); false for the
-                                     // first frame, lost frames and re-initialisations (their
-                                     // pose is the prior's prediction) unless the direct image
-                                     // alignment measured them (direct_motion)
-  bool reinitialised = false;        // the pipeline restarted on this frame after a loss
-  bool few_point_motion = false;     // the motion came from the few-point solver with the
-                                     // prior (RobustTrackingOptions::few_point_motion)
-  bool rotation_from_shift = false;  // lost or re-initialised, its pose is the prior corrected
-                                     // by the image shift from the previous frame
-  bool bridge_aligned = false;       // lost or re-initialised, its forward step or yaw was
-                                     // measured against the previous frame's features
-                                     // (tracking.vehicle_bridge_alignment)
-  bool direct_motion = false;        // lost or re-initialised, its motion was measured by
-                                     // direct image alignment (motion_measured;
-                                     // tracking.vehicle_direct_alignment)
-  int64_t chained_to_frame = -1;     // lost or re-initialised, its pose was measured against
-                                     // this earlier lost frame (tracking.chain_lost_frames;
-                                     // -1: not chained) ...
-  int chain_inliers = 0;             // ... with this many RANSAC inliers
-  PredictionSource prediction = PredictionSource::kNone;  // centre of the used matches' search
-  bool image_shift_ok = false;  // the coarse-to-fine image shift ran and found a shift
-  Eigen::Vector2d image_shift_px = Eigen::Vector2d::Zero();  // that shift (pixels), when ok
-  int num_first_pass_inliers = 0;  // inliers of the first (prior-centred) pass, before the
-                                   // coarse-to-fine and guided passes
-  int num_disparities = 0;         // the disparity search range of this frame (pixels)
-  int disparity_pixels = 0;        // pixels whose disparity was evaluated (the whole image
-                                   // with disparity_mode dense; left + right-view pixels
-                                   // with at_features)
-  StageTimes times;
-  bool initial_orientation_ok = false;   // first frame only: the hallway orientation was found
-  bool floor_refined = false;            // first frame only: its floor (without one, its
-                                         // ceiling) was refined on the images
-                                         // (orientation_floor_refinement)
-  std::string floor_refinement_message;  // first frame: what the refinement did, or why not
-                                         // and defines the world frame
-};
-
-// Where each reference feature's 3D point (p_cam0, from its disparity) appears in the current
-// left image when the camera moved by T_ref_curr (p_ref = T_ref_curr * p_curr): the predicted
-// centre of the matcher's search. NaN for features without depth or behind the camera
-// (z <= min_depth_m).
-std::vector<Eigen::Vector2d> PredictFeaturePositions(const StereoCamera& camera,
-                                                     const std::vector<Feature>& features,
-                                                     const Eigen::Isometry3d& T_ref_curr,
-                                                     double min_depth_m);
-
-// A ground vehicle's frame-to-frame motion (VehicleMotion: a yaw about up_prev, the world's up
-// in the previous camera frame, and the forward distance of the axle point axle_behind_camera_m
-// behind the camera) from a measured image shift: the forward distance is the prior's
-// (VehicleMotionParameters of T_prev_curr_prior), the yaw is the one whose motion, including
-// the camera's swing about the axle, predicts the measured shift for the image centre at
-// depth_m (metres; <= 0 or non-finite = far, the swing then shows no parallax). A camera ahead
-// of the axle swings sideways as the vehicle turns, so a near wall's image moves by (1 + d / z)
-// times the rotation's shift: read as a rotation alone (CorrectPriorWithImageShift), a turn in
-// front of a wall 0.85 m away is over-read by 18 % with d = 0.15 m. Fixed-point iteration
-// (contraction ~ d / z); exact for the centre point up to 1e-12 rad. A non-finite result or
-// input gives T_prev_curr_prior back.
-Eigen::Isometry3d VehicleMotionFromImageShift(const StereoCamera& camera,
-                                              const Eigen::Vector3d& up_prev,
-                                              double axle_behind_camera_m,
-                                              const Eigen::Isometry3d& T_prev_curr_prior,
-                                              const Eigen::Vector2d& shift_px, double depth_m);
-
-// Whether the motion T_a_b (p_a = T_a_b · p_b) of a ground vehicle whose up direction in frame a
-// is up_a (any length > 0) tilts by at most max_tilt_deg (the angle of its rotation left after
-// the twist about up, PlanarPart) and moves along up by at most max_lift_m. A non-finite input
-// is not vehicle-like. Used by tracking.vehicle_max_weak_tilt_deg / _lift_m.
-bool IsVehicleLike(const Eigen::Isometry3d& T_a_b, const Eigen::Vector3d& up_a, double max_tilt_deg,
-                   double max_lift_m);
-
-// The image shift (pixels, image_motion.h convention) that the motion T_ref_curr predicts for
-// the reference image's centre at depth_m (metres; <= 0 or non-finite = infinitely far, the
-// rotation alone): where that point appears in the current image minus the centre. +inf when
-// it falls behind the camera.
-Eigen::Vector2d PredictedCentreShift(const StereoCamera& camera,
-                                     const Eigen::Isometry3d& T_ref_curr, double depth_m);
-
-// The prior's frame-to-frame motion T_prev_curr_prior corrected by a measured image shift
-// (image_motion.h: curr(x + shift) ≈ prev(x)): the shift the prior predicts for the image
-// centre at depth_m (metres; <= 0 or non-finite = infinitely far, rotation only) is subtracted,
-// and the rest is explained by a rotation of the current camera about its centre (pan/tilt, no
-// roll). Exact for the image centre; used to bridge frames whose features are too few for a
-// motion (a plain wall in front of a turning robot).
-Eigen::Isometry3d CorrectPriorWithImageShift(const StereoCamera& camera,
-                                             const Eigen::Isometry3d& T_prev_curr_prior,
-                                             const Eigen::Vector2d& shift_px, double depth_m);
-
-// A frame without a measured motion: lost, or re-initialised at the predicted pose (what
-// `lost_frames` counts). The first frame (kInitializing) has nothing to measure and is not.
-inline bool IsLostFrame(const OdometryResult& r) {
-  return !r.motion_measured && r.status != TrackingStatus::kInitializing;
-}
-
-// What one StereoOdometry call matched, beside its OdometryResult: the frame's features (with
-// depth, track ids set when tracked), the reference frame's features, the matches between
-// them (prev = index into reference_features, curr = index into features) and per match
-// whether it is a RANSAC inlier. Empty for a frame that matched nothing (first, lost).
-struct FrameDiagnostics {
-  const std::vector<Feature>& features;
-  const std::vector<Feature>& reference_features;
-  const std::vector<Match>& matches;
-  const std::vector<bool>& inlier_mask;
-};
 
 class StereoOdometry {
  public:
@@ -771,127 +149,46 @@ class StereoOdometry {
 
   using TimePoint = std::chrono::steady_clock::time_point;
 
-  // One matching pass and its RANSAC motion.
-  struct MotionAttempt {
-    std::vector<Match> matches;
-    std::vector<int> match_index;  // correspondence → index into matches
-    std::vector<StereoCorrespondence> correspondences;
-    RansacResult ransac;
-    PredictionSource source = PredictionSource::kNone;
-    int inliers() const { return ransac.ok() ? ransac.num_inliers : 0; }
-  };
-  // RANSAC on the matches (both features with depth), seeded by track ages.
-  MotionAttempt EstimateMotion(const std::vector<Feature>& ref_features,
-                               const std::vector<Feature>& curr_features,
-                               std::vector<Match> matches, PredictionSource source) const;
-  // Matches `frame` against `ref` (the reference, or the lost-frame chain) with the prediction
-  // passes (see the header comment); fills the prediction fields and times of `result`.
-  // T_ref_curr_prior: the prior's motion from `ref` to `frame` (null = none known).
-  // few_point_tie: with few_point_motion, a 0-0 tie of the passes goes to the one the
-  // few-point motion supports more (only against the reference, whose pose is in the window).
-  MotionAttempt MatchAndEstimate(const MatchFrame& ref, const MatchFrame& frame,
-                                 const Eigen::Isometry3d* T_ref_curr_prior, OdometryResult* result,
-                                 std::string* matcher_error, bool few_point_tie = true);
-  // tracking.chain_lost_frames: `frame`, which the reference could not measure, against the
-  // chain (the last lost frame with features). True with *T_world_curr when RANSAC finds at
-  // least min_inliers inliers; the motion then moves the constant velocity. Times go to
-  // `result`.
-  bool ChainLostFrame(const MatchFrame& frame, const MotionPrior* prior, OdometryResult* result,
-                      Eigen::Isometry3d* T_world_curr);
-  // Whether a motion T_ref_curr measured from few matches agrees with the frame's
-  // coarse-to-fine image shift (when found: shift_ok): the shift it predicts at the image
-  // centre (ref_features' median depth) is no farther from the measured one than the prior's
-  // prediction, by more than tracking.few_point_max_shift_disagreement_px.
-  // How far a measured motion with num_inliers RANSAC inliers moves the constant velocity:
-  // (num_inliers / reliable_min_inliers)^prior_update_exponent, at most 1.
-  double PriorUpdateWeight(int num_inliers) const;
-  bool AgreesWithImageShift(const std::vector<Feature>& ref_features,
-                            const Eigen::Isometry3d& T_ref_curr,
-                            const Eigen::Isometry3d& T_ref_curr_prior, bool shift_ok,
-                            const Eigen::Vector2d& shift_px) const;
-  // The few-point motion (prior_motion.h) of `correspondences` from the prior
-  // T_ref_curr_prior, made planar for a ground vehicle (tracking.ground_vehicle with the up
-  // known); *few_prior: the prior the solver used.
-  PriorMotionResult FewPointMotion(const std::vector<StereoCorrespondence>& correspondences,
-                                   const Eigen::Isometry3d& T_ref_curr_prior,
-                                   Eigen::Isometry3d* few_prior) const;
-  // Positions of ref_features in the current image under T_ref_curr (NaN where a point falls
-  // behind the camera or has no depth).
-  std::vector<Eigen::Vector2d> PredictPositions(const std::vector<Feature>& ref_features,
-                                                const Eigen::Isometry3d& T_ref_curr) const;
-  // The prior's motion since the previous output: the caller's prior, else the constant
-  // velocity, else none (identity).
-  Eigen::Isometry3d PriorMotion(const MotionPrior* prior) const;
+  // What the recovery needs of this call (the previous output, the prior, this frame).
+  BridgeContext Bridge(const MotionPrior* prior);
   // The predicted T_world_cam0 of the newest frame: the previous output moved by the prior.
   Eigen::Isometry3d PredictedPose(const MotionPrior* prior) const;
-  // A bridged frame-to-frame motion made planar (PlanarPart about the world's up) for a ground
-  // vehicle, unless the caller gave the prior; as it is otherwise.
-  Eigen::Isometry3d PlanarBridge(const Eigen::Isometry3d& T_prev_curr,
-                                 const MotionPrior* prior) const;
-  // The prior's motion for a frame without a measured motion: PlanarBridge(PriorMotion).
-  Eigen::Isometry3d BridgeMotion(const MotionPrior* prior) const;
-  // The pose of a frame without a measured motion: `chained` when ChainLostFrame measured one
-  // (non-null), else the predicted pose, corrected by the image shift from the previous frame
-  // where it is found (sets result->rotation_from_shift).
-  Eigen::Isometry3d BridgedPose(const MotionPrior* prior, OdometryResult* result,
-                                const Eigen::Isometry3d* chained = nullptr);
-  // BridgedPose without the chain: the prior corrected by the image shift.
-  Eigen::Isometry3d ShiftCorrectedPose(const MotionPrior* prior, OdometryResult* result);
-  // tracking.vehicle_bridge_alignment: the bridged pose `bridged` with the forward step and the
-  // yaw measured against the previous frame's features (sets result->bridge_aligned); the
-  // motion becomes the constant velocity.
-  Eigen::Isometry3d AlignedBridgePose(const Eigen::Isometry3d& bridged, OdometryResult* result);
-  // tracking.vehicle_direct_alignment: the bridged pose measured by direct image alignment
-  // against the previous frame on scene_planes_ (sets result->direct_motion and
-  // motion_measured when it is a measurement; the motion becomes the constant velocity).
-  Eigen::Isometry3d DirectAlignedPose(const Eigen::Isometry3d& bridged, OdometryResult* result);
-  // The planes of this frame's features (last_features_), else the previous ones moved by
-  // T_prev_curr, for the next frame's direct alignment.
-  void UpdateScenePlanes(const Eigen::Isometry3d& T_prev_curr);
-
-  // A lost frame: pose = constant-velocity prediction (or `chained`, see BridgedPose),
-  // reference and tracks kept.
+  // The world's up in the reference camera frame for a ground vehicle whose up is known (the
+  // few-point motion and the weak-motion check are planar about it); null otherwise.
+  const Eigen::Vector3d* VehicleUpAtReference(Eigen::Vector3d* storage) const;
+  // A lost frame: pose bridged (or `chained`, see Recovery::BridgedPose), reference and
+  // tracks kept.
   OdometryResult Lost(OdometryResult result, const std::string& message, TimePoint start,
                       const MotionPrior* prior = nullptr,
                       const Eigen::Isometry3d* chained = nullptr);
-  // (Re-)initialises on `frame`: first time at the initial orientation, later at the predicted
+  // (Re-)initialises on `frame`: first time at the initial orientation, later at the bridged
   // (or chained) pose (kRecovered). `reason` goes into the message.
   OdometryResult Initialise(OdometryResult result, MatchFrame frame, const std::string& reason,
                             TimePoint start, const MotionPrior* prior = nullptr,
                             const Eigen::Isometry3d* chained = nullptr);
-  // The constant-velocity model moved `weight` of the way (slerp) to a measured per-frame
-  // motion (the first one is taken as it is; a non-finite one is ignored).
-  void MoveVelocity(const Eigen::Isometry3d& per_frame, double weight);
+  // The first frame's orientation (initial_orientation.h) from its points; sets the world
+  // frame and the vehicle's up. The message for Initialise.
+  std::string OrientFirstFrame(const std::vector<Eigen::Vector3d>& points, const cv::Mat& left,
+                               const cv::Mat& right, const cv::Mat& disparity_px,
+                               OdometryResult* result);
   // The window BA's planar motion prior (disabled unless ground_vehicle, vehicle_planar_ba and
   // a known up).
   PlanarMotionPrior WindowPlanarPrior() const;
-  // Everything after matching: RANSAC, tracks, blend, BA. `result` carries the counts so far.
-  // T_ref_curr_prior: the prior's motion from the reference to this frame (null = none), the
-  // blend's partner; `prior`: the caller's prior (for the pose of a lost frame), may be null.
+  // Everything after matching: the frame's motion, tracks, blend, BA. `result` carries the
+  // counts so far. T_ref_curr_prior: the prior's motion from the reference to this frame (null
+  // = none), the blend's partner; `prior`: the caller's prior (for a lost frame), may be null.
   OdometryResult Track(OdometryResult result, MatchFrame frame, MotionAttempt attempt,
                        const Eigen::Isometry3d* T_ref_curr_prior, const MotionPrior* prior,
                        TimePoint start);
   // Sets the output pose (finite), T_prev_curr and the total time.
   OdometryResult Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
                         TimePoint start);
-  // Refines orientation_result_'s floor on the images over the dense map's pixels on it and
-  // rebuilds its up, height and R_hall_cam0 from it; false (unchanged) when refusing. *message
-  // says what it did or why not.
-  bool RefineInitialFloor(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity_px,
-                          std::string* message);
-  // Plane-based orientation of the first frame; true when it defines the world frame. With the
-  // images and the dense disparity map (Process; empty in ProcessFeatures) and
-  // orientation_floor_refinement, the floor is refined photometrically (result->floor_refined).
-  bool EstimateInitialOrientation(const std::vector<Eigen::Vector3d>& points_cam0,
-                                  const cv::Mat& left, const cv::Mat& right,
-                                  const cv::Mat& disparity_px, OdometryResult* result);
 
   StereoCamera camera_;
   OdometryOptions options_;
-  std::unique_ptr<DisparityEstimator> disparity_;
-  std::unique_ptr<FeatureDetector> detector_;
-  std::unique_ptr<FeatureDetector> weak_detector_;  // adaptive_min_features fallback (or null)
-  std::unique_ptr<FrameMatcher> matcher_;
+  std::unique_ptr<FrontEnd> front_end_;  // disparity, features, depth
+  std::unique_ptr<Tracker> tracker_;     // the matcher and its prediction passes
+  Recovery recovery_;                    // bridges, the lost-frame chain
   SlidingWindow window_;  // tracks, window poses and the bundle adjustment (sliding_window.h)
 
   int64_t frame_index_ = 0;      // index of the next call
@@ -905,33 +202,17 @@ class StereoOdometry {
   bool previous_measured_ = false;  // the previous call's motion was measured (the prior is
                                     // a measured motion, not a bridge: few_point_motion)
   Reference reference_;
-  Reference lost_chain_;  // the last lost frame with at least min_features features, since the
-                          // last tracked one (tracking.chain_lost_frames), ...
-  Eigen::Isometry3d T_world_chain_ = Eigen::Isometry3d::Identity();  // ... and its output pose
-  Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();   // previous call's output
-  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // constant-velocity model: last
-                                                                // estimated per-frame T_prev_curr
-  bool has_velocity_ = false;
-  // The last measured motion as it was measured, per frame (T_prev_curr), and its frame (-1:
-  // none). The prior blends a weak motion in only in part; where the motion changes fast (a
-  // turn that starts) this one is nearer the next frame's.
-  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
-  int64_t last_motion_frame_ = -1;
+  Eigen::Isometry3d T_world_prev_ = Eigen::Isometry3d::Identity();  // previous call's output
+  ConstantVelocity velocity_;      // the prior, and the last motion as measured
   int scene_num_disparities_ = 0;  // next frame's search range from the scene; 0 = full
 
   Eigen::Matrix3d R_hall_cam0_initial_ = Eigen::Matrix3d::Identity();
   PlaneOrientationResult orientation_result_;
   std::vector<Feature> last_features_;
-  std::vector<Feature> previous_frame_features_;  // last_features_ of the previous call
-  // The planes of the features in the previous output's camera frame
-  // (vehicle_direct_alignment), carried for scene_planes_age_ frames since they were fitted.
-  std::vector<ScenePlane> scene_planes_;
-  int scene_planes_age_ = 0;
   std::vector<Match> last_matches_;
   std::vector<bool> last_inlier_mask_;
   std::vector<Feature> last_reference_features_;
-  cv::Mat current_left_;   // this call's left image (for the image shift of a lost frame)
-  cv::Mat previous_left_;  // the previous call's left image (empty after ProcessFeatures)
+  cv::Mat current_left_;                  // this call's left image
   std::vector<int> prev_call_index_map_;  // ProcessFeatures: given index → kept index of the
                                           // previous call's features (empty when unusable)
 };

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "vo/camera.h"
@@ -23,6 +24,26 @@ inline StereoCamera TestCamera() {
   cam.cy_px = 119.5;
   cam.baseline_m = 0.12;
   return cam;
+}
+
+// The simulator's hallway rig (docs/DESIGN.md / the harness): 320x240, fx ≈ 230 px, 0.09 m.
+inline StereoCamera HallwayCamera() {
+  StereoCamera cam;
+  cam.width = 320;
+  cam.height = 240;
+  cam.fx_px = cam.fy_px = 230.0;
+  cam.cx_px = 159.5;
+  cam.cy_px = 119.5;
+  cam.baseline_m = 0.09;
+  return cam;
+}
+
+// The pose [R | t].
+inline Eigen::Isometry3d MakePose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R;
+  T.translation() = t;
+  return T;
 }
 
 // A standard normal sample (Box-Muller) from the seeded generator.

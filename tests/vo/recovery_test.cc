@@ -1,0 +1,141 @@
+#include "vo/recovery.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <vector>
+
+#include "tests/test_util.h"
+#include "tests/vo/texture_util.h"
+#include "tests/vo/vo_test_util.h"
+
+namespace vo {
+namespace {
+
+using vobench_test::RotationAngleRad;
+
+constexpr double kDeg = M_PI / 180.0;
+
+Eigen::Isometry3d Pose(double yaw_deg, double roll_deg, const Eigen::Vector3d& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll_deg * kDeg, Eigen::Vector3d::UnitZ()))
+                   .toRotationMatrix();
+  T.translation() = t;
+  return T;
+}
+
+struct Fixture {
+  StereoCamera camera = test::TestCamera();
+  ConstantVelocity velocity;
+  std::vector<Feature> features;  // none: the image centre is far away
+  BridgeContext Context(const Eigen::Isometry3d& T_world_prev, const cv::Mat& left = cv::Mat()) {
+    BridgeContext c;
+    c.T_world_prev = T_world_prev;
+    c.current_left = left;
+    c.features = &features;
+    c.velocity = &velocity;
+    return c;
+  }
+};
+
+TEST(RecoveryTest, ALostFrameIsBridgedByThePriorExactly) {
+  Fixture f;
+  Recovery recovery(f.camera, OdometryOptions());
+  const Eigen::Isometry3d T_world_prev = Pose(30.0, 0.0, Eigen::Vector3d(1.0, 0.0, 2.0));
+  const Eigen::Isometry3d v = Pose(2.0, 0.0, Eigen::Vector3d(0.0, 0.0, 0.05));
+  f.velocity.Move(v, 1.0);
+  OdometryResult result;
+  // No images: the constant velocity, bit for bit.
+  EXPECT_TRUE(recovery.BridgedPose(f.Context(T_world_prev), &result).matrix() ==
+              (T_world_prev * v).matrix());
+  EXPECT_FALSE(result.rotation_from_shift);
+  // The caller's prior replaces it.
+  MotionPrior prior;
+  prior.T_prev_curr = Pose(-4.0, 0.0, Eigen::Vector3d(0.1, 0.0, 0.0));
+  BridgeContext c = f.Context(T_world_prev);
+  c.prior = &prior;
+  EXPECT_TRUE(recovery.BridgedPose(c, &result).matrix() ==
+              (T_world_prev * prior.T_prev_curr).matrix());
+  // A chained pose is taken as it is.
+  const Eigen::Isometry3d chained = Pose(1.0, 0.0, Eigen::Vector3d(3.0, 0.0, 0.0));
+  EXPECT_TRUE(recovery.BridgedPose(c, &result, &chained).matrix() == chained.matrix());
+}
+
+TEST(RecoveryTest, AGroundVehiclesBridgeIsPlanar) {
+  Fixture f;
+  OdometryOptions o;
+  o.tracking.ground_vehicle = true;
+  o.tracking.vehicle_bridge_alignment = false;  // no features to align with here
+  Recovery recovery(f.camera, o);
+  // The world's up is the camera's −y at the previous pose (a level camera).
+  Eigen::Isometry3d T_world_prev = Eigen::Isometry3d::Identity();
+  T_world_prev.linear().col(0) = -Eigen::Vector3d::UnitY();
+  T_world_prev.linear().col(1) = -Eigen::Vector3d::UnitZ();
+  T_world_prev.linear().col(2) = Eigen::Vector3d::UnitX();
+  // A velocity with 3° of roll and a step up: the bridge keeps only the yaw and the planar step.
+  f.velocity.Move(Pose(2.0, 3.0, Eigen::Vector3d(0.0, -0.02, 0.05)), 1.0);
+  BridgeContext c = f.Context(T_world_prev);
+  c.world_up_known = true;
+  OdometryResult result;
+  const Eigen::Isometry3d T = T_world_prev.inverse() * recovery.BridgedPose(c, &result);
+  EXPECT_TRUE(IsVehicleLike(T, -Eigen::Vector3d::UnitY(), 1e-9, 1e-12));
+  EXPECT_NEAR(Eigen::AngleAxisd(T.linear()).angle(), 2.0 * kDeg, 0.02 * kDeg);
+  // Without the up known: the velocity as it is.
+  c.world_up_known = false;
+  EXPECT_FALSE(IsVehicleLike(T_world_prev.inverse() * recovery.BridgedPose(c, &result),
+                             -Eigen::Vector3d::UnitY(), 1.0, 0.01));
+}
+
+TEST(RecoveryTest, ALostFrameFollowsAPanByTheImageShift) {
+  Fixture f;
+  Recovery recovery(f.camera, OdometryOptions());
+  const int shift = 12;  // the view pans: the content moves 12 px to the left
+  const cv::Mat texture = test::BlurredNoise(f.camera.width + shift, f.camera.height, 5, 5, 1.2);
+  const cv::Mat previous = texture(cv::Rect(0, 0, f.camera.width, f.camera.height)).clone();
+  const cv::Mat current = texture(cv::Rect(shift, 0, f.camera.width, f.camera.height)).clone();
+  f.velocity.Move(Eigen::Isometry3d::Identity(), 1.0);  // the prior: standing still
+  recovery.EndFrame(f.features, Eigen::Isometry3d::Identity(), previous);
+  OdometryResult result;
+  const Eigen::Isometry3d T =
+      recovery.BridgedPose(f.Context(Eigen::Isometry3d::Identity(), current), &result);
+  ASSERT_TRUE(result.rotation_from_shift);
+  EXPECT_NEAR(result.image_shift_px.x(), -shift, 0.25);
+  EXPECT_NEAR(result.image_shift_px.y(), 0.0, 0.25);
+  // The rotation explains the shift at the image centre (far away: rotation only), and it
+  // became the prior's rotation.
+  EXPECT_LT((PredictedCentreShift(f.camera, T, -1.0) - result.image_shift_px).norm(), 1e-9);
+  EXPECT_LT(RotationAngleRad(f.velocity.per_frame().linear(), T.linear()), 1e-12);
+  // A still view: no correction.
+  Recovery still(f.camera, OdometryOptions());
+  still.EndFrame(f.features, Eigen::Isometry3d::Identity(), previous);
+  OdometryResult r2;
+  f.velocity.Reset();
+  still.BridgedPose(f.Context(Eigen::Isometry3d::Identity(), previous), &r2);
+  EXPECT_FALSE(r2.rotation_from_shift);
+}
+
+TEST(RecoveryTest, WithoutAChainThereIsNothingToChainTo) {
+  Fixture f;
+  const OdometryOptions o;
+  std::string error;
+  const std::unique_ptr<Tracker> tracker = Tracker::Create(f.camera, o, &error);
+  ASSERT_TRUE(tracker) << error;
+  Recovery recovery(f.camera, o);
+  MatchFrame frame;
+  frame.frame_id = 3;
+  OdometryResult result;
+  result.frame_index = 3;
+  Eigen::Isometry3d T;
+  EXPECT_FALSE(recovery.ChainLostFrame(tracker.get(), frame,
+                                       f.Context(Eigen::Isometry3d::Identity()), &result, &T));
+  // A chain to a later (or the same) frame is no chain either.
+  recovery.ContinueChain(3, frame, Eigen::Isometry3d::Identity());
+  EXPECT_FALSE(recovery.ChainLostFrame(tracker.get(), frame,
+                                       f.Context(Eigen::Isometry3d::Identity()), &result, &T));
+  EXPECT_EQ(result.chained_to_frame, -1);
+}
+
+}  // namespace
+}  // namespace vo

@@ -1,0 +1,261 @@
+#include "vo/recovery.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "vo/bridge_alignment.h"
+#include "vo/image_motion.h"
+#include "vo/motion_estimation.h"
+#include "vo/prior_motion.h"
+
+namespace vo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The planes of a frame's features for the direct alignment of the next lost frame
+// (tracking.vehicle_direct_alignment): up to 3 (a wall, the floor, a side wall); a feature is on
+// one within 1 px of disparity; each with at least 6 features spread at least 5 cm across (not
+// all along one edge), 60 % of the features on them. Without such planes a frame carries the
+// previous ones by its motion, for at most 30 frames.
+constexpr double kScenePlaneTolerancePx = 1.0;
+constexpr int kScenePlaneMinInliers = 6;
+constexpr double kScenePlaneMinFraction = 0.6;
+constexpr double kScenePlaneMinSpreadM = 0.05;
+constexpr int kMaxScenePlanes = 3;
+constexpr int kMaxScenePlaneAge = 30;
+
+}  // namespace
+
+Recovery::Recovery(const StereoCamera& camera, const OdometryOptions& options)
+    : camera_(camera), options_(options) {}
+
+void Recovery::Reset() {
+  previous_frame_features_.clear();
+  scene_planes_.clear();
+  scene_planes_age_ = 0;
+  previous_left_ = cv::Mat();
+  chain_valid_ = false;
+  chain_frame_index_ = -1;
+  chain_frame_ = MatchFrame();
+}
+
+void Recovery::EndFrame(const std::vector<Feature>& features, const Eigen::Isometry3d& T_prev_curr,
+                        cv::Mat left) {
+  // Only the bridge alignment reads the previous frame's features: no copy per frame otherwise.
+  if (options_.tracking.ground_vehicle && options_.tracking.vehicle_bridge_alignment) {
+    previous_frame_features_ = features;
+    if (options_.tracking.vehicle_direct_alignment) UpdateScenePlanes(features, T_prev_curr);
+  }
+  previous_left_ = std::move(left);
+}
+
+void Recovery::ContinueChain(int64_t frame_index, MatchFrame frame,
+                             const Eigen::Isometry3d& T_world) {
+  chain_valid_ = true;  // the next lost frame is matched against this one
+  chain_frame_index_ = frame_index;
+  chain_frame_ = std::move(frame);
+  T_world_chain_ = T_world;
+}
+
+Eigen::Isometry3d Recovery::BridgeMotion(const BridgeContext& c) const {
+  const Eigen::Isometry3d T_prev_curr = c.velocity->Prior(c.prior);
+  if (c.prior != nullptr || !options_.tracking.ground_vehicle || !c.world_up_known) {
+    return T_prev_curr;
+  }
+  return PlanarPart(T_prev_curr, WorldUpInCamera(c.T_world_prev));
+}
+
+Eigen::Isometry3d Recovery::BridgedPose(const BridgeContext& c, OdometryResult* result,
+                                        const Eigen::Isometry3d* chained) {
+  if (chained != nullptr) return *chained;  // measured against the lost-frame chain
+  const Eigen::Isometry3d bridged = ShiftCorrectedPose(c, result);
+  const RobustTrackingOptions& o = options_.tracking;
+  if (c.prior != nullptr || !o.ground_vehicle || !o.vehicle_bridge_alignment || !c.world_up_known ||
+      options_.matcher.prediction == PredictionMode::kNone) {
+    return bridged;
+  }
+  const Eigen::Isometry3d aligned = AlignedBridgePose(c, bridged, result);
+  return o.vehicle_direct_alignment ? DirectAlignedPose(c, aligned, result) : aligned;
+}
+
+Eigen::Isometry3d Recovery::DirectAlignedPose(const BridgeContext& c,
+                                              const Eigen::Isometry3d& bridged,
+                                              OdometryResult* result) {
+  if (scene_planes_.empty() || previous_left_.empty() || c.current_left.empty()) return bridged;
+  const RobustTrackingOptions& o = options_.tracking;
+  const Clock::time_point t = Clock::now();
+  const Eigen::Vector3d up = WorldUpInCamera(c.T_world_prev);
+  const double axle = o.few_point.axle_behind_camera_m;
+  const Eigen::Vector2d start =
+      VehicleMotionParameters(c.T_world_prev.inverse() * bridged, up, axle);
+  if (!start.allFinite()) return bridged;
+  const DirectAlignmentResult direct =
+      AlignVehicleDirect(camera_, previous_left_, c.current_left, scene_planes_, up, axle,
+                         start.x(), start.y(), o.vehicle_direct);
+  result->times.predict_ms += ElapsedMs(t);
+  if (!direct.ok) return bridged;
+  const Eigen::Isometry3d T = VehicleMotion(up, axle, direct.yaw_rad, direct.forward_m);
+  if (!IsFinitePose(T)) return bridged;
+  c.velocity->ReplaceIfKnown(T);
+  result->direct_motion = true;
+  result->motion_measured = true;
+  return c.T_world_prev * T;
+}
+
+void Recovery::UpdateScenePlanes(const std::vector<Feature>& features,
+                                 const Eigen::Isometry3d& T_prev_curr) {
+  std::vector<ScenePlane> fitted;
+  if (FitScenePlanes(camera_, features, kScenePlaneTolerancePx, kScenePlaneMinInliers,
+                     kScenePlaneMinFraction, kScenePlaneMinSpreadM, kMaxScenePlanes, &fitted)) {
+    scene_planes_ = fitted;
+    scene_planes_age_ = 0;
+  } else if (!scene_planes_.empty() && IsFinitePose(T_prev_curr) &&
+             ++scene_planes_age_ <= kMaxScenePlaneAge) {
+    std::vector<ScenePlane> moved;
+    for (const ScenePlane& plane : scene_planes_) {
+      const ScenePlane m = TransformPlane(plane, T_prev_curr);
+      if (m.distance_m > 0.0) moved.push_back(m);  // the camera is still in front of it
+    }
+    scene_planes_.swap(moved);
+  } else {
+    scene_planes_.clear();
+  }
+}
+
+Eigen::Isometry3d Recovery::AlignedBridgePose(const BridgeContext& c,
+                                              const Eigen::Isometry3d& bridged,
+                                              OdometryResult* result) {
+  const std::vector<Feature>& last_features = *c.features;
+  const RobustTrackingOptions& o = options_.tracking;
+  const Clock::time_point t = Clock::now();
+  Eigen::Isometry3d T = c.T_world_prev.inverse() * bridged;
+  int pairs = 0;
+  double t_z = 0.0;
+  if (ForwardStepFromDepth(camera_, previous_frame_features_, last_features, T, o.vehicle_bridge,
+                           &t_z, &pairs)) {
+    T.translation().z() = t_z;
+    result->bridge_aligned = true;
+  }
+  const Eigen::Vector3d up = WorldUpInCamera(c.T_world_prev);
+  const double axle = o.few_point.axle_behind_camera_m;
+  const Eigen::Vector2d yaw_forward = VehicleMotionParameters(T, up, axle);
+  double yaw = yaw_forward.x();
+  if (yaw_forward.allFinite() &&
+      AlignVehicleYaw(camera_, previous_frame_features_, last_features, up, axle, yaw_forward.y(),
+                      o.vehicle_bridge, &yaw, &pairs)) {
+    T = VehicleMotion(up, axle, yaw, yaw_forward.y());
+    result->bridge_aligned = true;
+  }
+  result->times.predict_ms += ElapsedMs(t);
+  if (!IsFinitePose(T)) return bridged;
+  c.velocity->ReplaceIfKnown(T);
+  return c.T_world_prev * T;
+}
+
+Eigen::Isometry3d Recovery::ShiftCorrectedPose(const BridgeContext& c, OdometryResult* result) {
+  const MotionPrior* prior = c.prior;
+  const std::vector<Feature>& last_features = *c.features;
+  const Eigen::Isometry3d predicted = c.T_world_prev * BridgeMotion(c);
+  const RobustTrackingOptions& o = options_.tracking;
+  if (options_.matcher.prediction == PredictionMode::kNone || !o.rotation_from_shift ||
+      previous_left_.empty() || c.current_left.empty() ||
+      previous_left_.size() != c.current_left.size()) {
+    return predicted;
+  }
+  const Clock::time_point t = Clock::now();
+  const ImageShiftResult shift = EstimateImageShift(previous_left_, c.current_left, o.image_shift);
+  result->times.predict_ms += ElapsedMs(t);
+  // A ground vehicle (its motion a yaw and a forward step, the camera swinging about the axle)
+  // reads the shift with that model: a sharp peak is trusted at a lower score, and a shift whose
+  // vertical part (no pitch: zoom, parallax) is large against its horizontal part is no turn.
+  const bool vehicle = prior == nullptr && o.ground_vehicle && c.world_up_known;
+  const bool strong = shift.score >= o.rotation_min_shift_score &&
+                      shift.second_best_ratio >= o.rotation_min_peak_ratio;
+  const bool sharp = vehicle && shift.score >= o.vehicle_rotation_min_shift_score &&
+                     shift.second_best_ratio >= o.vehicle_rotation_min_peak_ratio;
+  if (!shift.ok || !(strong || sharp)) return predicted;
+  // The prior's own frame-to-frame motion (not T_world_prev⁻¹ · predicted, which would feed
+  // rounding in the composed poses back into the prior, frame after frame), corrected at the
+  // median depth of this frame's features (last_features; none: far away).
+  const Eigen::Isometry3d T_prev_curr_prior = BridgeMotion(c);
+  double depth_m = -1.0;
+  if (!last_features.empty()) {
+    std::vector<double> z;
+    for (const Feature& f : last_features) z.push_back(f.p_cam0.z());
+    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+    depth_m = z[z.size() / 2];
+  }
+  Eigen::Isometry3d T_prev_curr;
+  if (vehicle) {
+    const Eigen::Vector2d residual =
+        shift.shift_px - PredictedCentreShift(camera_, T_prev_curr_prior, depth_m);
+    if (!(std::abs(residual.y()) <=
+          std::max(o.rotation_min_residual_px,
+                   o.vehicle_max_vertical_shift_ratio * std::abs(residual.x())))) {
+      return predicted;
+    }
+    T_prev_curr = VehicleMotionFromImageShift(camera_, WorldUpInCamera(c.T_world_prev),
+                                              o.few_point.axle_behind_camera_m, T_prev_curr_prior,
+                                              shift.shift_px, depth_m);
+  } else {  // (not a ground vehicle whose up is known: PlanarBridge would change nothing)
+    T_prev_curr = CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m);
+  }
+  if (!IsFinitePose(T_prev_curr)) return predicted;
+  // The shift the prior itself predicts: the correction's rotation seen at the image centre.
+  const double residual_px =
+      camera_.fx_px *
+      Eigen::AngleAxisd(T_prev_curr_prior.linear().transpose() * T_prev_curr.linear()).angle();
+  if (residual_px <= o.rotation_min_residual_px) return predicted;
+  // The measured rotation becomes the prior's rotation (a turn goes on through the next frames
+  // that have no usable shift); the prior's translation stays.
+  if (prior == nullptr) c.velocity->ReplaceRotationIfKnown(T_prev_curr.linear());
+  result->rotation_from_shift = true;
+  result->image_shift_ok = true;
+  result->image_shift_px = shift.shift_px;
+  return c.T_world_prev * T_prev_curr;
+}
+
+bool Recovery::ChainLostFrame(Tracker* tracker, const MatchFrame& frame, const BridgeContext& c,
+                              OdometryResult* result, Eigen::Isometry3d* T_world_curr) {
+  const MotionPrior* prior = c.prior;
+  // A caller's prior (wheel odometry, a gyro) bridges a lost frame as given.
+  if (!options_.tracking.chain_lost_frames || prior != nullptr || !chain_valid_ ||
+      chain_frame_index_ >= result->frame_index ||
+      options_.matcher.prediction == PredictionMode::kNone ||
+      tracker->matcher_type() == MatcherType::kKalman) {
+    return false;
+  }
+  const Eigen::Isometry3d T_chain_curr_prior =
+      T_world_chain_.inverse() * (c.T_world_prev * c.velocity->Prior(prior));
+  OdometryResult pass;  // the chain's prediction fields are not this frame's against the reference
+  std::string matcher_error;
+  TrackingContext context;
+  context.T_ref_curr_prior = IsFinitePose(T_chain_curr_prior) ? &T_chain_curr_prior : nullptr;
+  context.after_loss = c.after_loss;
+  context.velocity = c.velocity;
+  context.few_point_tie = false;
+  const MotionAttempt attempt =
+      tracker->MatchAndEstimate(chain_frame_, frame, context, &pass, &matcher_error);
+  result->times.predict_ms += pass.times.predict_ms;
+  result->times.match_ms += pass.times.match_ms;
+  result->times.motion_ms += pass.times.motion_ms;
+  result->times.guided_ms += pass.times.guided_ms;
+  const RansacResult& ransac = attempt.ransac;
+  if (!matcher_error.empty() || attempt.inliers() < options_.min_inliers ||
+      !IsFinitePose(ransac.T_prev_curr)) {
+    return false;
+  }
+  *T_world_curr = T_world_chain_ * ransac.T_prev_curr;
+  result->chained_to_frame = chain_frame_index_;
+  result->chain_inliers = ransac.num_inliers;
+  // The measured motion moves the constant velocity as a tracked one does (by its support).
+  const Eigen::Isometry3d per_frame =
+      Root(ransac.T_prev_curr, result->frame_index - chain_frame_index_);
+  c.velocity->Move(per_frame, PriorUpdateWeight(ransac.num_inliers, options_.tracking));
+  return true;
+}
+
+}  // namespace vo

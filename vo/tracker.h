@@ -1,0 +1,91 @@
+// The tracker: a frame matched against the reference (or the lost-frame chain) with the
+// prediction passes, each followed by RANSAC (motion_estimation.h); it owns the inter-frame
+// matcher (matcher.h: SVD · NCC · Gabor by default, the baselines).
+//
+// Predicted matching (matcher.prediction = kMotionPrior, the default; kNone = the paper's
+// unpredicted form, every position gate centred on the previous position). Beyond the paper,
+// whose proximity term exp(−d²/2σ²) with σ = 10 px stops at ~28 px of image motion:
+//   1. prior pass: each reference feature's 3D point is moved by the motion prior (the
+//      constant-velocity motion from the last RELIABLE frame, or the caller's MotionPrior) and
+//      projected (PredictFeaturePositions); every matcher centres its position gate there
+//      (MatchPrediction), then RANSAC.
+//   2. coarse-to-fine pass, when the prior is weak (no motion known yet, after a lost frame)
+//      or contradicted (fewer inliers than tracking.confident_min_inliers or
+//      confident_inlier_fraction of the features): the dominant image shift from the reference
+//      to this frame on an image pyramid (image_motion.h, the paper's "multi-scale analysis"),
+//      matching around uv + shift with gates widened by shift_radius_scale, then RANSAC; the
+//      pass with more inliers is kept. When neither pass reaches a RANSAC consensus, the pass
+//      whose matches support more of the few-point motion is kept (a prior that lags a turn
+//      would otherwise win the tie).
+//   2b. last-motion pass, when still not confident and the reference (the previous frame)
+//      measured its own motion: matching around that motion as measured
+//      (tracking.last_motion_pass). The prior takes a weak motion in only in part, so it lags
+//      a turn that starts; the pass with more inliers is kept.
+//   3. guided pass: every reference feature predicted with the motion just estimated, matched
+//      in a tight window (guided_radius_scale), RANSAC; kept when it has at least as many
+//      inliers, so more correct matches reach the bundle adjustment.
+// The stateful Kalman tracker runs pass 1 only. OdometryResult::prediction says which pass
+// the used matches came from; StageTimes::predict_ms / guided_ms time the new steps.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+
+#include "vo/camera.h"
+#include "vo/matcher.h"
+#include "vo/motion_estimation.h"
+#include "vo/motion_model.h"
+#include "vo/odometry_options.h"
+#include "vo/odometry_result.h"
+
+namespace vo {
+
+// What one matching of a frame knows besides the two frames.
+struct TrackingContext {
+  const Eigen::Isometry3d* T_ref_curr_prior = nullptr;  // the prior's motion from the
+                                                        // reference to the frame (null: none)
+  bool after_loss = false;  // frames were lost since the last tracked one (the prior is weak)
+  const ConstantVelocity* velocity = nullptr;  // its last measured motion (pass 2b; may be null)
+  // With few_point_motion, a 0-0 tie of the prior's and the shift's pass goes to the one the
+  // few-point motion supports more (only against the reference, whose pose is in the window).
+  bool few_point_tie = true;
+  const Eigen::Vector3d* up_ref = nullptr;  // the world's up in the reference camera frame for
+                                            // a ground vehicle (FewPointMotion; null: 6-DoF)
+};
+
+class Tracker {
+ public:
+  // nullptr (and *error filled) when options.matcher cannot build a matcher.
+  static std::unique_ptr<Tracker> Create(const StereoCamera& camera, const OdometryOptions& options,
+                                         std::string* error);
+  Tracker(const Tracker&) = delete;
+  Tracker& operator=(const Tracker&) = delete;
+
+  // Matches `frame` against `ref` with the prediction passes; fills the prediction fields
+  // (num_first_pass_inliers, image_shift_ok/_px) and times of `result`. A matcher failure
+  // leaves *matcher_error set and returns the best pass so far.
+  MotionAttempt MatchAndEstimate(const MatchFrame& ref, const MatchFrame& frame,
+                                 const TrackingContext& context, OdometryResult* result,
+                                 std::string* matcher_error);
+
+  // RANSAC on given matches (the seam), as each pass does after matching.
+  MotionAttempt Estimate(const std::vector<Feature>& ref_features,
+                         const std::vector<Feature>& curr_features, std::vector<Match> matches,
+                         PredictionSource source) const;
+
+  // Frames are skipped from the matcher's point of view (the Kalman tracker keeps state).
+  void Reset() { matcher_->Reset(); }
+  MatcherType matcher_type() const { return matcher_->type(); }
+
+ private:
+  Tracker(const StereoCamera& camera, const OdometryOptions& options,
+          std::unique_ptr<FrameMatcher> matcher);
+
+  StereoCamera camera_;
+  OdometryOptions options_;
+  std::unique_ptr<FrameMatcher> matcher_;
+};
+
+}  // namespace vo
