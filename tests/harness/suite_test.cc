@@ -357,10 +357,20 @@ TEST(SuiteRunTest, WritesEveryRunAndResumesOnlyUnfinishedRuns) {
   fs::copy(full, out, fs::copy_options::recursive);
   const std::string gone = "corridor__paper__s1__k1", stale = "l_hallway__ncc__s1__k2";
   fs::remove_all(out / "runs" / gone);
-  fs::create_directories(out / "runs" / (gone + ".partial"));
-  WriteText((out / "runs" / (gone + ".partial") / "metrics.json").string(), "{}");
-  fs::copy_file(out / "runs" / stale / ".vobench.json",  // vobench's leftover: marked
-                out / "runs" / (gone + ".partial") / ".vobench.json");
+  // vobench's leftover: a work folder of a process that has exited, marked as its work folder.
+  const pid_t dead = fork();
+  if (dead == 0) _exit(0);
+  waitpid(dead, nullptr, 0);
+  const std::string partial = gone + ".partial-" + std::to_string(dead) + "-AbC123";
+  fs::create_directories(out / "runs" / partial);
+  WriteText((out / "runs" / partial / "metrics.json").string(), "{}");
+  nlohmann::json work_marker =
+      nlohmann::json::parse(ReadAll(out / "runs" / stale / ".vobench.json"));
+  work_marker["pid"] = dead;
+  work_marker["work_folder_of_pid"] = dead;
+  WriteText((out / "runs" / partial / ".vobench.json").string(), work_marker.dump(2));
+  // A finished folder copied aside under such a name (a user's backup): kept (issue #31).
+  fs::copy(out / "runs" / stale, out / "runs" / (gone + ".partial"), fs::copy_options::recursive);
   fs::create_directories(out / "tmp" / "shard1of1" / "l_hallway__paper__s1__k1.partial");
   std::string stamp = ReadAll(out / "runs" / stale / "suite_run.json");
   stamp.replace(stamp.find("\"spec_hash\": \"") + 14, 16, "0000000000000000");
@@ -381,7 +391,9 @@ TEST(SuiteRunTest, WritesEveryRunAndResumesOnlyUnfinishedRuns) {
   }
   EXPECT_NE(MTime(out / "runs" / stale / "metrics.json"), before[stale]);
   EXPECT_TRUE(fs::exists(out / "runs" / gone / "suite_run.json"));
-  EXPECT_FALSE(fs::exists(out / "runs" / (gone + ".partial")));
+  EXPECT_FALSE(fs::exists(out / "runs" / partial));
+  EXPECT_TRUE(fs::exists(out / "runs" / (gone + ".partial") / "metrics.json"));
+  fs::remove_all(out / "runs" / (gone + ".partial"));  // not part of the summary below
   EXPECT_FALSE(fs::exists(out / "tmp"));
   EXPECT_EQ(WithoutTimingColumns(ReadAll(out / "summary.csv")), WithoutTimingColumns(csv));
 
@@ -480,8 +492,9 @@ TEST(SuiteRunTest, ShardsCanShareOneOutputFolder) {
 
 TEST(SuiteFailureTest, AFailedRunIsRecordedAndTheOthersGoOn) {
   TempDir dir("suite_fail");
+  // A scene that loads (the scenario reads) but has no robot: the run fails, not the suite.
   WriteText(dir / "broken.xml",
-            "<mujoco><worldbody><geom type='nonsense'/></worldbody></mujoco>\n");
+            "<mujoco><worldbody><geom type='plane' size='5 5 0.1'/></worldbody></mujoco>\n");
   WriteText(dir / "broken.yaml",
             "name: broken\nscene: broken.xml\npath:\n  - [0, 0]\n  - [1, 0]\n");
   WriteText(dir / "suite.yaml",
@@ -492,7 +505,7 @@ TEST(SuiteFailureTest, AFailedRunIsRecordedAndTheOthersGoOn) {
   EXPECT_NE(r.output.find("1 failed"), std::string::npos) << r.output;
   const std::string failed = ReadAll(dir / "out/runs/broken__paper__s1__k1.failed.txt");
   EXPECT_NE(failed.find("exit status 1"), std::string::npos) << failed;
-  EXPECT_NE(failed.find("nonsense"), std::string::npos) << failed;  // the child's message
+  EXPECT_NE(failed.find("robot"), std::string::npos) << failed;  // the child's message
   EXPECT_FALSE(fs::exists(dir / "out/runs/broken__paper__s1__k1"));
   EXPECT_TRUE(fs::exists(dir / "out/runs/l_hallway__paper__s1__k1/metrics.json"));
   const std::string csv = ReadAll(dir / "out/summary.csv");

@@ -240,9 +240,12 @@ TEST(SimulatorTest, PathThroughAWallIsRefusedBeforeSimulating) {
   EXPECT_NE(error.find("key 'path[1]'"), std::string::npos) << error;
   EXPECT_NE(error.find("crosses wall 'blocker'"), std::string::npos) << error;
   EXPECT_NE(error.find("at (0.5, 0)"), std::string::npos) << error;
-  // Stopping short of it is fine.
+  // Stopping short of it, the robot (0.33 m about its axle) clear of it, is fine; 0.4 m (the
+  // camera 0.1 m short of the wall) is not (issue #31).
   error.clear();
-  EXPECT_NE(sim::Simulator::Create(MakeScenario(scene, 0.4), &error), nullptr) << error;
+  EXPECT_NE(sim::Simulator::Create(MakeScenario(scene, 0.15), &error), nullptr) << error;
+  EXPECT_EQ(sim::Simulator::Create(MakeScenario(scene, 0.4), &error), nullptr);
+  EXPECT_NE(error.find("comes within 0.1 m of wall 'blocker'"), std::string::npos) << error;
 }
 
 TEST(SimulatorTest, IntrinsicsFromFovy) {
