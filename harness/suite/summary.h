@@ -33,8 +33,10 @@ struct SuiteResult {
 
 // The summary's columns: axes and status, then the metric registry's metrics (csv ones, in
 // metrics.json order; dotted keys as they are); the timing columns (SuiteTimingColumns: the
-// registry's timing metrics and the run's wall_s) are the last ones and the only ones that
-// vary between identical runs.
+// registry's timing metrics, an external configuration's command_wall_s and
+// command_peak_rss_mb, and the run's wall_s) are the last ones and the only ones that vary
+// between identical runs. A run's metrics.json without a column's key (an external
+// configuration has no lost_frames, a built-in one no command_wall_s) leaves its cell empty.
 const std::vector<std::string>& SuiteSummaryColumns();
 const std::vector<std::string>& SuiteTimingColumns();
 
