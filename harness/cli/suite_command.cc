@@ -17,7 +17,7 @@ struct SuiteArgs {
   bool force = false, plots = false, quiet = false;
   std::string merge_out;
   std::vector<std::string> merge_dirs;
-  std::string external_spec, external_out;
+  std::string external_spec, external_out, external_datasets;
 };
 
 void PrintResult(const SuiteResult& r, const std::string& out) {
@@ -75,7 +75,7 @@ int RunExternalCommandLine(const SuiteArgs& a) {
   ExternalRunSpec spec;
   if (!ReadExternalRunSpec(a.external_spec, &spec, &error))
     return PrintFailure("suite external", kExitBadInput, error);
-  if (!RunExternalRun(spec, a.external_out, &error))
+  if (!RunExternalRun(spec, a.external_out, a.external_datasets, &error))
     return PrintFailure("suite external", kExitFailed, error);
   return kExitOk;
 }
@@ -112,6 +112,8 @@ Command AddSuiteCommand(CLI::App& app) {
   external->group("");
   external->add_option("spec", sa->external_spec, "specs/<id>.external.json")->required();
   external->add_option("--out,-o", sa->external_out, "Run folder")->required();
+  external->add_option("--datasets", sa->external_datasets,
+                       "Folder of the sequences shared by the runs (default: the run's own)");
   external->add_flag("-q,--quiet", sa->quiet, "No progress display");
   return {suite, [sa, merge, external] {
             if (external->parsed()) return RunExternalCommandLine(*sa);

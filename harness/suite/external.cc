@@ -34,8 +34,9 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
-constexpr auto kPoll = std::chrono::milliseconds(20);  // polling period of the command
-constexpr double kKillGraceS = 2.0;                    // SIGTERM -> SIGKILL
+constexpr auto kPoll = std::chrono::milliseconds(20);       // polling period of the command
+constexpr double kKillGraceS = 2.0;                         // SIGTERM -> SIGKILL
+constexpr auto kLockPoll = std::chrono::milliseconds(100);  // waiting for a sequence's writer
 
 // argv with every placeholder replaced.
 std::vector<std::string> Expand(const std::vector<std::string>& argv,
@@ -80,6 +81,38 @@ bool WriteRunSequence(const ExternalRunSpec& spec, const std::string& dir, int* 
   if (!error->empty()) return false;
   *frames = static_cast<int>(writer.num_frames());
   return writer.Finish(error);
+}
+
+// The sequence of `spec` in the shared folder `datasets_dir` (one per scenario, seed, stride and
+// max_frames; runs of other configurations on the same sequence find it written): its folder,
+// written here unless another run has written it. One writer at a time (a lock beside it; the
+// others wait).
+bool SharedSequence(const ExternalRunSpec& spec, const fs::path& datasets_dir, fs::path* dir,
+                    std::string* error) {
+  sim::Scenario scenario;
+  if (!sim::LoadScenario(spec.scenario_path, &scenario, error)) return false;
+  scenario.name.clear();  // the run's id: the configuration is not part of the sequence
+  *dir = datasets_dir /
+         Fnv1aHex(sim::ScenarioToYaml(scenario) + "stride: " + std::to_string(spec.stride) +
+                  "\nmax_frames: " + std::to_string(spec.max_frames) + "\n");
+  std::error_code ec;
+  fs::create_directories(datasets_dir, ec);
+  FolderLock lock;
+  for (std::string why; !lock.Acquire(dir->string() + ".writer.lock", dir->string(), &why);) {
+    if (why.find("another vobench") == std::string::npos) {
+      *error = why;
+      return false;
+    }
+    if (InterruptSignal() != 0) {
+      *error = "interrupted by signal " + std::to_string(InterruptSignal()) +
+               " while waiting for the sequence " + dir->string();
+      return false;
+    }
+    std::this_thread::sleep_for(kLockPoll);
+  }
+  if (HasFolderMarker(dir->string(), "dataset")) return true;
+  int frames = 0;
+  return WriteRunSequence(spec, dir->string(), &frames, error);
 }
 
 bool CopyFile(const fs::path& from, const fs::path& to, std::string* error) {
@@ -364,19 +397,26 @@ bool CommandLauncher::Run(const std::vector<std::string>& argv, double timeout_s
   return true;
 }
 
-bool RunExternalRun(const ExternalRunSpec& spec, const std::string& out_dir, std::string* error) {
+bool RunExternalRun(const ExternalRunSpec& spec, const std::string& out_dir,
+                    const std::string& datasets_dir, std::string* error) {
   const ExternalEstimator& e = spec.estimator;
   CommandLauncher launcher;  // before the simulator: see CommandLauncher
   if (!launcher.Start(error)) return false;
   OutputFolder folder;
   if (!folder.Create(out_dir, "run", error)) return false;
   const fs::path work = fs::absolute(folder.path());
-  const fs::path dataset = work / "dataset", estimate = work / "estimate";
+  const fs::path estimate = work / "estimate";
+  fs::path dataset = work / "dataset";
   int frames = 0;
-  std::printf("external %s: writing the sequence (stride %d, max_frames %d) to %s\n",
-              spec.id.c_str(), spec.stride, spec.max_frames, dataset.c_str());
+  std::printf("external %s: the sequence (stride %d, max_frames %d)\n", spec.id.c_str(),
+              spec.stride, spec.max_frames);
   std::fflush(stdout);
-  if (!WriteRunSequence(spec, dataset.string(), &frames, error)) return false;
+  if (!(datasets_dir.empty() ? WriteRunSequence(spec, dataset.string(), &frames, error)
+                             : SharedSequence(spec, fs::absolute(datasets_dir), &dataset, error)))
+    return false;
+  std::vector<double> times;
+  if (!ReadKittiTimes((dataset / "times.txt").string(), &times, error)) return false;
+  frames = static_cast<int>(times.size());
   std::error_code ec;
   fs::create_directories(estimate, ec);
   if (ec) {
@@ -439,7 +479,8 @@ bool RunExternalRun(const ExternalRunSpec& spec, const std::string& out_dir, std
   metrics["frame_stride"] = spec.stride;
   metrics["command_wall_s"] = outcome.wall_s;
   metrics["command_peak_rss_mb"] = outcome.peak_rss_mb;
-  fs::remove_all(dataset, ec);  // the images: the run folder keeps what was scored
+  if (datasets_dir.empty())
+    fs::remove_all(dataset, ec);  // the images: the run folder keeps what was scored
   if (!WriteTextFile((work / "external.json").string(), info.dump(2) + "\n", error) ||
       !WriteTextFile((work / "metrics.json").string(), metrics.dump(2) + "\n", error))
     return false;

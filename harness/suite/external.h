@@ -14,16 +14,18 @@
 // the command's output. A first argument with a '/' that is relative is a path relative to the
 // suite file; one without is looked up on PATH.
 //
-// A suite runs an external run as a child `vobench suite external SPEC --out DIR` (the same
-// child-process path as a built-in run: log, failure record, resume, shards). That child
-// simulates the scenario once and writes the sequence the run sees (every stride-th source
-// frame of the first max_frames) as a dataset, runs the command on it (in a process group of
+// A suite runs an external run as a child `vobench suite external SPEC --out DIR --datasets D`
+// (the same child-process path as a built-in run: log, failure record, resume, shards). The
+// first child of a sequence simulates the scenario and writes the sequence the runs see (every
+// stride-th source frame of the first max_frames) as a dataset in D, the shard's work folder,
+// where the external configurations on the same sequence share it until the suite call ends;
+// each child runs its command on it (in a process group of
 // its own, killed when timeout_s passes or the suite is interrupted), measures its wall time
 // and peak memory (wait4's ru_maxrss), scores the trajectory against the sequence's ground
 // truth (harness/score.h) and writes a run folder: metrics.json (score's keys, plus frames,
 // frame_stride, command_wall_s, command_peak_rss_mb), external.json, the trajectory and the
-// ground truth it was scored against, the command's {out} folder as estimate/. The dataset
-// itself is removed at the end (images).
+// ground truth it was scored against, the command's {out} folder as estimate/. The command
+// must not change the dataset (other runs read it).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -92,8 +94,13 @@ class CommandLauncher {
 };
 
 // The external run of `spec` into the run folder `out_dir` (kind "run", written as a work
-// folder and published at the end). False with the reason (the sequence could not be written,
-// the command failed or timed out, its trajectory is missing or cannot be scored).
-bool RunExternalRun(const ExternalRunSpec& spec, const std::string& out_dir, std::string* error);
+// folder and published at the end). The sequence is written into `datasets_dir` (a folder per
+// sequence, named by the hash of the scenario without its name, stride and max_frames), where
+// the runs of other configurations on the same sequence find it (the suite gives its work
+// folder, removed when the call ends); with datasets_dir empty, into the run's work folder,
+// removed when scored. False with the reason (the sequence could not be written, the command
+// failed or timed out, its trajectory is missing or cannot be scored).
+bool RunExternalRun(const ExternalRunSpec& spec, const std::string& out_dir,
+                    const std::string& datasets_dir, std::string* error);
 
 }  // namespace harness

@@ -94,9 +94,13 @@ bool FinishJob(const fs::path& out, const Job& job, int status, double wall_s, b
 
 std::vector<std::string> RunArgv(const std::string& binary, const fs::path& out,
                                  const fs::path& tmp, const SuiteRun& r, bool plots) {
-  if (r.external)  // the child of an external configuration (suite/external.h)
-    return {binary,  "suite",      "external", (out / "specs" / (r.id + ".external.json")).string(),
-            "--out", tmp.string(), "-q"};
+  // The child of an external configuration (suite/external.h); the sequences it shares with
+  // the other external runs of this call live in the shard's work folder beside tmp.
+  if (r.external)
+    return {
+        binary,  "suite",      "external",   (out / "specs" / (r.id + ".external.json")).string(),
+        "--out", tmp.string(), "--datasets", (tmp.parent_path() / "datasets").string(),
+        "-q"};
   std::vector<std::string> argv = {binary,
                                    "run",
                                    (out / "specs" / (r.id + ".scenario.yaml")).string(),
