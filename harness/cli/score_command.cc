@@ -19,11 +19,16 @@ struct ScoreArgs {
   double max_difference_s = 0.02;
 };
 
-int RunScore(const ScoreArgs& a) {
+// max_difference_given: --max-difference was on the command line.
+int RunScore(const ScoreArgs& a, bool max_difference_given) {
   ScoreOptions options;
   if (!ParseTrajectoryFormat(a.format, &options.format))
     return PrintFailure("score", kExitBadInput,
                         "--format: expected tum or kitti, got '" + a.format + "'");
+  if (max_difference_given && options.format == TrajectoryFormat::kKitti)
+    return PrintFailure("score", kExitBadInput,
+                        "--max-difference: only for --format tum (KITTI poses are paired line "
+                        "by line)");
   options.max_difference_s = a.max_difference_s;
   std::string error;
   if (!options.IsValid(&error))
@@ -77,7 +82,7 @@ Command AddScoreCommand(CLI::App& app) {
       ->add_option("--max-difference", a->max_difference_s,
                    "tum: largest estimate to ground-truth time difference associated (s)")
       ->capture_default_str();
-  return {score, [a] { return RunScore(*a); }};
+  return {score, [a, score] { return RunScore(*a, score->count("--max-difference") > 0); }};
 }
 
 }  // namespace harness

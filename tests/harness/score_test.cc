@@ -163,6 +163,9 @@ TEST(ScoreTest, BadInputExitsWith2NamingTheFileAndWritesNothing) {
        "line by line"},
       {"--format g2o --est " + (dir / "gt.txt"), "expected tum or kitti"},
       {"--format tum --max-difference 0 --est " + (dir / "gt.txt"), "--max-difference"},
+      {"--format kitti --max-difference 0.1 --gt " + (dir / "gt_kitti.txt") + " --est " +
+           (dir / "gt_kitti.txt"),
+       "only for --format tum"},
   };
   for (const Case& c : cases) {
     const std::string gt_arg =

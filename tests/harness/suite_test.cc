@@ -549,7 +549,9 @@ TEST(SuiteExternalTest, ExternalProgramsRunBesideTheBuiltInVo) {
   TempDir dir("suite_ext");
   const std::vector<std::pair<std::string, std::string>> scripts = {
       {"gt_kitti.sh", "#!/bin/sh\ncp \"$1/poses.txt\" \"$2/traj_kitti.txt\"\n"},
-      {"gt_tum.sh", "#!/bin/sh\ntest -f \"$3\" && cp \"$1/groundtruth_tum.txt\" \"$2/traj.txt\"\n"},
+      {"gt_tum.sh",
+       "#!/bin/sh\ntest -f \"$3\" && test -d \"$1/mav0/cam0\" && cp \"$1/groundtruth_tum.txt\" "
+       "\"$2/traj.txt\"\n"},
       {"fails.sh", "#!/bin/sh\necho 'no features in frame 0'\nexit 3\n"},
       {"slow.sh", "#!/bin/sh\necho 'thinking'\nsleep 60\n"},
   };
@@ -610,6 +612,35 @@ TEST(SuiteExternalTest, ExternalProgramsRunBesideTheBuiltInVo) {
   EXPECT_EQ(again.exit_code, 1) << again.output;
   EXPECT_NE(again.output.find("3 ok (0 run now, 3 kept), 2 failed"), std::string::npos)
       << again.output;
+}
+
+// Shards split external runs as any other; the merge holds them, and the unsharded suite on the
+// merged folder finds every run finished.
+TEST(SuiteExternalTest, ShardsAndMergeHoldExternalRuns) {
+  TempDir dir("suite_ext_shards");
+  WriteText(dir / "gt.sh", "#!/bin/sh\ncp \"$1/poses.txt\" \"$2/t.txt\"\n");
+  fs::permissions(dir / "gt.sh", fs::perms::owner_all);
+  WriteText(dir / "suite.yaml",
+            "name: exts\nmax_frames: 4\nstrides: [1, 2]\nscenarios:\n  - scenario: l_hallway\n"
+            "configs:\n  - name: gt\n    external: {command: [./gt.sh, \"{dataset}\", \"{out}\"], "
+            "trajectory: t.txt, format: kitti}\n");
+  for (int i = 1; i <= 2; ++i) {
+    const auto r = RunVobench("suite " + (dir / "suite.yaml") + " -q --shard " + std::to_string(i) +
+                              "/2 --out " + (dir / ("s" + std::to_string(i))));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("1 ok (1 run now"), std::string::npos) << r.output;
+  }
+  const std::string merged = dir / "merged";
+  const auto m =
+      RunVobench("suite merge --out " + merged + " " + (dir / "s1") + " " + (dir / "s2"));
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  for (const char* id : {"l_hallway__gt__s1__k1", "l_hallway__gt__s1__k2"}) {
+    EXPECT_TRUE(fs::exists(merged + "/runs/" + id + "/metrics.json")) << id;
+    EXPECT_TRUE(fs::exists(merged + "/specs/" + id + ".external.json")) << id;
+  }
+  const auto again = RunVobench("suite " + (dir / "suite.yaml") + " -q --out " + merged);
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_NE(again.output.find("2 ok (0 run now, 2 kept)"), std::string::npos) << again.output;
 }
 
 }  // namespace
