@@ -19,6 +19,8 @@
 #include <regex>
 #include <thread>
 
+#include "harness/dataset/euroc.h"
+#include "harness/dataset/kitti.h"
 #include "harness/dataset/writer.h"
 #include "harness/interrupt.h"
 #include "harness/output_folder.h"
@@ -52,68 +54,67 @@ std::vector<std::string> Expand(const std::vector<std::string>& argv,
   return out;
 }
 
-// The run's sequence: every stride-th of the first max_frames source frames of the scenario,
-// written as a dataset (KITTI layout, EuRoC's mav0/ beside it, rig.yaml).
-bool WriteRunSequence(const ExternalRunSpec& spec, const std::string& dir, int* frames,
-                      std::string* error) {
-  sim::Scenario scenario;
-  if (!sim::LoadScenario(spec.scenario_path, &scenario, error)) return false;
-  std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
-  if (!simulator) return false;
-  DatasetWriter::Options options;
-  options.format = DatasetFormat::kEuroc;
-  options.T_body_cam0 = simulator->calibration().T_body_cam0;
-  options.rate_hz = scenario.rate_hz / spec.stride;
-  options.write_rig = true;
-  options.rig.forward_m = scenario.camera.forward_m;
-  options.rig.height_m = scenario.camera.height_m;
-  options.rig.pitch_deg = scenario.camera.pitch_deg;
-  DatasetWriter writer(options);
-  if (!writer.Open(dir, ToStereoCamera(simulator->calibration()), error)) return false;
-  sim::StereoFrame frame;
-  for (int index = 0; spec.max_frames == 0 || index < spec.max_frames; ++index) {
-    if (!simulator->Next(&frame, error)) break;
-    if (index % spec.stride == 0 && !writer.Add(ToDatasetFrame(frame), error)) return false;
-    if (InterruptSignal() != 0) {
-      *error = InterruptedMessage(index, simulator->EstimatedFrames(), "frames", dir);
-      return false;
-    }
-  }
-  if (!error->empty()) return false;
-  *frames = static_cast<int>(writer.num_frames());
-  return writer.Finish(error);
-}
-
-// The sequence of `spec` in the shared folder `datasets_dir` (one per scenario, seed, stride and
-// max_frames; runs of other configurations on the same sequence find it written): its folder,
-// written here unless another run has written it. One writer at a time (a lock beside it; the
-// others wait).
-bool SharedSequence(const ExternalRunSpec& spec, const fs::path& datasets_dir, fs::path* dir,
-                    std::string* error) {
-  sim::Scenario scenario;
-  if (!sim::LoadScenario(spec.scenario_path, &scenario, error)) return false;
-  scenario.name.clear();  // the run's id: the configuration is not part of the sequence
-  *dir = datasets_dir /
-         Fnv1aHex(sim::ScenarioToYaml(scenario) + "stride: " + std::to_string(spec.stride) +
-                  "\nmax_frames: " + std::to_string(spec.max_frames) + "\n");
-  std::error_code ec;
-  fs::create_directories(datasets_dir, ec);
-  FolderLock lock;
-  for (std::string why; !lock.Acquire(dir->string() + ".writer.lock", dir->string(), &why);) {
+// Waits for the lock of a sequence's writer (another run may be writing it).
+bool LockSequence(const fs::path& dir, FolderLock* lock, std::string* error) {
+  for (std::string why; !lock->Acquire(dir.string() + ".writer.lock", dir.string(), &why);) {
     if (why.find("another vobench") == std::string::npos) {
       *error = why;
       return false;
     }
     if (InterruptSignal() != 0) {
       *error = "interrupted by signal " + std::to_string(InterruptSignal()) +
-               " while waiting for the sequence " + dir->string();
+               " while waiting for the sequence " + dir.string();
       return false;
     }
     std::this_thread::sleep_for(kLockPoll);
   }
-  if (HasFolderMarker(dir->string(), "dataset")) return true;
-  int frames = 0;
-  return WriteRunSequence(spec, dir->string(), &frames, error);
+  return true;
+}
+
+// The writer's options for the sequence of `scenario` seen at `stride`.
+DatasetWriter::Options SequenceWriterOptions(const sim::Scenario& scenario, int stride,
+                                             const Eigen::Isometry3d& T_body_cam0) {
+  DatasetWriter::Options options;
+  options.format = DatasetFormat::kEuroc;
+  options.T_body_cam0 = T_body_cam0;
+  options.rate_hz = scenario.rate_hz / stride;
+  options.write_rig = true;
+  options.rig.forward_m = scenario.camera.forward_m;
+  options.rig.height_m = scenario.camera.height_m;
+  options.rig.pitch_deg = scenario.camera.pitch_deg;
+  return options;
+}
+
+// The sequences of `spec` in the shared folder `datasets_dir`: the whole one (stride 1, one per
+// scenario, seed and max_frames) simulated by the first run that needs it, and the run's strided
+// copy of it; runs of other configurations find them written. One writer per folder at a time
+// (a lock beside it; the others wait).
+bool SharedSequence(const ExternalRunSpec& spec, const fs::path& datasets_dir, fs::path* dir,
+                    std::string* error) {
+  sim::Scenario scenario;
+  if (!sim::LoadScenario(spec.scenario_path, &scenario, error)) return false;
+  scenario.name.clear();  // the run's id: the configuration is not part of the sequence
+  const fs::path full = datasets_dir / Fnv1aHex(sim::ScenarioToYaml(scenario) + "max_frames: " +
+                                                std::to_string(spec.max_frames) + "\n");
+  std::error_code ec;
+  fs::create_directories(datasets_dir, ec);
+  {
+    FolderLock lock;
+    if (!LockSequence(full, &lock, error)) return false;
+    ExternalRunSpec whole = spec;
+    whole.stride = 1;
+    if (!HasFolderMarker(full.string(), "dataset") && !WriteSequence(whole, full.string(), error))
+      return false;
+  }
+  if (spec.stride == 1) {
+    *dir = full;
+    return true;
+  }
+  *dir = full.string() + "_k" + std::to_string(spec.stride);
+  FolderLock lock;
+  if (!LockSequence(*dir, &lock, error)) return false;
+  return HasFolderMarker(dir->string(), "dataset") ||
+         WriteStridedCopy(spec, full.string(), dir->string(), error);
 }
 
 bool CopyFile(const fs::path& from, const fs::path& to, std::string* error) {
@@ -124,6 +125,48 @@ bool CopyFile(const fs::path& from, const fs::path& to, std::string* error) {
 }
 
 }  // namespace
+
+bool WriteSequence(const ExternalRunSpec& spec, const std::string& dir, std::string* error) {
+  sim::Scenario scenario;
+  if (!sim::LoadScenario(spec.scenario_path, &scenario, error)) return false;
+  std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
+  if (!simulator) return false;
+  DatasetWriter writer(
+      SequenceWriterOptions(scenario, spec.stride, simulator->calibration().T_body_cam0));
+  if (!writer.Open(dir, ToStereoCamera(simulator->calibration()), error)) return false;
+  sim::StereoFrame frame;
+  for (int index = 0; spec.max_frames == 0 || index < spec.max_frames; ++index) {
+    if (!simulator->Next(&frame, error)) break;
+    if (index % spec.stride == 0 && !writer.Add(ToDatasetFrame(frame), error)) return false;
+    if (InterruptSignal() != 0) {
+      *error = InterruptedMessage(index, simulator->EstimatedFrames(), "frames", dir);
+      return false;
+    }
+  }
+  return error->empty() && writer.Finish(error);
+}
+
+bool WriteStridedCopy(const ExternalRunSpec& spec, const std::string& full_dir,
+                      const std::string& dir, std::string* error) {
+  sim::Scenario scenario;
+  KittiReader reader;
+  EurocCameraCalibration cam0;
+  if (!sim::LoadScenario(spec.scenario_path, &scenario, error) || !reader.Open(full_dir, error) ||
+      !ReadEurocSensorYaml((fs::path(full_dir) / "mav0/cam0/sensor.yaml").string(), &cam0, error))
+    return false;
+  DatasetWriter writer(SequenceWriterOptions(scenario, spec.stride, cam0.T_body_cam));
+  if (!writer.Open(dir, reader.camera(), error)) return false;
+  DatasetFrame frame;
+  for (size_t index = 0; index < reader.size(); index += static_cast<size_t>(spec.stride)) {
+    if (!reader.ReadFrame(index, &frame, error) || !writer.Add(frame, error)) return false;
+    if (InterruptSignal() != 0) {
+      *error = InterruptedMessage(static_cast<int>(index), static_cast<int>(reader.size()),
+                                  "frames", dir);
+      return false;
+    }
+  }
+  return writer.Finish(error);
+}
 
 const std::vector<std::string>& ExternalPlaceholders() {
   static const std::vector<std::string> kPlaceholders = {"{dataset}", "{euroc}", "{calib}",
@@ -412,7 +455,7 @@ bool RunExternalRun(const ExternalRunSpec& spec, const std::string& out_dir,
   std::printf("external %s: the sequence (stride %d, max_frames %d)\n", spec.id.c_str(),
               spec.stride, spec.max_frames);
   std::fflush(stdout);
-  if (!(datasets_dir.empty() ? WriteRunSequence(spec, dataset.string(), &frames, error)
+  if (!(datasets_dir.empty() ? WriteSequence(spec, dataset.string(), error)
                              : SharedSequence(spec, fs::absolute(datasets_dir), &dataset, error)))
     return false;
   std::vector<double> times;

@@ -16,9 +16,10 @@
 //
 // A suite runs an external run as a child `vobench suite external SPEC --out DIR --datasets D`
 // (the same child-process path as a built-in run: log, failure record, resume, shards). The
-// first child of a sequence simulates the scenario and writes the sequence the runs see (every
-// stride-th source frame of the first max_frames) as a dataset in D, the shard's work folder,
-// where the external configurations on the same sequence share it until the suite call ends;
+// first child of a sequence simulates the scenario once (the first max_frames source frames)
+// into D, the shard's work folder, and writes the strided sequence its run sees (every
+// stride-th frame) from it; the external runs on the same sequence share both until the suite
+// call ends;
 // each child runs its command on it (in a process group of
 // its own, killed when timeout_s passes or the suite is interrupted), measures its wall time
 // and peak memory (wait4's ru_maxrss), scores the trajectory against the sequence's ground
@@ -62,6 +63,16 @@ nlohmann::ordered_json ExternalEstimatorJson(const ExternalEstimator& e);
 nlohmann::ordered_json ExternalRunSpecJson(const ExternalRunSpec& spec);
 bool ReadExternalRunSpec(const std::string& path, ExternalRunSpec* spec, std::string* error);
 
+// The sequence a run of `spec` sees, every stride-th of the first max_frames source frames of
+// its scenario, simulated and written as a dataset in `dir` (KITTI layout, EuRoC's mav0/ and
+// rig.yaml beside it; DatasetWriter: nothing at dir on failure).
+bool WriteSequence(const ExternalRunSpec& spec, const std::string& dir, std::string* error);
+// The same from `full_dir`, the sequence written by WriteSequence at stride 1: every
+// spec.stride-th of its frames, read back and written into `dir`. Images, depth, stamps and
+// rig.yaml are those WriteSequence writes at that stride, the ground truth equal to ~1e-15 m.
+bool WriteStridedCopy(const ExternalRunSpec& spec, const std::string& full_dir,
+                      const std::string& dir, std::string* error);
+
 // How the command ended.
 struct CommandOutcome {
   int wait_status = 0;       // waitpid status (when !timed_out)
@@ -94,10 +105,11 @@ class CommandLauncher {
 };
 
 // The external run of `spec` into the run folder `out_dir` (kind "run", written as a work
-// folder and published at the end). The sequence is written into `datasets_dir` (a folder per
-// sequence, named by the hash of the scenario without its name, stride and max_frames), where
-// the runs of other configurations on the same sequence find it (the suite gives its work
-// folder, removed when the call ends); with datasets_dir empty, into the run's work folder,
+// folder and published at the end). The sequence is written into `datasets_dir`: the whole one
+// (named by the hash of the scenario without its name and max_frames), simulated once, and a
+// strided copy of it per stride ("<hash>_k<stride>", WriteStridedCopy), where the runs of other
+// configurations and strides find them (the suite gives its work folder, removed when the call
+// ends); with datasets_dir empty, simulated at the run's stride into the run's work folder and
 // removed when scored. False with the reason (the sequence could not be written, the command
 // failed or timed out, its trajectory is missing or cannot be scored).
 bool RunExternalRun(const ExternalRunSpec& spec, const std::string& out_dir,
