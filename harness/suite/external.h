@@ -19,11 +19,10 @@
 // first child of a sequence simulates the scenario once (the first max_frames source frames)
 // into D, the shard's work folder, and writes the strided sequence its run sees (every
 // stride-th frame) from it; the external runs on the same sequence share both until the suite
-// call ends;
-// each child runs its command on it (in a process group of
-// its own, killed when timeout_s passes or the suite is interrupted), measures its wall time
-// and peak memory (wait4's ru_maxrss), scores the trajectory against the sequence's ground
-// truth (harness/score.h) and writes a run folder: metrics.json (score's keys, plus frames,
+// call ends. Each child runs its command on its sequence (in a process group of its own,
+// killed when timeout_s passes or the suite is interrupted), measures its wall time and peak
+// memory (wait4's ru_maxrss), scores the trajectory against the sequence's ground truth
+// (harness/score.h) and writes a run folder: metrics.json (score's keys, plus frames,
 // frame_stride, command_wall_s, command_peak_rss_mb), external.json, the trajectory and the
 // ground truth it was scored against, the command's {out} folder as estimate/. The command
 // must not change the dataset (other runs read it).
@@ -41,7 +40,10 @@ struct ExternalEstimator {
   std::vector<std::string> command;  // argv with placeholders
   std::string trajectory;            // the command's trajectory file, relative to {out}
   TrajectoryFormat format = TrajectoryFormat::kKitti;
-  double timeout_s = 600.0;  // > 0
+  double timeout_s = 600.0;   // > 0
+  std::string program_given;  // command[0] as the suite file gives it, before it was resolved
+                              // against the suite's folder: the spec hash sees this one, so it
+                              // is the same on every machine ("" = command[0])
 };
 
 // The placeholders a command may use, as written ("{dataset}", ...).

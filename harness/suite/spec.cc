@@ -126,6 +126,7 @@ void ParseExternal(const YAML::Node& node, const std::string& key, const std::st
   }
   // A program given as a path: relative to the suite file, and it must be there.
   std::string& program = e->command[0];
+  e->program_given = program;
   if (program.find('/') != std::string::npos) {
     fs::path path = program;
     if (path.is_relative()) path = fs::path(base_dir) / path;
@@ -327,8 +328,12 @@ std::vector<SuiteRun> ExpandSuite(const Suite& suite) {
     for (const auto& cfg : suite.configs) {
       // What the run's hash sees of the configuration: the VO options, or the external program.
       const std::string vo_yaml = cfg.external ? "" : VoConfigToYaml(cfg.options);
+      // The program enters as the suite file names it (not resolved), so the hash is portable.
+      ExternalEstimator portable_estimator = cfg.estimator;
+      if (cfg.external && !portable_estimator.program_given.empty())
+        portable_estimator.command[0] = portable_estimator.program_given;
       const std::string config_text =
-          cfg.external ? "external:\n" + ExternalEstimatorJson(cfg.estimator).dump() + "\n"
+          cfg.external ? "external:\n" + ExternalEstimatorJson(portable_estimator).dump() + "\n"
                        : "vo:\n" + vo_yaml;
       for (uint64_t seed : seeds) {
         for (int stride : suite.strides) {

@@ -265,6 +265,18 @@ TEST(SuiteFileTest, ExternalConfigsAreReadAndChecked) {
   EXPECT_TRUE(runs[1].external);
   EXPECT_EQ(runs[1].id, "l_hallway__mine__s1__k1");
   EXPECT_NE(runs[0].spec_hash, runs[1].spec_hash);
+  // The program enters the hash as the suite file names it: the same suite in another folder
+  // (another machine's checkout) has the same hashes.
+  TempDir other("suite_ext_file_other");
+  fs::copy_file(dir / "vo.sh", other / "vo.sh");
+  harness::Suite moved;
+  ASSERT_TRUE(harness::ParseSuite(
+      head + "  - name: paper\n  - name: mine\n    external: {command: [./vo.sh, \"{dataset}\", "
+             "\"--calib={calib}\", \"{out}\"], trajectory: t.txt, format: tum, timeout_s: 5}\n",
+      "e.yaml", other.str(), &moved, &error))
+      << error;
+  EXPECT_EQ(moved.configs[1].estimator.command[0], other / "vo.sh");
+  EXPECT_EQ(harness::ExpandSuite(moved)[1].spec_hash, runs[1].spec_hash);
 
   struct Bad {
     std::string config;
