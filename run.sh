@@ -4,5 +4,6 @@
 # printing the metrics; the run folder with report.md and plots goes to out/l_hallway/.
 set -euo pipefail
 cd "$(dirname "$0")"
-./setup.sh
+# Only the vobench command is built (the tests and benchmarks are test.sh's).
+BUILD_TARGET=vobench ./setup.sh
 ./build/vobench run l_hallway --out out/l_hallway "$@"

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages vobench needs (only those missing), then configures and builds
 # it in Release under build/. Used by run.sh and test.sh; safe to run again.
+# BUILD_TARGET=vobench builds only the command (and the libraries it links), not the tests and
+# benchmarks: what run.sh needs; unset, everything is built (test.sh).
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -30,4 +32,4 @@ fi
 
 JOBS="${JOBS:-$(nproc)}"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" > build.cmake.log 2>&1 || { cat build.cmake.log; exit 1; }
-cmake --build build -j "$JOBS"
+cmake --build build -j "$JOBS" ${BUILD_TARGET:+--target "$BUILD_TARGET"}

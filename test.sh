@@ -3,5 +3,5 @@
 # Tests that need OpenGL (OSMesa) carry the ctest label "gl"; run the rest with: ctest -LE gl
 set -euo pipefail
 cd "$(dirname "$0")"
-./setup.sh
+BUILD_TARGET= ./setup.sh  # everything: the command, the tests, the benchmarks
 ctest --test-dir build --output-on-failure -j "${JOBS:-$(nproc)}" "$@"

@@ -13,6 +13,7 @@
 #include "harness/cli/match_eval_command.h"
 #include "harness/cli/render_command.h"
 #include "harness/cli/run_command.h"
+#include "harness/cli/score_command.h"
 #include "harness/cli/suite_command.h"
 #include "harness/cli/tune_command.h"
 #include "harness/interrupt.h"
@@ -33,7 +34,8 @@ int main(int argc, char** argv) {
   const std::vector<harness::Command> commands = {
       harness::AddRenderCommand(app), harness::AddMatchEvalCommand(app),
       harness::AddRunCommand(app),    harness::AddEvalCommand(app),
-      harness::AddTuneCommand(app),   harness::AddSuiteCommand(app),  // suite, suite merge
+      harness::AddScoreCommand(app),  harness::AddTuneCommand(app),
+      harness::AddSuiteCommand(app),  // suite, suite merge
       harness::AddCheckCommand(app)};
 
   // Argument errors exit with 2 (one line on stderr), --help with 0; the command runs after the

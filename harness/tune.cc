@@ -491,6 +491,16 @@ bool ParseTuneSpec(const std::string& yaml_text, const std::string& source_name,
   TuneSpec s;
   s.text = yaml_text;
   s.name = fs::path(source_name).stem().string();
+  // A suite's external configuration (harness/suite/external.h) is another program: its
+  // parameters are its own, out of reach of tune, which searches this VO's options.
+  for (const char* key : {"external", "configs"})
+    if (YamlReader::Has(root, key)) {
+      r.Fail(root[key], key,
+             "tune searches this VO's options (parameters, base_config); an external "
+             "program's parameters cannot be tuned here: score it in a suite (configs: "
+             "external:) or `vobench score`");
+      return r.Report(error);
+    }
   if (!r.CheckKeys(
           root, "",
           {"name", "base_config", "train", "validation", "parameters", "objective", "optimizer"}) ||

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "harness/suite.h"
+#include "harness/suite/external.h"
 
 namespace harness {
 namespace {
@@ -16,6 +17,7 @@ struct SuiteArgs {
   bool force = false, plots = false, quiet = false;
   std::string merge_out;
   std::vector<std::string> merge_dirs;
+  std::string external_spec, external_out, external_datasets;
 };
 
 void PrintResult(const SuiteResult& r, const std::string& out) {
@@ -67,6 +69,17 @@ int RunMergeCommand(const SuiteArgs& a) {
   return kExitOk;
 }
 
+// The child of an external run (harness/suite/external.h); the suite starts it, users do not.
+int RunExternalCommandLine(const SuiteArgs& a) {
+  std::string error;
+  ExternalRunSpec spec;
+  if (!ReadExternalRunSpec(a.external_spec, &spec, &error))
+    return PrintFailure("suite external", kExitBadInput, error);
+  if (!RunExternalRun(spec, a.external_out, a.external_datasets, &error))
+    return PrintFailure("suite external", kExitFailed, error);
+  return kExitOk;
+}
+
 }  // namespace
 
 Command AddSuiteCommand(CLI::App& app) {
@@ -93,8 +106,19 @@ Command AddSuiteCommand(CLI::App& app) {
       "merge", "Combine the output folders of a suite's shards into one summary");
   merge->add_option("--out,-o", sa->merge_out, "Merged output folder")->required();
   merge->add_option("shards", sa->merge_dirs, "Output folders of the shards")->required();
-  return {suite,
-          [sa, merge] { return merge->parsed() ? RunMergeCommand(*sa) : RunSuiteCommand(*sa); }};
+  // Hidden (no group): the child process of an external configuration's run.
+  CLI::App* external =
+      suite->add_subcommand("external", "Run one external configuration's run (internal)");
+  external->group("");
+  external->add_option("spec", sa->external_spec, "specs/<id>.external.json")->required();
+  external->add_option("--out,-o", sa->external_out, "Run folder")->required();
+  external->add_option("--datasets", sa->external_datasets,
+                       "Folder of the sequences shared by the runs (default: the run's own)");
+  external->add_flag("-q,--quiet", sa->quiet, "No progress display");
+  return {suite, [sa, merge, external] {
+            if (external->parsed()) return RunExternalCommandLine(*sa);
+            return merge->parsed() ? RunMergeCommand(*sa) : RunSuiteCommand(*sa);
+          }};
 }
 
 }  // namespace harness

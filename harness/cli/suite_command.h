@@ -3,6 +3,8 @@
 // `vobench suite merge`, the summary of a suite's shards.
 //   vobench suite FILE [-j N] [--out DIR] [--shard i/N] [--force] [--plots] [-q]
 //   vobench suite merge --out DIR SHARD_DIR...
+// (and, hidden from --help, `vobench suite external SPEC --out DIR`: the child process of an
+// external configuration's run, harness/suite/external.h).
 // Exit status: 0 all runs finished; 1 a run failed or is missing; 2 bad input (nothing was
 // written).
 #pragma once

@@ -54,6 +54,7 @@ json Manifest(const Suite& suite, const std::vector<SuiteRun>& runs, const Shard
     e["stride"] = r.stride;
     e["max_frames"] = r.max_frames;
     e["spec_hash"] = r.spec_hash;
+    if (r.external) e["external"] = true;
     j["runs"].push_back(e);
   }
   return j;
@@ -173,9 +174,18 @@ bool MakeDirs(const fs::path& out, std::string* error) {
 }
 
 bool WriteSpecs(const fs::path& out, const SuiteRun& r, std::string* error) {
-  return WriteFileAtomically((out / "specs" / (r.id + ".scenario.yaml")).string(), r.scenario_yaml,
-                             error) &&
-         WriteFileAtomically((out / "specs" / (r.id + ".vo.yaml")).string(), r.vo_yaml, error);
+  const fs::path scenario = out / "specs" / (r.id + ".scenario.yaml");
+  if (!WriteFileAtomically(scenario.string(), r.scenario_yaml, error)) return false;
+  if (!r.external)
+    return WriteFileAtomically((out / "specs" / (r.id + ".vo.yaml")).string(), r.vo_yaml, error);
+  ExternalRunSpec spec;
+  spec.id = r.id;
+  spec.scenario_path = scenario.string();
+  spec.stride = r.stride;
+  spec.max_frames = r.max_frames;
+  spec.estimator = r.estimator;
+  return WriteFileAtomically((out / "specs" / (r.id + ".external.json")).string(),
+                             ExternalRunSpecJson(spec).dump(2) + "\n", error);
 }
 
 }  // namespace suite_internal

@@ -7,7 +7,9 @@
 //   suite.json      manifest: suite name, the shard, every run of the suite (id, axes, spec hash)
 //   suite.yaml      copy of the suite file
 //   specs/<id>.scenario.yaml, specs/<id>.vo.yaml
-//                   effective inputs of each run (what the child reads)
+//                   effective inputs of each run (what the child reads); an external
+//                   configuration's run has specs/<id>.external.json instead of .vo.yaml
+//                   (suite/external.h)
 //   runs/<id>/      finished run folders (`vobench run` layout + suite_run.json: spec hash,
 //                   wall time). A run appears here only when finished: the child writes under
 //                   tmp/shard<i>of<N>/<id>, the suite adds suite_run.json and renames it into

@@ -95,6 +95,13 @@ bool FinishJob(const fs::path& out, const Job& job, int status, double wall_s, b
 
 std::vector<std::string> RunArgv(const std::string& binary, const fs::path& out,
                                  const fs::path& tmp, const SuiteRun& r, bool plots) {
+  // The child of an external configuration (suite/external.h); the sequences it shares with
+  // the other external runs of this call live in the shard's work folder beside tmp.
+  if (r.external)
+    return {
+        binary,  "suite",      "external",   (out / "specs" / (r.id + ".external.json")).string(),
+        "--out", tmp.string(), "--datasets", (tmp.parent_path() / "datasets").string(),
+        "-q"};
   std::vector<std::string> argv = {binary,
                                    "run",
                                    (out / "specs" / (r.id + ".scenario.yaml")).string(),
@@ -355,8 +362,10 @@ bool MergeSuiteShards(const std::vector<std::string>& shard_dirs, const std::str
     for (const auto& dir : shard_dirs) {
       const fs::path specs = fs::path(dir) / "specs";
       if (!fs::exists(specs / (r.id + ".scenario.yaml"))) continue;
-      for (const std::string& f : {r.id + ".scenario.yaml", r.id + ".vo.yaml"})
-        fs::copy_file(specs / f, out / "specs" / f, fs::copy_options::overwrite_existing, ec);
+      for (const std::string& f :
+           {r.id + ".scenario.yaml", r.id + ".vo.yaml", r.id + ".external.json"})
+        if (fs::exists(specs / f))
+          fs::copy_file(specs / f, out / "specs" / f, fs::copy_options::overwrite_existing, ec);
       if (fs::exists(fs::path(dir) / "logs" / (r.id + ".log")))
         fs::copy_file(fs::path(dir) / "logs" / (r.id + ".log"), out / "logs" / (r.id + ".log"),
                       fs::copy_options::overwrite_existing, ec);

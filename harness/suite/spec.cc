@@ -1,5 +1,6 @@
 #include "harness/suite/spec.h"
 
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>
@@ -85,6 +86,57 @@ bool ResolveSuiteScenario(const std::string& value, const fs::path& base_dir,
     return false;
   }
   return true;
+}
+
+// A configuration's `external:` mapping (suite/external.h).
+void ParseExternal(const YAML::Node& node, const std::string& key, const std::string& base_dir,
+                   ExternalEstimator* e, YamlReader* r) {
+  if (!r->ExpectMap(node, key, "a mapping with command, trajectory, format (and timeout_s)"))
+    return;
+  r->CheckKeys(node, key, {"command", "trajectory", "format", "timeout_s"});
+  if (!r->Require(node, key, "command", "the program and its arguments, a list") ||
+      !r->Require(node, key, "trajectory", "the trajectory file the command writes in {out}") ||
+      !r->Require(node, key, "format", "the trajectory's format, kitti or tum"))
+    return;
+  const YAML::Node command = node["command"];
+  if (!command.IsSequence() || command.size() == 0) {
+    r->Fail(command, key + ".command", "expected a list: the program, then its arguments");
+    return;
+  }
+  e->command.clear();
+  for (size_t i = 0; r->ok() && i < command.size(); ++i) {
+    std::string a;
+    if (r->ReadString(command[i], YamlReader::Item(key + ".command", i), &a, i > 0))
+      e->command.push_back(a);
+  }
+  r->String(node, key, "trajectory", &e->trajectory, false);
+  r->Enum(node, key, "format",
+          std::vector<std::pair<std::string, TrajectoryFormat>>{{"kitti", TrajectoryFormat::kKitti},
+                                                                {"tum", TrajectoryFormat::kTum}},
+          &e->format);
+  if (r->ok() && YamlReader::Has(node, "timeout_s"))
+    r->ReadDoubleIn(node["timeout_s"], key + ".timeout_s", 1e-3, 1e7, &e->timeout_s);
+  if (!r->ok()) return;
+  std::string why;
+  if (!CheckExternalEstimator(*e, &why)) {
+    // why is "command[1]: ...", "trajectory: ...": the key below `external` and the problem.
+    const size_t colon = why.find(": ");
+    const std::string part = why.substr(0, why.find_first_of("[:"));
+    r->Fail(node[part].IsDefined() ? node[part] : node, key + "." + why.substr(0, colon),
+            why.substr(colon + 2));
+    return;
+  }
+  // A program given as a path: relative to the suite file, and it must be there.
+  std::string& program = e->command[0];
+  e->program_given = program;
+  if (program.find('/') != std::string::npos) {
+    fs::path path = program;
+    if (path.is_relative()) path = fs::path(base_dir) / path;
+    program = path.lexically_normal().string();
+    if (!fs::is_regular_file(path) || access(program.c_str(), X_OK) != 0)
+      r->Fail(command[0], key + ".command[0]",
+              "no executable program '" + program + "' (a path is relative to the suite file)");
+  }
 }
 
 }  // namespace
@@ -217,7 +269,7 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
   for (size_t i = 0; r.ok() && i < configs.size(); ++i) {
     const YAML::Node e = configs[i];
     const std::string key = "configs[" + std::to_string(i) + "]";
-    r.CheckKeys(e, key, {"name", "config", "set"});
+    r.CheckKeys(e, key, {"name", "config", "set", "external"});
     SuiteConfig c;
     if (!r.Require(e, key, "name", "the configuration's name") ||
         !r.String(e, key, "name", &c.name, false))
@@ -226,6 +278,17 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
       r.Fail(e["name"], key + ".name", name_error);
     if (r.ok() && !names.insert(c.name).second)
       r.Fail(e["name"], key + ".name", "configuration name '" + c.name + "' is used twice");
+    if (r.ok() && YamlReader::Has(e, "external")) {
+      for (const char* k : {"config", "set"})
+        if (YamlReader::Has(e, k))
+          r.Fail(e[k], key + "." + k,
+                 "not with external (an external program has no VO options; give its "
+                 "settings in its command)");
+      c.external = true;
+      if (r.ok()) ParseExternal(e["external"], key + ".external", base_dir, &c.estimator, &r);
+      s.configs.push_back(c);
+      continue;
+    }
     std::string file;
     if (YamlReader::Has(e, "config") && r.String(e, key, "config", &file, false)) {
       fs::path path = file;
@@ -316,7 +379,15 @@ std::vector<SuiteRun> ExpandSuite(const Suite& suite) {
     const std::vector<uint64_t> seeds =
         suite.seeds.empty() ? std::vector<uint64_t>{sc.scenario.seed} : suite.seeds;
     for (const auto& cfg : suite.configs) {
-      const std::string vo_yaml = VoConfigToYaml(cfg.options);
+      // What the run's hash sees of the configuration: the VO options, or the external program.
+      const std::string vo_yaml = cfg.external ? "" : VoConfigToYaml(cfg.options);
+      // The program enters as the suite file names it (not resolved), so the hash is portable.
+      ExternalEstimator portable_estimator = cfg.estimator;
+      if (cfg.external && !portable_estimator.program_given.empty())
+        portable_estimator.command[0] = portable_estimator.program_given;
+      const std::string config_text =
+          cfg.external ? "external:\n" + ExternalEstimatorJson(portable_estimator).dump() + "\n"
+                       : "vo:\n" + vo_yaml;
       for (uint64_t seed : seeds) {
         for (int stride : suite.strides) {
           SuiteRun run;
@@ -333,11 +404,13 @@ std::vector<SuiteRun> ExpandSuite(const Suite& suite) {
           scenario.name = run.id;
           run.scenario_yaml = sim::ScenarioToYaml(scenario);
           run.vo_yaml = vo_yaml;
+          run.external = cfg.external;
+          run.estimator = cfg.estimator;
           // The hash sees the scene by name and content, so it is the same on every machine.
           sim::Scenario portable = scenario;
           portable.scene_path = scene_id;
-          run.spec_hash = Fnv1aHex("scenario:\n" + sim::ScenarioToYaml(portable) + "vo:\n" +
-                                   vo_yaml + "stride: " + std::to_string(stride) +
+          run.spec_hash = Fnv1aHex("scenario:\n" + sim::ScenarioToYaml(portable) + config_text +
+                                   "stride: " + std::to_string(stride) +
                                    "\nmax_frames: " + std::to_string(sc.max_frames) + "\n");
           runs.push_back(run);
         }

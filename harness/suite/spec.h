@@ -15,6 +15,9 @@
 //     - name: paper             # required, unique
 //       config: vo.yaml         # optional VO config file relative to the suite file
 //       set: {matcher.type: ncc_mutual}   # optional VO overrides, applied after `config`
+//     - name: my_vo             # an external program instead of this VO (suite/external.h)
+//       external: {command: [my_vo, "{dataset}", "{out}"], trajectory: traj_kitti.txt,
+//                  format: kitti, timeout_s: 600}
 //   seeds: [1, 2]               # optional noise seeds (default: each scenario's own seed)
 //   strides: [1, 2]             # optional frame strides (default [1])
 //
@@ -26,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/suite/external.h"
 #include "sim/scenario.h"
 #include "vo/odometry.h"
 
@@ -39,7 +43,9 @@ struct SuiteScenario {
 
 struct SuiteConfig {
   std::string name;             // id component
-  vo::OdometryOptions options;  // effective VO options
+  vo::OdometryOptions options;  // effective VO options (built-in VO)
+  bool external = false;        // an external program (`external:`) instead of this VO
+  ExternalEstimator estimator;  // when external
 };
 
 struct Suite {
@@ -61,17 +67,19 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
 
 // One run of a suite.
 struct SuiteRun {
-  int index = 0;              // position in the suite's fixed order, from 0
-  std::string id;             // <scenario>__<config>__s<seed>__k<stride>
-  std::string scenario;       // SuiteScenario::name
-  std::string config;         // SuiteConfig::name
-  uint64_t seed = 0;          // noise seed of the run
-  int stride = 1;             // frame stride
-  int max_frames = 0;         // source frames (0 = all)
-  std::string scenario_yaml;  // effective scenario (named after the id), as the child reads it
-  std::string vo_yaml;        // effective VO options, as the child reads them
-  std::string spec_hash;      // 16 hex digits: FNV-1a over the inputs (portable: the scene file
-                              // enters by name and content, not by absolute path)
+  int index = 0;                // position in the suite's fixed order, from 0
+  std::string id;               // <scenario>__<config>__s<seed>__k<stride>
+  std::string scenario;         // SuiteScenario::name
+  std::string config;           // SuiteConfig::name
+  uint64_t seed = 0;            // noise seed of the run
+  int stride = 1;               // frame stride
+  int max_frames = 0;           // source frames (0 = all)
+  std::string scenario_yaml;    // effective scenario (named after the id), as the child reads it
+  std::string vo_yaml;          // effective VO options, as the child reads them ("" external)
+  bool external = false;        // an external configuration's run (suite/external.h)
+  ExternalEstimator estimator;  // when external
+  std::string spec_hash;        // 16 hex digits: FNV-1a over the inputs (portable: the scene file
+                                // enters by name and content, not by absolute path)
 };
 
 // The runs of `suite` in their fixed order.

@@ -107,7 +107,8 @@ std::vector<ConfigAggregate> Aggregates(const std::vector<SuiteRow>& rows) {
       ate.push_back(Number(row.metrics, "ate_rmse_m"));
       drift.push_back(Number(row.metrics, "drift_pct"));
       ms.push_back(Number(row.metrics, "vo_ms_median"));
-      a.lost_total += static_cast<long>(Number(row.metrics, "lost_frames"));
+      const double lost = Number(row.metrics, "lost_frames");  // nan: an external program's
+      if (std::isfinite(lost)) a.lost_total += static_cast<long>(lost);
       if (std::isfinite(epe.back()) && !(a.epe_pct_max >= epe.back())) a.epe_pct_max = epe.back();
     }
     a.epe_pct_median = MedianOf(epe);
@@ -260,6 +261,9 @@ const std::vector<std::string>& SuiteTimingColumns() {
     std::vector<std::string> c;
     for (const MetricInfo& m : RunMetrics())
       if (m.group == MetricGroup::kTiming) c.push_back(m.key);
+    // An external configuration's command (suite/external.h): its wall time and peak memory.
+    c.push_back("command_wall_s");
+    c.push_back("command_peak_rss_mb");
     c.push_back("wall_s");
     return c;
   }();

@@ -33,9 +33,10 @@ struct SuiteResult {
 
 // The summary's columns: axes and status, then every key of the metric registry (in
 // metrics.json order; dotted keys as they are; a key a run's metrics.json does not have, or
-// null, is an empty cell or "nan"); the timing columns (SuiteTimingColumns: the
-// registry's timing metrics and the run's wall_s) are the last ones and the only ones that
-// vary between identical runs.
+// null, is an empty cell or "nan": an external configuration has no lost_frames, a built-in one
+// no command_wall_s); the timing columns (SuiteTimingColumns: the registry's timing metrics, an
+// external configuration's command_wall_s and command_peak_rss_mb, and the run's wall_s) are
+// the last ones and the only ones that vary between identical runs.
 const std::vector<std::string>& SuiteSummaryColumns();
 const std::vector<std::string>& SuiteTimingColumns();
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "harness/output_folder.h"
 #include "harness/suite/folder.h"
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
@@ -235,6 +237,79 @@ TEST(SuiteFileTest, CommandRefusesABadSuiteWithExitTwoAndWritesNothing) {
   EXPECT_NE(other.exit_code, 0);
   EXPECT_NE(other.output.find("not a vobench suite folder"), std::string::npos) << other.output;
   EXPECT_EQ(fs::directory_iterator(dir / "mine")->path().filename(), "notes.txt");
+}
+
+// Issue #36: external configurations in the suite file.
+TEST(SuiteFileTest, ExternalConfigsAreReadAndChecked) {
+  TempDir dir("suite_ext_file");
+  WriteText(dir / "vo.sh", "#!/bin/sh\n");
+  fs::permissions(dir / "vo.sh", fs::perms::owner_all);
+  const std::string head = "name: e\nscenarios:\n  - scenario: l_hallway\nconfigs:\n";
+  harness::Suite suite;
+  std::string error;
+  ASSERT_TRUE(harness::ParseSuite(
+      head + "  - name: paper\n  - name: mine\n    external: {command: [./vo.sh, \"{dataset}\", "
+             "\"--calib={calib}\", \"{out}\"], trajectory: t.txt, format: tum, timeout_s: 5}\n",
+      "e.yaml", dir.str(), &suite, &error))
+      << error;
+  ASSERT_EQ(suite.configs.size(), 2u);
+  EXPECT_FALSE(suite.configs[0].external);
+  const harness::SuiteConfig& c = suite.configs[1];
+  EXPECT_TRUE(c.external);
+  EXPECT_EQ(c.estimator.command[0], dir / "vo.sh");  // relative to the suite file
+  EXPECT_EQ(c.estimator.command[2], "--calib={calib}");
+  EXPECT_EQ(c.estimator.format, harness::TrajectoryFormat::kTum);
+  EXPECT_EQ(c.estimator.timeout_s, 5.0);
+  const auto runs = harness::ExpandSuite(suite);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_TRUE(runs[1].external);
+  EXPECT_EQ(runs[1].id, "l_hallway__mine__s1__k1");
+  EXPECT_NE(runs[0].spec_hash, runs[1].spec_hash);
+  // The program enters the hash as the suite file names it: the same suite in another folder
+  // (another machine's checkout) has the same hashes.
+  TempDir other("suite_ext_file_other");
+  fs::copy_file(dir / "vo.sh", other / "vo.sh");
+  harness::Suite moved;
+  ASSERT_TRUE(harness::ParseSuite(
+      head + "  - name: paper\n  - name: mine\n    external: {command: [./vo.sh, \"{dataset}\", "
+             "\"--calib={calib}\", \"{out}\"], trajectory: t.txt, format: tum, timeout_s: 5}\n",
+      "e.yaml", other.str(), &moved, &error))
+      << error;
+  EXPECT_EQ(moved.configs[1].estimator.command[0], other / "vo.sh");
+  EXPECT_EQ(harness::ExpandSuite(moved)[1].spec_hash, runs[1].spec_hash);
+
+  struct Bad {
+    std::string config;
+    std::vector<std::string> expected;
+  };
+  const std::vector<Bad> bad = {
+      {"  - name: x\n    external: {command: [vo.sh, \"{data}\"], trajectory: t, format: tum}\n",
+       {"e.yaml:6", "configs[0].external.command[1]", "unknown placeholder {data}"}},
+      {"  - name: x\n    set: {ba_window_frames: 4}\n    external: {command: [vo.sh], "
+       "trajectory: t, format: tum}\n",
+       {"e.yaml:6", "configs[0].set", "not with external"}},
+      {"  - name: x\n    external: {command: [vo.sh], format: tum}\n",
+       {"e.yaml:6", "configs[0].external.trajectory"}},
+      {"  - name: x\n    external: {command: [vo.sh], trajectory: t, format: g2o}\n",
+       {"e.yaml:6", "configs[0].external.format", "g2o"}},
+      {"  - name: x\n    external: {command: [./none.sh], trajectory: t, format: kitti}\n",
+       {"e.yaml:6", "configs[0].external.command[0]", "no executable program"}},
+      {"  - name: x\n    external: {command: [vo.sh], trajectory: ../t, format: kitti}\n",
+       {"e.yaml:6", "configs[0].external.trajectory", "relative to {out}"}},
+      {"  - name: x\n    external: {command: [], trajectory: t, format: kitti}\n",
+       {"e.yaml:6", "configs[0].external.command", "expected a list"}},
+      {"  - name: x\n    external: {command: [vo.sh], trajectory: t, format: kitti, "
+       "timeout_s: 0}\n",
+       {"e.yaml:6", "configs[0].external.timeout_s"}},
+      {"  - name: x\n    external: {command: [vo.sh], trajectory: t, format: kitti, shell: 1}\n",
+       {"e.yaml:6", "shell", "unknown key"}},
+  };
+  for (const Bad& b : bad) {
+    EXPECT_FALSE(harness::ParseSuite(head + b.config, "e.yaml", dir.str(), &suite, &error))
+        << b.config;
+    for (const auto& e : b.expected)
+      EXPECT_NE(error.find(e), std::string::npos) << "'" << e << "' not in: " << error;
+  }
 }
 
 TEST(ShardTest, ParsesAndPartitionsTheRuns) {
@@ -512,6 +587,149 @@ TEST(SuiteFailureTest, AFailedRunIsRecordedAndTheOthersGoOn) {
   EXPECT_NE(csv.find("broken__paper__s1__k1,broken,paper,1,1,4,failed"), std::string::npos) << csv;
   EXPECT_NE(csv.find("l_hallway__paper__s1__k1,l_hallway,paper,1,1,4,ok,4,1,"), std::string::npos)
       << csv;
+}
+
+// Issue #36: the built-in VO and external programs side by side. The stand-in estimators write
+// the dataset's ground truth as their trajectory (KITTI and TUM): they must score 0; one fails,
+// one outlives its timeout. Stride 2 of 4 source frames: the programs see 2 frames.
+TEST(SuiteExternalTest, ExternalProgramsRunBesideTheBuiltInVo) {
+  TempDir dir("suite_ext");
+  const std::vector<std::pair<std::string, std::string>> scripts = {
+      {"gt_kitti.sh", "#!/bin/sh\ncp \"$1/poses.txt\" \"$2/traj_kitti.txt\"\n"},
+      {"gt_tum.sh",
+       "#!/bin/sh\ntest -f \"$3\" && test -d \"$1/mav0/cam0\" && cp \"$1/groundtruth_tum.txt\" "
+       "\"$2/traj.txt\"\n"},
+      {"fails.sh", "#!/bin/sh\necho 'no features in frame 0'\nexit 3\n"},
+      {"slow.sh", "#!/bin/sh\necho 'thinking'\nsleep 60\n"},
+  };
+  for (const auto& [name, text] : scripts) {
+    WriteText(dir / name, text);
+    fs::permissions(dir / name, fs::perms::owner_all);
+  }
+  WriteText(dir / "suite.yaml",
+            "name: ext\nmax_frames: 4\nstrides: [2]\nscenarios:\n  - scenario: l_hallway\n"
+            "configs:\n  - name: paper\n"
+            "  - name: kitti\n    external: {command: [./gt_kitti.sh, \"{dataset}\", \"{out}\"], "
+            "trajectory: traj_kitti.txt, format: kitti}\n"
+            "  - name: tum\n    external: {command: [./gt_tum.sh, \"{euroc}\", \"{out}\", "
+            "\"{calib}\"], trajectory: traj.txt, format: tum}\n"
+            "  - name: fails\n    external: {command: [./fails.sh], trajectory: t.txt, "
+            "format: kitti}\n"
+            "  - name: slow\n    external: {command: [./slow.sh], trajectory: t.txt, "
+            "format: kitti, timeout_s: 0.5}\n");
+  const std::string out = dir / "out";
+  const auto start = std::chrono::steady_clock::now();
+  const auto r = RunVobench("suite " + (dir / "suite.yaml") + " -q -j 2 --out " + out);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 50.0);
+  EXPECT_EQ(r.exit_code, 1) << r.output;  // two runs failed; the suite itself did not
+  EXPECT_NE(r.output.find("3 ok (3 run now, 0 kept), 2 failed"), std::string::npos) << r.output;
+  for (const char* config : {"kitti", "tum"}) {
+    const std::string run = out + "/runs/l_hallway__" + config + "__s1__k2";
+    const nlohmann::json m = nlohmann::json::parse(ReadAll(run + "/metrics.json"));
+    EXPECT_EQ(m.at("frames"), 2) << config;
+    EXPECT_EQ(m.at("frame_stride"), 2) << config;
+    EXPECT_EQ(m.at("ground_truth_frames"), 2) << config;
+    EXPECT_GT(m.at("path_length_m").get<double>(), 0.0) << config;
+    EXPECT_LT(m.at("end_pose_error_m").get<double>(), 1e-12) << config;
+    EXPECT_LT(m.at("ate_rmse_m").get<double>(), 1e-12) << config;
+    EXPECT_GT(m.at("command_wall_s").get<double>(), 0.0) << config;
+    EXPECT_GT(m.at("command_peak_rss_mb").get<double>(), 0.0) << config;
+    EXPECT_TRUE(harness::HasFolderMarker(run, "run")) << config;
+    EXPECT_FALSE(fs::exists(run + "/dataset")) << config;  // the images are not kept
+  }
+  const std::string fails = ReadAll(out + "/runs/l_hallway__fails__s1__k2.failed.txt");
+  EXPECT_NE(fails.find("exit status 3"), std::string::npos) << fails;
+  EXPECT_NE(fails.find("no features in frame 0"), std::string::npos) << fails;  // its log tail
+  const std::string slow = ReadAll(out + "/runs/l_hallway__slow__s1__k2.failed.txt");
+  EXPECT_NE(slow.find("timed out after 0.5 s"), std::string::npos) << slow;
+  EXPECT_NE(slow.find("thinking"), std::string::npos) << slow;
+  EXPECT_FALSE(fs::exists(out + "/tmp"));
+  // summary.csv: a row per run, beside each other; an external row has no built-in VO columns.
+  const std::string csv = ReadAll(out + "/summary.csv");
+  EXPECT_NE(csv.find("l_hallway__paper__s1__k2,l_hallway,paper,1,2,4,ok,2,"), std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("l_hallway__kitti__s1__k2,l_hallway,kitti,1,2,4,ok,2,2,"), std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("l_hallway__slow__s1__k2,l_hallway,slow,1,2,4,failed"), std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find(",command_wall_s,command_peak_rss_mb,wall_s\n"), std::string::npos) << csv;
+
+  // Resume: the finished runs are kept, only the failed ones run again.
+  const auto again = RunVobench("suite " + (dir / "suite.yaml") + " -q -j 2 --out " + out);
+  EXPECT_EQ(again.exit_code, 1) << again.output;
+  EXPECT_NE(again.output.find("3 ok (0 run now, 3 kept), 2 failed"), std::string::npos)
+      << again.output;
+}
+
+// Shards split external runs as any other; the merge holds them, and the unsharded suite on the
+// merged folder finds every run finished.
+TEST(SuiteExternalTest, ShardsAndMergeHoldExternalRuns) {
+  TempDir dir("suite_ext_shards");
+  WriteText(dir / "gt.sh", "#!/bin/sh\ncp \"$1/poses.txt\" \"$2/t.txt\"\n");
+  fs::permissions(dir / "gt.sh", fs::perms::owner_all);
+  WriteText(dir / "suite.yaml",
+            "name: exts\nmax_frames: 4\nstrides: [1, 2]\nscenarios:\n  - scenario: l_hallway\n"
+            "configs:\n  - name: gt\n    external: {command: [./gt.sh, \"{dataset}\", \"{out}\"], "
+            "trajectory: t.txt, format: kitti}\n");
+  for (int i = 1; i <= 2; ++i) {
+    const auto r = RunVobench("suite " + (dir / "suite.yaml") + " -q --shard " + std::to_string(i) +
+                              "/2 --out " + (dir / ("s" + std::to_string(i))));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("1 ok (1 run now"), std::string::npos) << r.output;
+  }
+  const std::string merged = dir / "merged";
+  const auto m =
+      RunVobench("suite merge --out " + merged + " " + (dir / "s1") + " " + (dir / "s2"));
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  for (const char* id : {"l_hallway__gt__s1__k1", "l_hallway__gt__s1__k2"}) {
+    EXPECT_TRUE(fs::exists(merged + "/runs/" + id + "/metrics.json")) << id;
+    EXPECT_TRUE(fs::exists(merged + "/specs/" + id + ".external.json")) << id;
+  }
+  const auto again = RunVobench("suite " + (dir / "suite.yaml") + " -q --out " + merged);
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_NE(again.output.find("2 ok (0 run now, 2 kept)"), std::string::npos) << again.output;
+}
+
+// The strided sequence an external run sees, written from the whole sequence simulated once,
+// equals the one simulated at that stride: the same images, depth, stamps, calibration and rig
+// byte for byte, the ground truth to 1e-12.
+TEST(SuiteExternalTest, AStridedCopyEqualsTheSequenceSimulatedAtThatStride) {
+  TempDir dir("suite_ext_stride");
+  harness::ExternalRunSpec spec;
+  spec.scenario_path = sim::BuiltinScenarioPath("l_hallway");
+  spec.max_frames = 5;
+  spec.stride = 1;
+  std::string error;
+  ASSERT_TRUE(harness::WriteSequence(spec, dir / "full", &error)) << error;
+  spec.stride = 2;
+  ASSERT_TRUE(harness::WriteSequence(spec, dir / "direct", &error)) << error;
+  ASSERT_TRUE(harness::WriteStridedCopy(spec, dir / "full", dir / "copy", &error)) << error;
+  int files = 0, numbers = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "direct")) {
+    if (!e.is_regular_file() || e.path().filename() == harness::kFolderMarkerFile) continue;
+    const std::string rel = fs::relative(e.path(), dir / "direct").string();
+    const std::string a = ReadAll(e.path().string()), b = ReadAll(dir / ("copy/" + rel));
+    ++files;
+    if (rel != "poses.txt" && rel != "groundtruth_tum.txt" && rel != "T_world_cam0first.txt" &&
+        rel != "mav0/state_groundtruth_estimate0/data.csv") {
+      EXPECT_EQ(a, b) << rel;
+      continue;
+    }
+    std::istringstream sa(a), sb(b);
+    std::string ta, tb;
+    while (sa >> ta) {
+      ASSERT_TRUE(static_cast<bool>(sb >> tb)) << rel;
+      ++numbers;
+      if (ta == tb) continue;
+      std::replace(ta.begin(), ta.end(), ',', ' ');
+      std::replace(tb.begin(), tb.end(), ',', ' ');
+      std::istringstream na(ta), nb(tb);
+      for (double x, y; na >> x && nb >> y;) EXPECT_NEAR(x, y, 1e-12) << rel;
+    }
+    EXPECT_FALSE(static_cast<bool>(sb >> tb)) << rel;
+  }
+  EXPECT_GE(files, 3 * 3 + 6);  // 3 frames: left, right, depth (+ EuRoC images), text files
+  EXPECT_GE(numbers, 3 * 12);   // poses.txt at least
 }
 
 }  // namespace

@@ -385,6 +385,10 @@ std::vector<BadFile> BadFiles() {
        replace("name: tiny", "name: ../tiny"),
        {":1:", "tune name '../tiny': cannot name a folder: contains '..'"}},
       {"name like an option", replace("name: tiny", "name: -tiny"), {":1:", "starts with '-'"}},
+      // Issue #36: an external program's parameters are not this VO's options.
+      {"external program",
+       replace("name: tiny\n", "name: tiny\nconfigs:\n  - name: x\n    external: {}\n"),
+       {":3:", "'configs'", "external program's parameters cannot be tuned"}},
   };
 }
 
