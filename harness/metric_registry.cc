@@ -203,7 +203,9 @@ std::vector<MetricInfo> MakeRegistry() {
   return r;
 }
 
-bool Written(const MetricInfo& m, const RunSummary& s) {
+}  // namespace
+
+bool MetricWritten(const MetricInfo& m, const RunSummary& s) {
   if (m.reason && m.value(s).get<std::string>().empty()) return false;  // the figure applies
   switch (m.group) {
     case MetricGroup::kAccuracy:
@@ -214,8 +216,6 @@ bool Written(const MetricInfo& m, const RunSummary& s) {
       return true;
   }
 }
-
-}  // namespace
 
 const std::vector<MetricInfo>& RunMetrics() {
   static const std::vector<MetricInfo> kRegistry = MakeRegistry();
@@ -232,7 +232,7 @@ std::string MetricsJson(const RunSummary& s) {
   json j;
   j["name"] = s.name;
   for (const MetricInfo& m : RunMetrics()) {
-    if (!Written(m, s)) continue;
+    if (!MetricWritten(m, s)) continue;
     const size_t dot = m.key.find('.');
     if (dot == std::string::npos)
       j[m.key] = m.value(s);

@@ -48,6 +48,10 @@ const std::vector<MetricInfo>& RunMetrics();
 const MetricInfo* FindMetric(const std::string& key);
 
 // The summary as metrics.json text (the registry's keys in order; "name" first).
+// Whether metrics.json holds `m` for `summary`: a reason only beside its null figure, accuracy
+// only with ground truth, the VO's match precision only where it was measured.
+bool MetricWritten(const MetricInfo& m, const RunSummary& summary);
+
 std::string MetricsJson(const RunSummary& summary);
 // The value of a metric in a parsed metrics.json (dotted keys looked up nested); null when
 // the file does not have it. Json: nlohmann::json or nlohmann::ordered_json.

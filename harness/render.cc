@@ -10,21 +10,28 @@ namespace harness {
 
 namespace fs = std::filesystem;
 
+DatasetWriter::Options ScenarioWriterOptions(const sim::Scenario& scenario,
+                                             const Eigen::Isometry3d& T_body_cam0) {
+  DatasetWriter::Options options;
+  options.T_body_cam0 = T_body_cam0;
+  options.rate_hz = scenario.rate_hz;
+  options.stamp_offset_ns = kSimulationEpochNs;  // EuRoC/TUM stamps: 19 digits from 2026-01-01
+  options.write_rig = true;
+  options.rig.forward_m = scenario.camera.forward_m;
+  options.rig.height_m = scenario.camera.height_m;
+  options.rig.pitch_deg = scenario.camera.pitch_deg;
+  return options;
+}
+
 bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
                     const RenderOptions& options, RenderSummary* summary, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
-  DatasetWriter::Options wopt;
+  DatasetWriter::Options wopt =
+      ScenarioWriterOptions(scenario, simulator->calibration().T_body_cam0);
   wopt.format = options.format;
   wopt.overwrite = options.overwrite;
-  wopt.T_body_cam0 = simulator->calibration().T_body_cam0;
-  wopt.rate_hz = scenario.rate_hz;
-  wopt.stamp_offset_ns = kSimulationEpochNs;  // EuRoC/TUM stamps: 19 digits from 2026-01-01
-  wopt.write_rig = true;
-  wopt.rig.forward_m = scenario.camera.forward_m;
-  wopt.rig.height_m = scenario.camera.height_m;
-  wopt.rig.pitch_deg = scenario.camera.pitch_deg;
   DatasetWriter writer(wopt);
   if (!writer.Open(out_dir, ToStereoCamera(simulator->calibration()), error)) return false;
 

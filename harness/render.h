@@ -30,6 +30,13 @@ struct RenderOptions {
 };
 
 // Renders `scenario` into `out_dir` (atomically: nothing is left at out_dir on failure).
+// The dataset writer's options for frames simulated from `scenario` (every writer of simulated
+// frames: render, a suite's sequence for an external estimator): the rig's mounting, the frame
+// rate, and the EuRoC/TUM stamps on the simulation epoch (kSimulationEpochNs: 19 digits, names
+// that sort). The caller sets the format (and overwrite, a stride's rate).
+DatasetWriter::Options ScenarioWriterOptions(const sim::Scenario& scenario,
+                                             const Eigen::Isometry3d& T_body_cam0);
+
 bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
                     const RenderOptions& options, RenderSummary* summary, std::string* error);
 

@@ -132,7 +132,7 @@ std::string ScoreMetricsJson(const ScoreResult& r) {
   if (r.format == TrajectoryFormat::kTum) j["max_difference_s"] = r.max_difference_s;
   j["ground_truth_frames"] = r.summary.ground_truth_frames;
   for (const MetricInfo& m : RunMetrics())
-    if (m.group == MetricGroup::kAccuracy) {
+    if (m.group == MetricGroup::kAccuracy && MetricWritten(m, r.summary)) {
       const size_t dot = m.key.find('.');  // "a.b" nested, as metrics.json writes it
       if (dot == std::string::npos)
         j[m.key] = m.value(r.summary);

@@ -24,6 +24,7 @@
 #include "harness/dataset/writer.h"
 #include "harness/interrupt.h"
 #include "harness/output_folder.h"
+#include "harness/render.h"
 #include "harness/sim_adapter.h"
 #include "harness/suite/child_process.h"
 #include "harness/suite/folder.h"
@@ -74,14 +75,9 @@ bool LockSequence(const fs::path& dir, FolderLock* lock, std::string* error) {
 // The writer's options for the sequence of `scenario` seen at `stride`.
 DatasetWriter::Options SequenceWriterOptions(const sim::Scenario& scenario, int stride,
                                              const Eigen::Isometry3d& T_body_cam0) {
-  DatasetWriter::Options options;
+  DatasetWriter::Options options = ScenarioWriterOptions(scenario, T_body_cam0);
   options.format = DatasetFormat::kEuroc;
-  options.T_body_cam0 = T_body_cam0;
   options.rate_hz = scenario.rate_hz / stride;
-  options.write_rig = true;
-  options.rig.forward_m = scenario.camera.forward_m;
-  options.rig.height_m = scenario.camera.height_m;
-  options.rig.pitch_deg = scenario.camera.pitch_deg;
   return options;
 }
 

@@ -101,9 +101,9 @@ TEST(ScoreTest, TumPosesAreAssociatedByTimeWithinTheMaxDifference) {
   EXPECT_NE(error.find("no time overlap"), std::string::npos) << error;
 }
 
-// A 40-frame run scored on its own files gives the run's accuracy figures: bit for bit from the
-// KITTI pair (the matrices are written exactly), to 1e-9 from the TUM pair (the rotation is
-// written as a quaternion).
+// A 40-frame run scored on its own files gives the run's accuracy figures: to 1e-12 from the
+// KITTI pair (written relative to the first pose, so rounded once more), to 1e-9 from the TUM
+// pair (the rotation is written as a quaternion).
 TEST(ScoreTest, ARunFoldersFilesGiveTheRunsAccuracyFigures) {
   TempDir dir("score_run");
   const std::string run = dir / "run";
@@ -127,12 +127,21 @@ TEST(ScoreTest, ARunFoldersFilesGiveTheRunsAccuracyFigures) {
       ++keys;
       const json* a = harness::FindMetricValue(run_metrics, m.key);
       const json* b = harness::FindMetricValue(scored, m.key);
+      if (m.reason) {  // written only beside its null figure: in both or in neither
+        EXPECT_EQ(a == nullptr, b == nullptr) << m.key;
+        if (a != nullptr && b != nullptr) {
+          EXPECT_EQ(*a, *b) << m.key;
+        }
+        continue;
+      }
       ASSERT_TRUE(a != nullptr && b != nullptr) << m.key;
-      if (format == "kitti") {
-        EXPECT_EQ(a->dump(), b->dump()) << m.key;  // the same double, bit for bit
+      if (a->is_null() || b->is_null()) {  // not applicable: in both
+        EXPECT_TRUE(a->is_null() && b->is_null()) << m.key;
       } else {
+        // The run computes on its world-frame poses; the KITTI files start at the identity
+        // (issue #33) and the TUM ones write the rotation as a quaternion: equal to rounding.
         const double x = a->get<double>(), y = b->get<double>();
-        EXPECT_NEAR(x, y, 1e-9 * std::max(1.0, std::abs(x))) << m.key;
+        EXPECT_NEAR(x, y, (format == "kitti" ? 1e-12 : 1e-9) * std::max(1.0, std::abs(x))) << m.key;
       }
     }
     EXPECT_GE(keys, 10);
