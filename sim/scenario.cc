@@ -309,11 +309,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
       r.ok() && !imu.empty() && s.physics_dt_s > 0 && s.physics_dt_s <= 0.01) {
     // At the imu key's line, else at physics_dt_s (a step that the default rate does not fit).
     YAML::Node n = root["imu"];  // not const: a missing key reads as undefined
-    const YAML::Node at = n.IsDefined() ? n[key.substr(4)] : YAML::Node();
-    r.Fail(at.IsDefined()                     ? at
-           : root["physics_dt_s"].IsDefined() ? root["physics_dt_s"]
-                                              : root,
-           key, imu);
+    const bool at_key = n.IsDefined() && n[key.substr(4)].IsDefined();
+    const bool at_step = root["physics_dt_s"].IsDefined();
+    r.Fail(at_key ? n[key.substr(4)] : at_step ? root["physics_dt_s"] : root, key, imu);
   }
   if (r.ok() && s.physics_dt_s > 0 && s.physics_dt_s <= 0.01) {
     // Rate vs step, exposure vs period: at the line of the key to change.

@@ -264,7 +264,7 @@ TEST_F(ScenarioFileTest, ImuRateMustBeAWholeNumberOfPhysicsSteps) {
   EXPECT_EQ(Load(std::string(kGood) + "physics_dt_s: 0.001\nimu:\n  rate_hz: 200\n", &s), "");
   EXPECT_EQ(s.imu.rate_hz, 200.0);
   // A physics step the default rate does not fit is blamed on physics_dt_s's line.
-  const std::string step = Load(std::string(kGood) + "physics_dt_s: 0.003\n");
+  const std::string step = Load(std::string(kGood) + "physics_dt_s: 0.0025\n");
   EXPECT_NE(step.find("s.yaml:12: key 'imu.rate_hz'"), std::string::npos) << step;
   const std::string above = Load(std::string(kGood) + "imu:\n  rate_hz: 1000\n");
   EXPECT_NE(above.find("key 'imu.rate_hz': 1000 Hz is above the physics rate"), std::string::npos)
