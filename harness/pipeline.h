@@ -47,6 +47,13 @@ struct StereoSequence {
   // camera.pitch_deg, rig.yaml); NaN = unknown. A ground vehicle takes its up from it when the
   // first frame shows no floor or ceiling (vo::ResolvePlatform).
   double camera_pitch_deg = std::numeric_limits<double>::quiet_NaN();
+  // An IMU: the frames carry its samples since the previous frame (DatasetFrame::imu). A
+  // simulated scenario always has one (its imu keys, the IMU's pose on the rig); a EuRoC folder
+  // when mav0/imu0/data.csv is there (then imu holds the defaults, T_imu_cam0 the identity).
+  // The VO does not use it yet.
+  bool has_imu = false;
+  sim::ImuOptions imu;                                           // rate and noise numbers
+  Eigen::Isometry3d T_imu_cam0 = Eigen::Isometry3d::Identity();  // cam0 in the IMU frame
 };
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).

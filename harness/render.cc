@@ -18,7 +18,10 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
   DatasetWriter::Options wopt;
   wopt.format = options.format;
   wopt.overwrite = options.overwrite;
-  wopt.T_body_cam0 = simulator->calibration().T_body_cam0;
+  // EuRoC's body frame is the IMU's (dataset/euroc_imu.h); the KITTI/TUM layouts ignore it.
+  wopt.T_body_cam0 =
+      CameraInImuFrame(simulator->calibration().T_body_cam0, simulator->calibration().T_body_imu);
+  wopt.imu = scenario.imu;
   wopt.rate_hz = scenario.rate_hz;
   wopt.write_rig = true;
   wopt.rig.forward_m = scenario.camera.forward_m;

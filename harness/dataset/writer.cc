@@ -7,6 +7,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "harness/dataset/euroc_imu.h"
 #include "harness/dataset/internal.h"
 #include "harness/trajectory_io.h"
 
@@ -239,6 +240,8 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
   times_s_.push_back(frame.time_s);
   times_ns_.push_back(t_ns);
   if (has_gt_) T_world_cam0_.push_back(frame.T_world_cam0);
+  if (options_.format == DatasetFormat::kEuroc)
+    imu_.insert(imu_.end(), frame.imu.begin(), frame.imu.end());
   return true;
 }
 
@@ -266,6 +269,8 @@ bool DatasetWriter::WriteEurocText(std::string* error) const {
                        EurocSensorYaml(comments[cam], T_body_cam[cam], camera_, rate_hz), error))
       return false;
   }
+  // With an IMU: imu0/, body.yaml and the ground truth at the IMU rate instead (euroc_imu.h).
+  if (!imu_.empty()) return WriteEurocImu(Join(partial_dir_, "mav0"), imu_, options_.imu, error);
   if (!has_gt_) return true;
 
   // Ground truth: body pose in the world, velocity by finite differences, zero biases.

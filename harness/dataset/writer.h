@@ -45,6 +45,10 @@ class DatasetWriter {
                              // frame interval, rounded to 1 mHz
     bool write_rig = false;  // write rig.yaml (the camera's mounting, harness/dataset/rig.h)
     RigMounting rig;         // with write_rig
+    // EuRoC: the IMU's rate and noise numbers for imu0/sensor.yaml. When the frames carry IMU
+    // samples (DatasetFrame::imu), kEuroc writes imu0/ and the ground truth at the IMU rate
+    // (dataset/euroc_imu.h); T_body_cam0 is then cam0 in the IMU frame (CameraInImuFrame).
+    sim::ImuOptions imu;
 
     bool IsValid(std::string* error) const;
   };
@@ -87,6 +91,7 @@ class DatasetWriter {
   std::vector<double> times_s_;
   std::vector<int64_t> times_ns_;
   std::vector<Eigen::Isometry3d> T_world_cam0_;  // one per frame when has_gt_
+  std::vector<sim::ImuSample> imu_;              // the frames' IMU samples (kEuroc)
   std::vector<int> compression_params_;
 };
 
