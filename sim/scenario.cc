@@ -77,6 +77,17 @@ std::string ImuProblem(const Scenario& s, std::string* key) {
       *key = std::string("imu.") + name;
       return "expected a finite number >= 0, got " + Num(v);
     }
+  const std::pair<const char*, double> pose[] = {{"x_m", o.x_m},
+                                                 {"y_m", o.y_m},
+                                                 {"z_m", o.z_m},
+                                                 {"roll_deg", o.roll_deg},
+                                                 {"pitch_deg", o.pitch_deg},
+                                                 {"yaw_deg", o.yaw_deg}};
+  for (const auto& [name, v] : pose)
+    if (!std::isfinite(v)) {
+      *key = std::string("imu.") + name;
+      return "expected a finite number, got " + Num(v);
+    }
   *key = "imu.rate_hz";
   if (!(o.rate_hz > 0) || !(s.physics_dt_s > 0)) return "expected > 0 Hz, got " + Num(o.rate_hz);
   const double steps = 1.0 / (o.rate_hz * s.physics_dt_s);

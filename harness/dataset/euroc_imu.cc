@@ -51,7 +51,8 @@ Eigen::Isometry3d CameraInImuFrame(const Eigen::Isometry3d& T_body_cam,
 }
 
 bool WriteEurocImu(const std::string& mav0, const std::vector<sim::ImuSample>& samples,
-                   const sim::ImuOptions& imu, std::string* error) {
+                   const sim::ImuOptions& imu, bool* wrote_ground_truth, std::string* error) {
+  *wrote_ground_truth = false;
   std::string data = std::string(kImuHeader) + "\n", gt = std::string(kGroundTruthHeader) + "\n";
   bool has_gt = !samples.empty();
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -105,6 +106,7 @@ bool WriteEurocImu(const std::string& mav0, const std::vector<sim::ImuSample>& s
                      error))
     return false;
   if (!has_gt) return true;
+  *wrote_ground_truth = true;
   const std::string gt_dir = Join(mav0, "state_groundtruth_estimate0");
   return MakeDir(gt_dir, error) && WriteTextFile(Join(gt_dir, "data.csv"), gt, error) &&
          WriteTextFile(Join(gt_dir, "sensor.yaml"),

@@ -26,11 +26,11 @@ namespace harness {
 Eigen::Isometry3d CameraInImuFrame(const Eigen::Isometry3d& T_body_cam,
                                    const Eigen::Isometry3d& T_body_imu);
 
-// Writes imu0/, state_groundtruth_estimate0/ (at the IMU rate, from the samples' ground truth;
-// samples without one give no ground truth) and body.yaml under `mav0`. Sample times are
-// seconds from the first frame, as the frames' (t_ns = TimeToNs(time_s)); they must increase.
+// Writes imu0/, body.yaml and, when every sample has its ground truth, state_groundtruth_estimate0/
+// at the IMU rate under `mav0`; *wrote_ground_truth says which. Sample times are the frames'
+// clock (t_ns = TimeToNs(time_s)); they must increase.
 bool WriteEurocImu(const std::string& mav0, const std::vector<sim::ImuSample>& samples,
-                   const sim::ImuOptions& imu, std::string* error);
+                   const sim::ImuOptions& imu, bool* wrote_ground_truth, std::string* error);
 
 // Reads an imu0/data.csv: a header (comment lines), then 7 numbers a line (stamp in ns, gyro xyz
 // in rad/s, accelerometer xyz in m/s^2), stamps strictly increasing, values finite. Errors name

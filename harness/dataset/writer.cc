@@ -270,8 +270,11 @@ bool DatasetWriter::WriteEurocText(std::string* error) const {
       return false;
   }
   // With an IMU: imu0/, body.yaml and the ground truth at the IMU rate instead (euroc_imu.h).
-  if (!imu_.empty()) return WriteEurocImu(Join(partial_dir_, "mav0"), imu_, options_.imu, error);
-  if (!has_gt_) return true;
+  bool imu_ground_truth = false;
+  if (!imu_.empty() &&
+      !WriteEurocImu(Join(partial_dir_, "mav0"), imu_, options_.imu, &imu_ground_truth, error))
+    return false;
+  if (!has_gt_ || imu_ground_truth) return true;
 
   // Ground truth: body pose in the world, velocity by finite differences, zero biases.
   const std::string gt_dir = Join(partial_dir_, "mav0/state_groundtruth_estimate0");

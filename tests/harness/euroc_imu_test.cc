@@ -204,5 +204,38 @@ TEST_F(EurocImuTest, WrittenAndReadBackWithTheDatasetWriterAndReader) {
   }
 }
 
+// Frames whose IMU samples carry no ground truth (a dataset's, re-written) keep the frames'
+// ground truth at the frame rate; imu0/ is written all the same.
+TEST_F(EurocImuTest, SamplesWithoutGroundTruthLeaveTheFramesGroundTruth) {
+  vo::StereoCamera camera;
+  camera.width = 32;
+  camera.height = 24;
+  camera.fx_px = camera.fy_px = 30;
+  camera.cx_px = 15.5;
+  camera.cy_px = 11.5;
+  camera.baseline_m = 0.1;
+  DatasetWriter::Options options;
+  options.format = DatasetFormat::kEuroc;
+  const std::string dir = (root_ / "euroc").string();
+  DatasetWriter writer(options);
+  std::string error;
+  ASSERT_TRUE(writer.Open(dir, camera, &error)) << error;
+  for (int i = 0; i < 2; ++i) {
+    DatasetFrame f;
+    f.time_s = 0.1 * i;
+    f.left = cv::Mat(24, 32, CV_8UC1, cv::Scalar(0));
+    f.right = f.left.clone();
+    f.has_gt = true;
+    sim::ImuSample s;
+    s.time_s = f.time_s;
+    f.imu.push_back(s);
+    ASSERT_TRUE(writer.Add(f, &error)) << error;
+  }
+  ASSERT_TRUE(writer.Finish(&error)) << error;
+  EXPECT_TRUE(fs::exists(dir + "/mav0/imu0/data.csv"));
+  const std::string gt = ReadAll(dir + "/mav0/state_groundtruth_estimate0/data.csv");
+  EXPECT_EQ(std::count(gt.begin(), gt.end(), '\n'), 3);  // header + the 2 frames
+}
+
 }  // namespace
 }  // namespace harness

@@ -297,6 +297,15 @@ TEST_F(ScenarioFileTest, ImuKeysAreCheckedAndRoundTrip) {
   EXPECT_NE(unknown.find("gyro_noise_density"), std::string::npos) << unknown;
   const std::string nan = Load(std::string(kGood) + "imu:\n  z_m: .nan\n");
   EXPECT_NE(nan.find("imu.z_m"), std::string::npos) << nan;
+  // Scenarios built in code are checked the same way (Simulator::Create calls IsValid).
+  std::string why;
+  s.imu.yaw_deg = std::nan("");
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_NE(why.find("imu.yaw_deg: expected a finite number"), std::string::npos) << why;
+  s.imu.yaw_deg = 0.0;
+  s.imu.rate_hz = 300.0;
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_NE(why.find("imu.rate_hz: the sample period"), std::string::npos) << why;
 }
 
 }  // namespace
