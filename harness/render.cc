@@ -18,15 +18,21 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
   DatasetWriter::Options wopt;
   wopt.format = options.format;
   wopt.overwrite = options.overwrite;
-  // EuRoC's body frame is the IMU's (dataset/euroc_imu.h); the KITTI/TUM layouts ignore it.
-  wopt.T_body_cam0 =
-      CameraInImuFrame(simulator->calibration().T_body_cam0, simulator->calibration().T_body_imu);
+  wopt.T_body_cam0 = simulator->calibration().T_body_cam0;
+  wopt.T_body_imu = simulator->calibration().T_body_imu;  // EuRoC's body with the IMU
   wopt.imu = scenario.imu;
   wopt.rate_hz = scenario.rate_hz;
   wopt.write_rig = true;
   wopt.rig.forward_m = scenario.camera.forward_m;
   wopt.rig.height_m = scenario.camera.height_m;
   wopt.rig.pitch_deg = scenario.camera.pitch_deg;
+  wopt.rig.has_imu = true;
+  wopt.rig.imu_x_m = scenario.imu.x_m;
+  wopt.rig.imu_y_m = scenario.imu.y_m;
+  wopt.rig.imu_z_m = scenario.imu.z_m;
+  wopt.rig.imu_roll_deg = scenario.imu.roll_deg;
+  wopt.rig.imu_pitch_deg = scenario.imu.pitch_deg;
+  wopt.rig.imu_yaw_deg = scenario.imu.yaw_deg;
   DatasetWriter writer(wopt);
   if (!writer.Open(out_dir, ToStereoCamera(simulator->calibration()), error)) return false;
 

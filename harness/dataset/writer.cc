@@ -116,6 +116,8 @@ bool DatasetWriter::Options::IsValid(std::string* error) const {
     return Fail(error, "png_compression must be in [0, 9], got " + std::to_string(png_compression));
   if (!T_body_cam0.matrix().allFinite() || !IsRotation(T_body_cam0.linear(), kRotationTolerance))
     return Fail(error, "T_body_cam0 must be finite with a rotation in its linear part");
+  if (!T_body_imu.matrix().allFinite() || !IsRotation(T_body_imu.linear(), kRotationTolerance))
+    return Fail(error, "T_body_imu must be finite with a rotation in its linear part");
   if (!std::isfinite(rate_hz) || rate_hz < 0.0)
     return Fail(error, "rate_hz must be finite and >= 0, got " + FormatDouble(rate_hz));
   std::string why;
@@ -256,8 +258,11 @@ bool DatasetWriter::WriteEurocText(std::string* error) const {
   }
   Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
   T_cam0_cam1.translation() = Eigen::Vector3d(camera_.baseline_m, 0.0, 0.0);
-  const Eigen::Isometry3d T_body_cam[2] = {options_.T_body_cam0,
-                                           options_.T_body_cam0 * T_cam0_cam1};
+  // With IMU samples EuRoC's body frame is the IMU's (dataset/euroc_imu.h).
+  const Eigen::Isometry3d T_body_cam0 =
+      imu_.empty() ? options_.T_body_cam0
+                   : CameraInImuFrame(options_.T_body_cam0, options_.T_body_imu);
+  const Eigen::Isometry3d T_body_cam[2] = {T_body_cam0, T_body_cam0 * T_cam0_cam1};
   const char* comments[2] = {"vobench cam0 (left)", "vobench cam1 (right)"};
   for (int cam = 0; cam < 2; ++cam) {
     const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));
@@ -279,7 +284,7 @@ bool DatasetWriter::WriteEurocText(std::string* error) const {
   // Ground truth: body pose in the world, velocity by finite differences, zero biases.
   const std::string gt_dir = Join(partial_dir_, "mav0/state_groundtruth_estimate0");
   if (!MakeDir(gt_dir, error)) return false;
-  const Eigen::Isometry3d T_cam0_body = options_.T_body_cam0.inverse();
+  const Eigen::Isometry3d T_cam0_body = T_body_cam0.inverse();
   std::vector<Eigen::Isometry3d> T_world_body(n);
   for (size_t i = 0; i < n; ++i) T_world_body[i] = T_world_cam0_[i] * T_cam0_body;
   std::string csv = std::string(kEurocGroundTruthHeader) + "\n";

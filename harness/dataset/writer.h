@@ -45,10 +45,12 @@ class DatasetWriter {
                              // frame interval, rounded to 1 mHz
     bool write_rig = false;  // write rig.yaml (the camera's mounting, harness/dataset/rig.h)
     RigMounting rig;         // with write_rig
-    // EuRoC: the IMU's rate and noise numbers for imu0/sensor.yaml. When the frames carry IMU
-    // samples (DatasetFrame::imu), kEuroc writes imu0/ and the ground truth at the IMU rate
-    // (dataset/euroc_imu.h); T_body_cam0 is then cam0 in the IMU frame (CameraInImuFrame).
+    // EuRoC with an IMU: when the frames carry IMU samples (DatasetFrame::imu), kEuroc writes
+    // imu0/ (its sensor.yaml with these rate and noise numbers) and the ground truth at the IMU
+    // rate, and EuRoC's body frame is the IMU's: the cameras' T_BS are CameraInImuFrame(
+    // T_body_cam0, T_body_imu) (dataset/euroc_imu.h), T_body_imu the IMU on the same body.
     sim::ImuOptions imu;
+    Eigen::Isometry3d T_body_imu = Eigen::Isometry3d::Identity();
 
     bool IsValid(std::string* error) const;
   };
