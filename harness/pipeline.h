@@ -49,7 +49,8 @@ struct StereoSequence {
   double camera_pitch_deg = std::numeric_limits<double>::quiet_NaN();
   // An IMU: the frames carry its samples since the previous frame (DatasetFrame::imu). A
   // simulated scenario always has one (its imu keys, the IMU's pose on the rig); a EuRoC folder
-  // when mav0/imu0/data.csv is there (then imu holds the defaults, T_imu_cam0 the identity).
+  // when mav0/imu0/data.csv is there (imu: its sensor.yaml's rate and noise numbers;
+  // T_imu_cam0 is not set there: EuRoC's cam0 T_BS is the raw camera's, not the rectified one's).
   // The VO does not use it yet.
   bool has_imu = false;
   sim::ImuOptions imu;                                           // rate and noise numbers

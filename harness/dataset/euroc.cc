@@ -212,6 +212,9 @@ bool EurocReader::Open(const std::string& dir, const Options& options, std::stri
   if (const std::string imu = Join(mav0, "imu0/data.csv");
       fs::exists(imu, ec) && !ReadEurocImu(imu, &imu_ns_, &imu_, error))
     return false;
+  if (const std::string yaml = Join(mav0, "imu0/sensor.yaml");
+      has_imu() && fs::exists(yaml, ec) && !ReadEurocImuSensorYaml(yaml, &imu_options_, error))
+    return false;
 
   // Ground truth (optional): the given file, else the first that exists.
   gt_index_.assign(t_ns_.size(), -1);

@@ -56,8 +56,10 @@ class EurocReader {
   const std::vector<StampedPose>& ground_truth_body() const { return gt_body_; }
   const std::string& ground_truth_path() const { return gt_path_; }  // "" when none
   size_t ground_truth_frames() const;  // frames with an associated ground-truth pose
-  // mav0/imu0/data.csv when present (euroc_imu.h): ReadFrame gives each frame its samples.
+  // mav0/imu0/data.csv when present (euroc_imu.h): ReadFrame gives each frame its samples;
+  // imu() the rate and noise numbers of imu0/sensor.yaml (sim::ImuOptions' defaults without it).
   bool has_imu() const { return !imu_.empty(); }
+  const sim::ImuOptions& imu() const { return imu_options_; }
 
   // The rectification of the pair (ComputeStereoRectification on cam0, cam1).
   bool Rectification(StereoRectification* rectification, std::string* error) const {
@@ -83,6 +85,7 @@ class EurocReader {
   size_t unpaired_ = 0;
   std::vector<int64_t> imu_ns_;      // imu0 stamps
   std::vector<sim::ImuSample> imu_;  // imu0 samples
+  sim::ImuOptions imu_options_;      // imu0/sensor.yaml
 };
 
 }  // namespace harness

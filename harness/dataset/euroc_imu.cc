@@ -7,6 +7,7 @@
 #include "harness/dataset/common.h"
 #include "harness/dataset/internal.h"
 #include "harness/trajectory_io.h"
+#include "sim/yaml_input.h"
 
 namespace harness {
 namespace {
@@ -148,6 +149,35 @@ bool ReadEurocImu(const std::string& path, std::vector<int64_t>* t_ns,
     samples->push_back(s);
   }
   if (samples->empty()) return Fail(error, path + ": no IMU samples");
+  return true;
+}
+
+bool ReadEurocImuSensorYaml(const std::string& path, sim::ImuOptions* imu, std::string* error) {
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, error)) return false;
+  std::string text;  // OpenCV's "%YAML:1.0", which yaml-cpp rejects, as an empty line
+  for (size_t i = 0; i < lines.size(); ++i)
+    text += (i == 0 && lines[i].rfind("%YAML:", 0) == 0 ? std::string() : lines[i]) + "\n";
+  sim::YamlReader r(path);
+  if (!r.Parse(text)) return r.Report(error);
+  YAML::Node root = r.root();  // not const: a missing key reads as undefined, not invalid
+  if (!r.ExpectMap(root, "", "a mapping (rate_hz, gyroscope_noise_density, ...)"))
+    return r.Report(error);
+  sim::ImuOptions o = *imu;
+  const std::pair<const char*, double*> keys[] = {
+      {"rate_hz", &o.rate_hz},
+      {"gyroscope_noise_density", &o.gyro_noise_density},
+      {"gyroscope_random_walk", &o.gyro_random_walk},
+      {"accelerometer_noise_density", &o.accel_noise_density},
+      {"accelerometer_random_walk", &o.accel_random_walk}};
+  for (const auto& [key, value] : keys) {
+    if (!r.Require(root, "", key, "a number") || !r.ReadDouble(root[key], key, value) ||
+        !r.Check(*value > 0.0 || (*value == 0.0 && key != keys[0].first), root, "", key,
+                 std::string(key == keys[0].first ? "expected > 0 Hz" : "expected >= 0") +
+                     ", got " + FormatDouble(*value)))
+      return r.Report(error);
+  }
+  *imu = o;
   return true;
 }
 

@@ -38,6 +38,12 @@ bool WriteEurocImu(const std::string& mav0, const std::vector<sim::ImuSample>& s
 bool ReadEurocImu(const std::string& path, std::vector<int64_t>* t_ns,
                   std::vector<sim::ImuSample>* samples, std::string* error);
 
+// Reads an imu0/sensor.yaml (a leading "%YAML:1.0" accepted): rate_hz (> 0) and
+// gyroscope_noise_density, gyroscope_random_walk, accelerometer_noise_density,
+// accelerometer_random_walk (finite, >= 0) into *imu, its pose fields untouched; the other keys
+// (T_BS, comment, ...) are not read. Errors name file:line and the key.
+bool ReadEurocImuSensorYaml(const std::string& path, sim::ImuOptions* imu, std::string* error);
+
 // The samples with stamps in (after_ns, up_to_ns] (sorted stamps), appended to *out.
 void ImuSamplesBetween(const std::vector<int64_t>& t_ns, const std::vector<sim::ImuSample>& samples,
                        int64_t after_ns, int64_t up_to_ns, std::vector<sim::ImuSample>* out);

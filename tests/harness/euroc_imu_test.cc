@@ -103,6 +103,32 @@ TEST_F(EurocImuTest, TheRealV101ImuIsRead) {
   EXPECT_NEAR(g, 9.81, 0.2);
 }
 
+TEST_F(EurocImuTest, TheRealV101SensorYamlIsReadAndABadOneRefused) {
+  const std::string path =
+      std::string(VOBENCH_SHARED_DATA_DIR) + "/euroc_v101_clip/mav0/imu0/sensor.yaml";
+  sim::ImuOptions imu;
+  std::string error;
+  if (fs::exists(path)) {
+    ASSERT_TRUE(ReadEurocImuSensorYaml(path, &imu, &error)) << error;
+    EXPECT_EQ(imu.rate_hz, 200.0);  // the ADIS16448's numbers
+    EXPECT_EQ(imu.gyro_noise_density, 1.6968e-04);
+    EXPECT_EQ(imu.gyro_random_walk, 1.9393e-05);
+    EXPECT_EQ(imu.accel_noise_density, 2.0e-3);
+    EXPECT_EQ(imu.accel_random_walk, 3.0e-3);
+  }
+  const std::string bad = (root_ / "sensor.yaml").string();
+  std::ofstream(bad) << "%YAML:1.0\nrate_hz: 200\ngyroscope_noise_density: -1\n";
+  EXPECT_FALSE(ReadEurocImuSensorYaml(bad, &imu, &error));
+  EXPECT_THAT(error, HasSubstr(bad + ":3: key 'gyroscope_noise_density': expected >= 0, got -1"))
+      << error;
+  std::ofstream(bad) << "%YAML:1.0\nrate_hz: 0\n";
+  EXPECT_FALSE(ReadEurocImuSensorYaml(bad, &imu, &error));
+  EXPECT_THAT(error, HasSubstr(bad + ":2: key 'rate_hz': expected > 0 Hz")) << error;
+  std::ofstream(bad) << "rate_hz: 200\n";
+  EXPECT_FALSE(ReadEurocImuSensorYaml(bad, &imu, &error));
+  EXPECT_THAT(error, HasSubstr("key 'gyroscope_noise_density': required")) << error;
+}
+
 TEST(EurocImuFrames, CameraInImuFrameIsTheCameraSeenFromTheImu) {
   Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity(), T_body_imu = T_body_cam;
   T_body_cam.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
@@ -195,6 +221,9 @@ TEST_F(EurocImuTest, WrittenAndReadBackWithTheDatasetWriterAndReader) {
   EurocReader reader;
   ASSERT_TRUE(reader.Open(dir, &error)) << error;
   EXPECT_TRUE(reader.has_imu());
+  EXPECT_EQ(reader.imu().rate_hz, 50.0);  // imu0/sensor.yaml read back
+  EXPECT_EQ(reader.imu().gyro_noise_density, 1.5e-4);
+  EXPECT_EQ(reader.imu().accel_random_walk, sim::ImuOptions().accel_random_walk);
   EXPECT_TRUE(reader.cam0().T_body_cam.isApprox(
       CameraInImuFrame(options.T_body_cam0, options.T_body_imu), 1e-12));
   EXPECT_EQ(reader.ground_truth_body().size(), static_cast<size_t>(k));
