@@ -7,6 +7,7 @@
 //   dataset/writer.h          DatasetWriter: the KITTI layout, plus EuRoC/ASL or TUM-style
 //   dataset/kitti.h           the KITTI odometry layout, ReadKittiCalib, KittiReader
 //   dataset/euroc.h           the EuRoC/ASL layout, ReadEurocSensorYaml, EurocReader (raw pairs)
+//   dataset/euroc_imu.h       EuRoC's imu0/ written and read, the ground truth at the IMU rate
 //   dataset/tum.h             the TUM-style stereo layout, TumReader
 //   dataset/rectification.h   raw pair -> the ideal rectified pair the VO expects (EuRoC)
 //
@@ -17,6 +18,7 @@
 
 #include "harness/dataset/common.h"
 #include "harness/dataset/euroc.h"
+#include "harness/dataset/euroc_imu.h"
 #include "harness/dataset/kitti.h"
 #include "harness/dataset/rectification.h"
 #include "harness/dataset/rig.h"

@@ -110,6 +110,8 @@ bool OpenEuroc(const std::string& dir, const EvalOptions& options, StereoSequenc
   info->rectified = !rectification->IsIdentity();
   info->camera = rectification->camera;
   sequence->camera = rectification->camera;
+  sequence->has_imu = reader->has_imu();
+  sequence->imu = reader->imu();
   sequence->expected_frames = static_cast<int>(reader->size());
   sequence->next = [reader, rectification, next = size_t{0}](DatasetFrame* frame,
                                                              std::string* err) mutable {

@@ -22,6 +22,10 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
   sequence->outline_scene = scenario.scene_path;
   sequence->axle_behind_camera_m = scenario.camera.forward_m;
   sequence->camera_pitch_deg = scenario.camera.pitch_deg;
+  sequence->has_imu = true;
+  sequence->imu = scenario.imu;
+  sequence->T_imu_cam0 =
+      CameraInImuFrame(simulator->calibration().T_body_cam0, simulator->calibration().T_body_imu);
   sequence->next = [simulator, f = sim::StereoFrame()](DatasetFrame* frame,
                                                        std::string* err) mutable {
     if (!simulator->Next(&f, err)) return false;

@@ -51,6 +51,14 @@ struct StereoSequence {
   // KITTI layout with T_world_cam0first.txt, EuRoC's and TUM's motion-capture worlds). Then a
   // run reports no initial-orientation error (RunSummary::initial_orientation_error_reason).
   std::string ground_truth_not_gravity_aligned;
+  // An IMU: the frames carry its samples since the previous frame (DatasetFrame::imu). A
+  // simulated scenario always has one (its imu keys, the IMU's pose on the rig); a EuRoC folder
+  // when mav0/imu0/data.csv is there (imu: its sensor.yaml's rate and noise numbers;
+  // T_imu_cam0 is not set there: EuRoC's cam0 T_BS is the raw camera's, not the rectified one's).
+  // The VO does not use it yet.
+  bool has_imu = false;
+  sim::ImuOptions imu;                                           // rate and noise numbers
+  Eigen::Isometry3d T_imu_cam0 = Eigen::Isometry3d::Identity();  // cam0 in the IMU frame
 };
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).

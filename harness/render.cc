@@ -20,6 +20,14 @@ DatasetWriter::Options ScenarioWriterOptions(const sim::Scenario& scenario,
   options.rig.forward_m = scenario.camera.forward_m;
   options.rig.height_m = scenario.camera.height_m;
   options.rig.pitch_deg = scenario.camera.pitch_deg;
+  options.imu = scenario.imu;
+  options.rig.has_imu = true;
+  options.rig.imu_x_m = scenario.imu.x_m;
+  options.rig.imu_y_m = scenario.imu.y_m;
+  options.rig.imu_z_m = scenario.imu.z_m;
+  options.rig.imu_roll_deg = scenario.imu.roll_deg;
+  options.rig.imu_pitch_deg = scenario.imu.pitch_deg;
+  options.rig.imu_yaw_deg = scenario.imu.yaw_deg;
   return options;
 }
 
@@ -32,6 +40,8 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
       ScenarioWriterOptions(scenario, simulator->calibration().T_body_cam0);
   wopt.format = options.format;
   wopt.overwrite = options.overwrite;
+  // EuRoC's body with the IMU: the cameras' T_BS relative to it, imu0/ from the frames' samples.
+  wopt.T_body_imu = simulator->calibration().T_body_imu;
   DatasetWriter writer(wopt);
   if (!writer.Open(out_dir, ToStereoCamera(simulator->calibration()), error)) return false;
 

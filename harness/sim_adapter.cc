@@ -41,6 +41,7 @@ DatasetFrame ToDatasetFrame(const sim::StereoFrame& f) {
   d.depth_m = f.depth_m;
   d.has_gt = true;
   d.T_world_cam0 = f.T_world_cam0;
+  d.imu = f.imu;
   return d;
 }
 

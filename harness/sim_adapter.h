@@ -4,7 +4,8 @@
 //
 //   ResolveScenario(arg)      a scenario file, or the name of one shipped in scenes/
 //   ToStereoCamera(calib)     sim::StereoCalibration -> vo::StereoCamera (pinhole, rectified)
-//   ToDatasetFrame(frame)     sim::StereoFrame -> DatasetFrame (images, depth, ground truth)
+//   ToDatasetFrame(frame)     sim::StereoFrame -> DatasetFrame (images, depth, ground truth,
+//                             the IMU samples since the previous frame)
 //
 // Pose conventions are already the VO's on the sim side (T_world_cam0, camera x right, y down,
 // z forward: the simulator converts from MuJoCo's cameras), so nothing is re-expressed here.

@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -98,6 +100,47 @@ double ShortestSegmentM(const std::vector<Eigen::Vector2d>& path) {
   return shortest;
 }
 
+// imu: the keys' own ranges and the sample period a whole number of physics steps (samples are
+// taken on steps): "" when fine, else the problem, and *key names the key to blame.
+std::string ImuProblem(const Scenario& s, std::string* key) {
+  const ImuOptions& o = s.imu;
+  std::ostringstream e;
+  const std::pair<const char*, double> densities[] = {
+      {"gyro_noise_density", o.gyro_noise_density},
+      {"gyro_random_walk", o.gyro_random_walk},
+      {"accel_noise_density", o.accel_noise_density},
+      {"accel_random_walk", o.accel_random_walk}};
+  for (const auto& [name, v] : densities)
+    if (!(v >= 0 && std::isfinite(v))) {
+      *key = std::string("imu.") + name;
+      return "expected a finite number >= 0, got " + Num(v);
+    }
+  const std::pair<const char*, double> pose[] = {{"x_m", o.x_m},
+                                                 {"y_m", o.y_m},
+                                                 {"z_m", o.z_m},
+                                                 {"roll_deg", o.roll_deg},
+                                                 {"pitch_deg", o.pitch_deg},
+                                                 {"yaw_deg", o.yaw_deg}};
+  for (const auto& [name, v] : pose)
+    if (!std::isfinite(v)) {
+      *key = std::string("imu.") + name;
+      return "expected a finite number, got " + Num(v);
+    }
+  *key = "imu.rate_hz";
+  if (!(o.rate_hz > 0) || !(s.physics_dt_s > 0)) return "expected > 0 Hz, got " + Num(o.rate_hz);
+  const double steps = 1.0 / (o.rate_hz * s.physics_dt_s);
+  const double whole = std::round(steps);
+  if (steps < 1.0 - kStepsPerFrameTolerance)
+    e << o.rate_hz << " Hz is above the physics rate 1/physics_dt_s = " << Num(1.0 / s.physics_dt_s)
+      << " Hz (a sample per physics step at most)";
+  else if (std::abs(steps - whole) > kStepsPerFrameTolerance * whole)
+    e << "the sample period 1/" << o.rate_hz << " s is " << Num(steps) << " physics steps of "
+      << s.physics_dt_s << " s; expected a whole number (samples are taken on physics steps), "
+      << "e.g. " << Num(1.0 / (std::floor(steps) * s.physics_dt_s)) << " or "
+      << Num(1.0 / (std::ceil(steps) * s.physics_dt_s)) << " Hz";
+  return e.str();
+}
+
 }  // namespace
 
 int EstimatedFrames(const Scenario& s) {
@@ -175,6 +218,8 @@ bool Scenario::IsValid(std::string* error) const {
       << noise.motion_blur_samples;
   else if (std::string key, physics = PhysicsProblem(*this, &key); !physics.empty())
     e << key << ": " << physics;
+  else if (std::string imu_key, imu = ImuProblem(*this, &imu_key); !imu.empty())
+    e << imu_key << ": " << imu;
   else {
     for (size_t i = 0; i < path.size(); ++i) {
       if (!path[i].allFinite()) {
@@ -212,7 +257,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   constexpr int kIntMax = std::numeric_limits<int>::max();
   r.CheckKeys(root, "",
               {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
-               "robot", "scene", "seed", "settle_s", "textures"});
+               "robot", "scene", "seed", "settle_s", "textures", "imu"});
   r.String(root, "", "name", &s.name);
   std::string scene;
   r.String(root, "", "scene", &scene);
@@ -304,6 +349,41 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   if (const YAML::Node n = root["textures"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(n, "textures", {"seed"});
     r.Uint64(n, "textures", "seed", &s.textures.seed);
+  }
+  if (const YAML::Node n = root["imu"]; n.IsDefined() && r.ok()) {
+    const char* keys[] = {"rate_hz",
+                          "gyro_noise_density",
+                          "gyro_random_walk",
+                          "accel_noise_density",
+                          "accel_random_walk",
+                          "x_m",
+                          "y_m",
+                          "z_m",
+                          "roll_deg",
+                          "pitch_deg",
+                          "yaw_deg"};
+    ImuOptions& o = s.imu;
+    double* values[] = {&o.rate_hz,
+                        &o.gyro_noise_density,
+                        &o.gyro_random_walk,
+                        &o.accel_noise_density,
+                        &o.accel_random_walk,
+                        &o.x_m,
+                        &o.y_m,
+                        &o.z_m,
+                        &o.roll_deg,
+                        &o.pitch_deg,
+                        &o.yaw_deg};
+    r.CheckKeys(n, "imu", std::vector<std::string>(std::begin(keys), std::end(keys)));
+    for (size_t i = 0; i < std::size(keys) && r.ok(); ++i) r.Double(n, "imu", keys[i], values[i]);
+  }
+  if (std::string key, imu = ImuProblem(s, &key);
+      r.ok() && !imu.empty() && s.physics_dt_s > 0 && s.physics_dt_s <= 0.01) {
+    // At the imu key's line, else at physics_dt_s (a step that the default rate does not fit).
+    YAML::Node n = root["imu"];  // not const: a missing key reads as undefined
+    const bool at_key = n.IsDefined() && n[key.substr(4)].IsDefined();
+    const bool at_step = root["physics_dt_s"].IsDefined();
+    r.Fail(at_key ? n[key.substr(4)] : at_step ? root["physics_dt_s"] : root, key, imu);
   }
   if (r.ok() && s.physics_dt_s > 0 && s.physics_dt_s <= 0.01) {
     // Rate vs step, exposure vs period: at the line of the key to change.
@@ -398,6 +478,22 @@ std::string ScenarioToYaml(const Scenario& s) {
       << YAML::EndMap;
   out << YAML::Key << "textures" << YAML::Value << YAML::BeginMap << YAML::Key << "seed"
       << YAML::Value << s.textures.seed << YAML::EndMap;
+  const ImuOptions& imu = s.imu;
+  out << YAML::Key << "imu" << YAML::Value << YAML::BeginMap;
+  for (const auto& [k, v] : std::initializer_list<std::pair<const char*, double>>{
+           {"rate_hz", imu.rate_hz},
+           {"gyro_noise_density", imu.gyro_noise_density},
+           {"gyro_random_walk", imu.gyro_random_walk},
+           {"accel_noise_density", imu.accel_noise_density},
+           {"accel_random_walk", imu.accel_random_walk},
+           {"x_m", imu.x_m},
+           {"y_m", imu.y_m},
+           {"z_m", imu.z_m},
+           {"roll_deg", imu.roll_deg},
+           {"pitch_deg", imu.pitch_deg},
+           {"yaw_deg", imu.yaw_deg}})
+    out << YAML::Key << k << YAML::Value << v;
+  out << YAML::EndMap;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

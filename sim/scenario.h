@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -60,6 +61,25 @@ struct TextureSettings {
   uint64_t seed = 1;  // texture generator seed; the same seed gives the same hallway
 };
 
+// The robot's IMU (sim/imu.h): MuJoCo gyro and accelerometer sensors on site "imu", sampled every
+// 1 / rate_hz, with the noise model of a Kalibr imu.yaml. Defaults: a TDK InvenSense ICM-20602
+// (datasheet DS-000176: gyro rate noise spectral density 0.004 deg/s/sqrt(Hz), accelerometer
+// noise spectral density 100 ug/sqrt(Hz); output data rates 1 kHz / n, so 250 Hz). Datasheets give
+// no bias random walk: those two are the EuRoC MAV's imu0/sensor.yaml (ADIS16448), the usual
+// order for a MEMS part. 250 Hz rather than EuRoC's 200 Hz: samples are taken on physics steps,
+// and 200 Hz is 2.5 steps of the bench's 0.002 s.
+struct ImuOptions {
+  double rate_hz = 250.0;  // sample rate (Hz): the period a whole number of physics steps
+  double gyro_noise_density = 0.004 * M_PI / 180.0;  // rad/s/sqrt(Hz), >= 0 (6.98e-5)
+  double gyro_random_walk = 1.9393e-05;              // rad/s^2/sqrt(Hz), >= 0
+  double accel_noise_density = 100e-6 * 9.80665;     // m/s^2/sqrt(Hz), >= 0 (9.81e-4)
+  double accel_random_walk = 3.0e-3;                 // m/s^3/sqrt(Hz), >= 0
+  // Pose on the robot body (x forward, y left, z up, origin at the wheel axle): by default on
+  // top of the chassis above the axle, axes of the body.
+  double x_m = 0.0, y_m = 0.0, z_m = 0.19;                // position (m)
+  double roll_deg = 0.0, pitch_deg = 0.0, yaw_deg = 0.0;  // R = Rz(yaw) Ry(pitch) Rx(roll)
+};
+
 struct Scenario {
   std::string name;             // scenario name (file stem unless given)
   std::string source_path;      // the YAML file it was read from (empty if built in code)
@@ -76,6 +96,7 @@ struct Scenario {
   CameraOptions camera;
   NoiseOptions noise;
   TextureSettings textures;
+  ImuOptions imu;
 
   bool IsValid(std::string* error) const;
 };

@@ -25,6 +25,9 @@ constexpr const char* kLeftActuator = "drive_left";
 constexpr const char* kRightActuator = "drive_right";
 constexpr const char* kCam0 = "cam0";
 constexpr const char* kCam1 = "cam1";
+constexpr const char* kImuSite = "imu";
+constexpr const char* kImuGyro = "imu_gyro";
+constexpr const char* kImuAccel = "imu_accel";
 constexpr double kStoppedSpeedMps = 0.005;  // the robot counts as standing still below this
 
 // MuJoCo reports warnings through a global hook: log them and count them so that the
@@ -136,6 +139,11 @@ struct Simulator::Impl {
   int next_frame = 0;     // index of the frame being assembled
   bool finished = false;  // path done and robot at rest: no further frames start
   int warnings_at_start = 0;
+  // IMU: site, sensordata addresses, physics steps per sample, noise, samples not yet handed out.
+  int imu_site = -1, gyro_adr = -1, accel_adr = -1;
+  long imu_every = 1;
+  std::unique_ptr<ImuNoiseModel> imu_noise;
+  std::vector<ImuSample> imu_pending;
 
   ~Impl() {
     renderer.reset();
@@ -187,6 +195,31 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
              "'robot'";
     return nullptr;
   }
+  // The IMU: a gyro and an accelerometer on site 'imu' of the robot.
+  im.imu_site = mj_name2id(m, mjOBJ_SITE, kImuSite);
+  const int gyro = mj_name2id(m, mjOBJ_SENSOR, kImuGyro);
+  const int accel = mj_name2id(m, mjOBJ_SENSOR, kImuAccel);
+  if (im.imu_site < 0 || m->site_bodyid[im.imu_site] != im.body || gyro < 0 || accel < 0 ||
+      m->sensor_type[gyro] != mjSENS_GYRO || m->sensor_type[accel] != mjSENS_ACCELEROMETER ||
+      m->sensor_objid[gyro] != im.imu_site || m->sensor_objid[accel] != im.imu_site) {
+    *error = scene +
+             ": the robot must carry the IMU: site 'imu' on body 'robot' with sensors gyro "
+             "'imu_gyro' and accelerometer 'imu_accel' on it; include robot_p2dx.xml";
+    return nullptr;
+  }
+  im.gyro_adr = m->sensor_adr[gyro];
+  im.accel_adr = m->sensor_adr[accel];
+  im.imu_every = std::lround(1.0 / (scenario.imu.rate_hz * scenario.physics_dt_s));
+  const Eigen::Isometry3d T_body_imu = ImuPoseOnBody(scenario.imu);
+  const Eigen::Quaterniond q_body_imu(T_body_imu.linear());
+  for (int i = 0; i < 3; ++i) m->site_pos[3 * im.imu_site + i] = T_body_imu.translation()[i];
+  m->site_quat[4 * im.imu_site + 0] = q_body_imu.w();
+  m->site_quat[4 * im.imu_site + 1] = q_body_imu.x();
+  m->site_quat[4 * im.imu_site + 2] = q_body_imu.y();
+  m->site_quat[4 * im.imu_site + 3] = q_body_imu.z();
+  sim->calibration_.T_body_imu = T_body_imu;
+  im.imu_noise = std::make_unique<ImuNoiseModel>(scenario.imu, ImuNoiseSeed(scenario.seed));
+
   m->opt.timestep = scenario.physics_dt_s;
   // A path through a wall (scenarios built in code; files are checked when read).
   int waypoint = -1;
@@ -370,6 +403,28 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
     d->ctrl[im.act_left] = wl;
     d->ctrl[im.act_right] = wr;
     mj_step2(m, d);
+    // The IMU on its steps: kinematics and gyro of mj_step1, accelerometer of mj_step2, all of
+    // the state at `step` (mj_step2 integrates qpos/qvel only).
+    if (step >= im.start_step && (step - im.start_step) % im.imu_every == 0) {
+      ImuSample s;
+      s.time_s = (step - im.start_step) * dt;
+      s.has_gt = true;
+      for (int i = 0; i < 3; ++i) {
+        s.gyro_true_radps[i] = d->sensordata[im.gyro_adr + i];
+        s.accel_true_mps2[i] = d->sensordata[im.accel_adr + i];
+      }
+      Eigen::Matrix3d R;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) R(r, c) = d->site_xmat[9 * im.imu_site + 3 * r + c];
+      s.T_world_imu.linear() = R;
+      const mjtNum* p = d->site_xpos + 3 * im.imu_site;
+      s.T_world_imu.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
+      mjtNum vel[6];  // (angular, linear) at the site, world axes
+      mj_objectVelocity(m, d, mjOBJ_SITE, im.imu_site, vel, 0);
+      s.v_world_mps = Eigen::Vector3d(vel[3], vel[4], vel[5]);
+      im.imu_noise->Apply(&s);
+      im.imu_pending.push_back(s);
+    }
     if (step >= last_step && have_gt && rendered == samples) break;
   }
 
@@ -380,6 +435,12 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
         ApplyCameraNoise(acc[c], sc.noise, DeriveSeed(sc.seed, static_cast<uint64_t>(k), c));
     (c == 0 ? frame->left : frame->right) = out;
   }
+  // The IMU samples up to the frame time (a blurred frame's exposure runs past it).
+  frame->imu.clear();
+  size_t taken = 0;
+  while (taken < im.imu_pending.size() && im.imu_pending[taken].time_s <= t_frame + 0.5 * dt)
+    frame->imu.push_back(im.imu_pending[taken++]);
+  im.imu_pending.erase(im.imu_pending.begin(), im.imu_pending.begin() + taken);
   frame->index = k;
   frame->time_s = t_frame;
   ++im.next_frame;

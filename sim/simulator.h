@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/imu.h"
 #include "sim/scenario.h"
 
 namespace sim {
@@ -24,6 +25,7 @@ struct StereoCalibration {
   double cy_px = 0.0;
   double baseline_m = 0.0;                                        // stereo baseline (m)
   Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();  // cam0 on the robot base
+  Eigen::Isometry3d T_body_imu = Eigen::Isometry3d::Identity();   // the IMU on the robot base
 };
 
 // One stereo frame and its ground truth.
@@ -35,6 +37,9 @@ struct StereoFrame {
   cv::Mat depth_m;      // CV_32FC1 z-depth of the left view (m), noise-free
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();  // computer-vision axes
   Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();  // robot base (x forward, z up)
+  // The IMU's samples since the previous frame: times in (previous frame's time, time_s]; frame 0
+  // has the sample at time 0. With the noise model applied and their ground truth (sim/imu.h).
+  std::vector<ImuSample> imu;
 };
 
 class Simulator {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "harness/trajectory_io.h"
+#include "sim/imu.h"
 
 namespace harness {
 
@@ -28,6 +29,10 @@ struct DatasetFrame {
   cv::Mat depth_m;      // CV_32FC1 z-depth of the left view (metres), 0 = none; may be empty
   bool has_gt = false;  // true when T_world_cam0 holds the ground-truth pose
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();  // left camera in the world
+  // The IMU's samples since the previous frame (stamps in (previous time_s, time_s]; the first
+  // frame: up to its time), empty without an IMU. Simulated samples carry their ground truth
+  // (sim::ImuSample::has_gt); a dataset's (EuRoC imu0) the measurements only.
+  std::vector<sim::ImuSample> imu;
 };
 
 enum class DatasetFormat {

@@ -4,11 +4,13 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string_view>
 #include <system_error>
 
+#include "harness/dataset/euroc_imu.h"
 #include "harness/dataset/internal.h"
 #include "sim/scenario.h"
 #include "sim/yaml_input.h"
@@ -224,6 +226,14 @@ bool EurocReader::Open(const std::string& dir, const Options& options, std::stri
                                std::to_string(cam) + "/data.csv)");
   if (!FirstPairBits(files_[0][0], files_[1][0], &bits_, error)) return false;
 
+  // The IMU (optional): mav0/imu0/data.csv.
+  if (const std::string imu = Join(mav0, "imu0/data.csv");
+      fs::exists(imu, ec) && !ReadEurocImu(imu, &imu_ns_, &imu_, error))
+    return false;
+  if (const std::string yaml = Join(mav0, "imu0/sensor.yaml");
+      has_imu() && fs::exists(yaml, ec) && !ReadEurocImuSensorYaml(yaml, &imu_options_, error))
+    return false;
+
   // Ground truth (optional): the given file, else the first that exists.
   gt_index_.assign(t_ns_.size(), -1);
   gt_path_ = options_.gt_path;
@@ -273,6 +283,9 @@ bool EurocReader::ReadFrame(size_t index, DatasetFrame* frame, std::string* erro
   frame->has_gt = gt >= 0;
   frame->T_world_cam0 =
       frame->has_gt ? gt_body_[gt].T_world_cam * cam_[0].T_body_cam : Eigen::Isometry3d::Identity();
+  frame->imu.clear();
+  ImuSamplesBetween(imu_ns_, imu_, index > 0 ? t_ns_[index - 1] : INT64_MIN, t_ns_[index],
+                    &frame->imu);
   return true;
 }
 

@@ -6,8 +6,10 @@
 //   resolution, rate_hz, camera_model pinhole); the same for cam1 (T_BS = T_body_cam0 *
 //   T_cam0_cam1); mav0/state_groundtruth_estimate0/data.csv [ground truth only]: the body pose
 //   T_world_body in the world, finite-differenced velocity, zero biases, and its sensor.yaml
-//   (T_BS identity). Every yaml starts with "%YAML:1.0" (cv::FileStorage needs it); stamps have
-//   one number of digits (writer.h: stamp_offset_ns), so names sort in time order.
+//   (T_BS identity). With IMU samples in the frames: mav0/imu0/, body.yaml and that ground truth
+//   at the IMU rate (euroc_imu.h). Every yaml starts with "%YAML:1.0" (cv::FileStorage needs
+//   it); stamps have one number of digits (writer.h: stamp_offset_ns), so names sort in time
+//   order.
 #pragma once
 
 #include <cstddef>
@@ -57,6 +59,10 @@ class EurocReader {
   const std::vector<StampedPose>& ground_truth_body() const { return gt_body_; }
   const std::string& ground_truth_path() const { return gt_path_; }  // "" when none
   size_t ground_truth_frames() const;  // frames with an associated ground-truth pose
+  // mav0/imu0/data.csv when present (euroc_imu.h): ReadFrame gives each frame its samples;
+  // imu() the rate and noise numbers of imu0/sensor.yaml (sim::ImuOptions' defaults without it).
+  bool has_imu() const { return !imu_.empty(); }
+  const sim::ImuOptions& imu() const { return imu_options_; }
 
   // The rectification of the pair (ComputeStereoRectification on cam0, cam1).
   bool Rectification(StereoRectification* rectification, std::string* error) const {
@@ -81,6 +87,9 @@ class EurocReader {
   std::string gt_path_;
   std::vector<long> gt_index_;  // per frame: index into gt_body_, -1 = none
   size_t unpaired_ = 0;
+  std::vector<int64_t> imu_ns_;      // imu0 stamps
+  std::vector<sim::ImuSample> imu_;  // imu0 samples
+  sim::ImuOptions imu_options_;      // imu0/sensor.yaml
 };
 
 }  // namespace harness

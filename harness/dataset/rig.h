@@ -7,6 +7,12 @@
 //   camera_forward_m: 0.15   # optical centre ahead of the wheel axle
 //   camera_height_m: 0.4     # optical centre above the floor
 //   camera_pitch_deg: 0      # downward tilt of the optical axis
+//   imu_x_m: 0               # the IMU on the vehicle (optional: all six or none; render writes
+//   imu_y_m: 0               #   them): position on the body (x forward, y left, z up, origin
+//   imu_z_m: 0.19            #   at the wheel axle) and axes R = Rz(yaw) Ry(pitch) Rx(roll) of
+//   imu_roll_deg: 0          #   the body's, as the scenario's imu keys (sim/scenario.h)
+//   imu_pitch_deg: 0
+//   imu_yaw_deg: 0
 #pragma once
 
 #include <string>
@@ -18,6 +24,9 @@ struct RigMounting {
                            // behind the axle (< 0) is recorded, not applied (vo::ResolvePlatform)
   double height_m = 0.0;   // optical centre above the floor (m), > 0
   double pitch_deg = 0.0;  // downward tilt of the optical axis (degrees), (-90, 90)
+  bool has_imu = false;    // the IMU's pose below is known (finite)
+  double imu_x_m = 0.0, imu_y_m = 0.0, imu_z_m = 0.0;
+  double imu_roll_deg = 0.0, imu_pitch_deg = 0.0, imu_yaw_deg = 0.0;
 
   bool IsValid(std::string* error) const;
 };
@@ -29,8 +38,8 @@ inline constexpr const char* kRigFileName = "rig.yaml";
 std::string RigYaml(const RigMounting& rig);
 
 // Reads `path` with sim::YamlReader ("PATH:LINE: key 'K': ..."). False when it cannot be read,
-// is not a YAML map of the three keys with finite numbers (unknown and duplicate keys are
-// refused), or the height or pitch is out of range.
+// is not a YAML map of the three camera keys with finite numbers, and optionally all six imu_
+// keys (unknown and duplicate keys are refused), or the height or pitch is out of range.
 bool ReadRigYaml(const std::string& path, RigMounting* rig, std::string* error);
 
 }  // namespace harness

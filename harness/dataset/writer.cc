@@ -9,6 +9,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "harness/dataset/euroc_imu.h"
 #include "harness/dataset/internal.h"
 #include "harness/trajectory_io.h"
 
@@ -151,6 +152,8 @@ bool DatasetWriter::Options::IsValid(std::string* error) const {
     return Fail(error, "png_compression must be in [0, 9], got " + std::to_string(png_compression));
   if (!T_body_cam0.matrix().allFinite() || !IsRotation(T_body_cam0.linear(), kRotationTolerance))
     return Fail(error, "T_body_cam0 must be finite with a rotation in its linear part");
+  if (!T_body_imu.matrix().allFinite() || !IsRotation(T_body_imu.linear(), kRotationTolerance))
+    return Fail(error, "T_body_imu must be finite with a rotation in its linear part");
   if (!std::isfinite(rate_hz) || rate_hz < 0.0)
     return Fail(error, "rate_hz must be finite and >= 0, got " + FormatDouble(rate_hz));
   if (stamp_offset_ns < 0 || stamp_offset_ns > kMaxStampOffsetNs)
@@ -297,6 +300,8 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
   times_s_.push_back(frame.time_s);
   stamps_ns_.push_back(stamp_ns);
   if (has_gt_) T_world_cam0_.push_back(frame.T_world_cam0);
+  if (options_.format == DatasetFormat::kEuroc)
+    imu_.insert(imu_.end(), frame.imu.begin(), frame.imu.end());
   return true;
 }
 
@@ -311,14 +316,25 @@ bool DatasetWriter::WriteEurocSensorFolders(std::string* error) const {
   }
   for (int cam = 0; cam < 2; ++cam)
     if (!WriteEurocCamera(cam, rate_hz, error)) return false;
-  return !has_gt_ || WriteEurocGroundTruth(error);
+  // With an IMU: imu0/, body.yaml and the ground truth at the IMU rate instead (euroc_imu.h).
+  bool imu_ground_truth = false;
+  if (!imu_.empty() && !WriteEurocImu(Join(partial_dir_, "mav0"), imu_, options_.imu,
+                                      options_.stamp_offset_ns, &imu_ground_truth, error))
+    return false;
+  return !has_gt_ || imu_ground_truth || WriteEurocGroundTruth(error);
+}
+
+Eigen::Isometry3d DatasetWriter::EurocBodyCam0() const {
+  // With IMU samples EuRoC's body frame is the IMU's (dataset/euroc_imu.h).
+  return imu_.empty() ? options_.T_body_cam0
+                      : CameraInImuFrame(options_.T_body_cam0, options_.T_body_imu);
 }
 
 bool DatasetWriter::WriteEurocCamera(int cam, double rate_hz, std::string* error) const {
   Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
   T_cam0_cam1.translation() = Eigen::Vector3d(camera_.baseline_m, 0.0, 0.0);
-  const Eigen::Isometry3d T_body_cam =
-      cam == 0 ? options_.T_body_cam0 : options_.T_body_cam0 * T_cam0_cam1;
+  const Eigen::Isometry3d T_body_cam0 = EurocBodyCam0();
+  const Eigen::Isometry3d T_body_cam = cam == 0 ? T_body_cam0 : T_body_cam0 * T_cam0_cam1;
   const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));
   std::string csv = "#timestamp [ns],filename\n";
   for (int64_t t_ns : stamps_ns_)
@@ -335,7 +351,7 @@ bool DatasetWriter::WriteEurocGroundTruth(std::string* error) const {
   const size_t n = times_s_.size();
   const std::string gt_dir = Join(partial_dir_, "mav0/state_groundtruth_estimate0");
   if (!MakeDir(gt_dir, error)) return false;
-  const Eigen::Isometry3d T_cam0_body = options_.T_body_cam0.inverse();
+  const Eigen::Isometry3d T_cam0_body = EurocBodyCam0().inverse();
   std::vector<Eigen::Isometry3d> T_world_body(n);
   for (size_t i = 0; i < n; ++i) T_world_body[i] = T_world_cam0_[i] * T_cam0_body;
   std::string csv = std::string(kEurocGroundTruthHeader) + "\n";

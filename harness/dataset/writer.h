@@ -63,6 +63,12 @@ class DatasetWriter {
     // at 0, so render gives kSimulationEpochNs. times.txt and the KITTI-side files keep the frame
     // times.
     int64_t stamp_offset_ns = 0;
+    // EuRoC with an IMU: when the frames carry IMU samples (DatasetFrame::imu), kEuroc writes
+    // imu0/ (its sensor.yaml with these rate and noise numbers) and the ground truth at the IMU
+    // rate, and EuRoC's body frame is the IMU's: the cameras' T_BS are CameraInImuFrame(
+    // T_body_cam0, T_body_imu) (dataset/euroc_imu.h), T_body_imu the IMU on the same body.
+    sim::ImuOptions imu;
+    Eigen::Isometry3d T_body_imu = Eigen::Isometry3d::Identity();
 
     bool IsValid(std::string* error) const;
   };
@@ -96,6 +102,8 @@ class DatasetWriter {
   // The mav0/ text files: WriteEurocSensorFolders writes each sensor's folder (data.csv,
   // sensor.yaml) by the functions below it; a new sensor (imu0/) and body.yaml go there.
   bool WriteEurocSensorFolders(std::string* error) const;
+  // cam0 in EuRoC's body frame: the robot's body, or the IMU's when the frames carry samples.
+  Eigen::Isometry3d EurocBodyCam0() const;
   bool WriteEurocCamera(int cam, double rate_hz, std::string* error) const;
   bool WriteEurocGroundTruth(std::string* error) const;
   bool WriteTumText(std::string* error) const;
@@ -111,6 +119,7 @@ class DatasetWriter {
   std::vector<double> times_s_;
   std::vector<int64_t> stamps_ns_;               // the EuRoC/TUM stamps: stamp_offset_ns + t_ns
   std::vector<Eigen::Isometry3d> T_world_cam0_;  // one per frame when has_gt_
+  std::vector<sim::ImuSample> imu_;              // the frames' IMU samples (kEuroc)
   std::vector<int> compression_params_;
 };
 

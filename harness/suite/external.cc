@@ -133,7 +133,11 @@ bool WriteSequence(const ExternalRunSpec& spec, const std::string& dir, std::str
   sim::StereoFrame frame;
   for (int index = 0; spec.max_frames == 0 || index < spec.max_frames; ++index) {
     if (!simulator->Next(&frame, error)) break;
-    if (index % spec.stride == 0 && !writer.Add(ToDatasetFrame(frame), error)) return false;
+    // The sequence for an external estimator carries no IMU samples yet: its strided copies are
+    // made from the KITTI layout, which has none, and must equal a simulation at that stride.
+    DatasetFrame dataset_frame = ToDatasetFrame(frame);
+    dataset_frame.imu.clear();
+    if (index % spec.stride == 0 && !writer.Add(dataset_frame, error)) return false;
     if (InterruptSignal() != 0) {
       *error = InterruptedMessage(index, simulator->EstimatedFrames(), "frames", dir);
       return false;

@@ -85,6 +85,8 @@ class EvalTest : public ::testing::Test {
       DatasetWriter::Options options;  // as RenderScenario sets them
       options.format = format;
       options.T_body_cam0 = simulator->calibration().T_body_cam0;
+      options.T_body_imu = simulator->calibration().T_body_imu;  // the frames carry the IMU
+      options.imu = scenario_->imu;
       options.rate_hz = scenario_->rate_hz;
       options.stamp_offset_ns = kSimulationEpochNs;
       options.write_rig = true;  // the mounting, so a run on the export knows the ground vehicle

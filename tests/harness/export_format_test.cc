@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "harness/dataset.h"
+#include "harness/dataset/euroc_imu.h"
 #include "harness/dataset/rig.h"
 #include "harness/sim_adapter.h"
 #include "harness/trajectory_io.h"
@@ -132,8 +133,10 @@ TEST_F(ExportFormatTest, EveryYamlStartsWithTheOpenCvDirectiveAndOpensInFileStor
   const std::string mav0 = Export("euroc") + "/mav0";
   Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
   T_cam0_cam1.translation().x() = calibration_->baseline_m;
-  const Eigen::Isometry3d T_body_cam[2] = {calibration_->T_body_cam0,
-                                           calibration_->T_body_cam0 * T_cam0_cam1};
+  // EuRoC's body is the IMU (every simulated sequence carries one): the cameras relative to it.
+  const Eigen::Isometry3d T_imu_cam0 =
+      harness::CameraInImuFrame(calibration_->T_body_cam0, calibration_->T_body_imu);
+  const Eigen::Isometry3d T_body_cam[2] = {T_imu_cam0, T_imu_cam0 * T_cam0_cam1};
   for (int cam = 0; cam < 2; ++cam) {
     const std::string path = mav0 + "/cam" + std::to_string(cam) + "/sensor.yaml";
     cv::FileStorage storage(path, cv::FileStorage::READ);
@@ -229,11 +232,18 @@ TEST_F(ExportFormatTest, EurocStampsHave19DigitsAndListingsSortInStampOrder) {
     // The sorted listing is data.csv's order, which is time order.
     EXPECT_EQ(SortedNames(base + "/data"), names) << base;
   }
-  // The ground truth at the same stamps.
+  // The ground truth at the IMU rate on the same clock: 19-digit stamps, sorted, covering every
+  // frame's stamp (the IMU rate is a multiple of the frame rate).
   const std::vector<std::string> gt = Lines(mav0 + "/state_groundtruth_estimate0/data.csv");
-  ASSERT_EQ(gt.size(), stamps.size() + 1);
-  for (size_t i = 0; i < stamps.size(); ++i)
-    EXPECT_EQ(gt[i + 1].substr(0, 20), std::to_string(stamps[i]) + ",") << i;
+  ASSERT_GT(gt.size(), stamps.size() + 1);
+  std::vector<int64_t> gt_stamps;
+  for (size_t i = 1; i < gt.size(); ++i) {
+    EXPECT_EQ(gt[i].find(','), 19u) << gt[i];
+    gt_stamps.push_back(std::stoll(gt[i].substr(0, gt[i].find(','))));
+  }
+  EXPECT_TRUE(std::is_sorted(gt_stamps.begin(), gt_stamps.end()));
+  for (int64_t t : stamps)
+    EXPECT_TRUE(std::binary_search(gt_stamps.begin(), gt_stamps.end(), t)) << t;
 
   // Round trip: the EuRoC reader takes the same stamps and the frames equal the KITTI layout's.
   harness::EurocReader euroc;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "harness/run_folder.h"
+#include "tests/sim/sim_test_util.h"
 #include "tests/vo/vo_test_util.h"
 
 namespace {
@@ -241,6 +242,42 @@ TEST(PipelineTest, AGroundVehicleTakesItsUpFromTheRigsPitch) {
   given.orientation.expected_up_cam0 = Eigen::Vector3d(0.0, -1.0, -0.1);
   EXPECT_EQ(vo::ResolvePlatform(given, 0.15, 30.0).orientation.expected_up_cam0,
             given.orientation.expected_up_cam0);
+}
+
+}  // namespace
+
+namespace {
+
+// A simulated sequence carries the IMU: each frame the samples since the previous one (250 Hz
+// at 10 Hz frames: 25, the first frame the sample at time 0) with their ground truth, and the
+// sequence the IMU's rate, noise numbers and cam0 in the IMU frame.
+TEST(PipelineTest, ASimulatedSequenceCarriesTheImuSamplesBetweenFrames) {
+  vobench_test::TempDir dir("pipeline_imu");
+  sim::Scenario s = vobench_test::MakeScenario(vobench_test::WriteScene(dir, ""));
+  s.camera.width = 16;
+  s.camera.height = 16;
+  s.imu.gyro_noise_density = 1e-3;
+  harness::StereoSequence sequence;
+  std::string error;
+  ASSERT_TRUE(harness::OpenScenarioSequence(s, &sequence, &error)) << error;
+  EXPECT_TRUE(sequence.has_imu);
+  EXPECT_EQ(sequence.imu.rate_hz, 250.0);
+  EXPECT_EQ(sequence.imu.gyro_noise_density, 1e-3);
+  // cam0: 0.15 m ahead of the axle, 0.045 m left, 1.0 - 0.095 m above it; the IMU 0.19 m above.
+  EXPECT_LT((sequence.T_imu_cam0.translation() - Eigen::Vector3d(0.15, 0.045, 0.715)).norm(),
+            1e-12);
+  harness::DatasetFrame f;
+  double last = -1.0;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(sequence.next(&f, &error)) << error;
+    ASSERT_EQ(f.imu.size(), k == 0 ? 1u : 25u) << k;
+    EXPECT_GT(f.imu.front().time_s, last);
+    EXPECT_NEAR(f.imu.back().time_s, f.time_s, 1e-12);
+    EXPECT_TRUE(f.imu.back().has_gt);
+    // The IMU's ground-truth pose and cam0's agree through T_imu_cam0.
+    EXPECT_TRUE((f.imu.back().T_world_imu * sequence.T_imu_cam0).isApprox(f.T_world_cam0, 1e-9));
+    last = f.imu.back().time_s;
+  }
 }
 
 }  // namespace

@@ -62,10 +62,13 @@ TEST(RenderTest, DatasetOnDiskEqualsTheSimulationAndIsDeterministic) {
   EXPECT_EQ(rig.forward_m, sim::CameraOptions().forward_m);
   EXPECT_EQ(rig.height_m, sim::CameraOptions().height_m);
   EXPECT_EQ(rig.pitch_deg, sim::CameraOptions().pitch_deg);
+  EXPECT_TRUE(rig.has_imu);  // and the IMU's, as the scenario's imu keys give it
+  EXPECT_EQ(rig.imu_z_m, sim::ImuOptions().z_m);
   for (const char* f :
        {"calib.txt", "times.txt", "poses.txt", "groundtruth_tum.txt", "image_0/000000.png",
         "image_1/000000.png", "depth/000000.png", "mav0/cam0/data.csv", "mav0/cam0/sensor.yaml",
-        "mav0/cam1/sensor.yaml", "mav0/state_groundtruth_estimate0/data.csv"})
+        "mav0/cam1/sensor.yaml", "mav0/state_groundtruth_estimate0/data.csv", "mav0/imu0/data.csv",
+        "mav0/imu0/sensor.yaml", "mav0/body.yaml"})
     EXPECT_TRUE(fs::exists(fs::path(dir / "a") / f)) << f;
 
   // Read back and compare with a fresh simulation of the same scenario.

@@ -247,3 +247,65 @@ TEST_F(ScenarioFileTest, OutOfRangeValues) {
 }
 
 }  // namespace
+
+namespace {
+
+// The IMU (sim/imu.h): its samples are taken on physics steps, its noise numbers are >= 0.
+TEST_F(ScenarioFileTest, ImuRateMustBeAWholeNumberOfPhysicsSteps) {
+  sim::Scenario s;
+  ASSERT_EQ(Load(kGood, &s), "");
+  EXPECT_EQ(s.imu.rate_hz, 250.0);  // the ICM-20602 default: every 2nd step of 0.002 s
+  const std::string imu = std::string(kGood) + "imu:\n  rate_hz: 200\n";
+  const std::string e = Load(imu);
+  EXPECT_NE(e.find("s.yaml:13: key 'imu.rate_hz': the sample period 1/200 s is 2.5 physics steps"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("e.g. 250 or 166.667 Hz"), std::string::npos) << e;
+  EXPECT_EQ(Load(std::string(kGood) + "physics_dt_s: 0.001\nimu:\n  rate_hz: 200\n", &s), "");
+  EXPECT_EQ(s.imu.rate_hz, 200.0);
+  // A physics step the default rate does not fit is blamed on physics_dt_s's line.
+  const std::string step = Load(std::string(kGood) + "physics_dt_s: 0.0025\n");
+  EXPECT_NE(step.find("s.yaml:12: key 'imu.rate_hz'"), std::string::npos) << step;
+  const std::string above = Load(std::string(kGood) + "imu:\n  rate_hz: 1000\n");
+  EXPECT_NE(above.find("key 'imu.rate_hz': 1000 Hz is above the physics rate"), std::string::npos)
+      << above;
+}
+
+TEST_F(ScenarioFileTest, ImuKeysAreCheckedAndRoundTrip) {
+  const std::string good = std::string(kGood) +
+                           "imu:\n  gyro_noise_density: 1e-4\n  accel_random_walk: 0\n"
+                           "  x_m: -0.1\n  yaw_deg: 90\n";
+  sim::Scenario s, again;
+  ASSERT_EQ(Load(good, &s), "");
+  EXPECT_EQ(s.imu.gyro_noise_density, 1e-4);
+  EXPECT_EQ(s.imu.accel_random_walk, 0.0);
+  EXPECT_EQ(s.imu.x_m, -0.1);
+  EXPECT_EQ(s.imu.yaw_deg, 90.0);
+  const std::string path = dir_ / "effective.yaml";
+  WriteText(path, sim::ScenarioToYaml(s));
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(path, &again, &error)) << error;
+  EXPECT_EQ(sim::ScenarioToYaml(again), sim::ScenarioToYaml(s));
+  EXPECT_EQ(again.imu.yaw_deg, 90.0);
+
+  const std::string negative = Load(std::string(kGood) + "imu:\n  gyro_random_walk: -1\n");
+  EXPECT_NE(negative.find("s.yaml:13: key 'imu.gyro_random_walk': expected a finite number >= 0"),
+            std::string::npos)
+      << negative;
+  const std::string unknown = Load(std::string(kGood) + "imu:\n  gyro_noise: 1\n");
+  EXPECT_NE(unknown.find("s.yaml:13"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("gyro_noise_density"), std::string::npos) << unknown;
+  const std::string nan = Load(std::string(kGood) + "imu:\n  z_m: .nan\n");
+  EXPECT_NE(nan.find("imu.z_m"), std::string::npos) << nan;
+  // Scenarios built in code are checked the same way (Simulator::Create calls IsValid).
+  std::string why;
+  s.imu.yaw_deg = std::nan("");
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_NE(why.find("imu.yaw_deg: expected a finite number"), std::string::npos) << why;
+  s.imu.yaw_deg = 0.0;
+  s.imu.rate_hz = 300.0;
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_NE(why.find("imu.rate_hz: the sample period"), std::string::npos) << why;
+}
+
+}  // namespace

@@ -134,8 +134,25 @@ TEST(SimulatorTest, RobotDrivesThePapersLPath) {
   ASSERT_TRUE(simulator) << error;
   sim::StereoFrame frame;
   int frames = 0;
-  while (simulator->Next(&frame, &error)) ++frames;
+  std::vector<sim::ImuSample> imu;
+  while (simulator->Next(&frame, &error)) {
+    ++frames;
+    imu.insert(imu.end(), frame.imu.begin(), frame.imu.end());
+  }
   ASSERT_TRUE(error.empty()) << error;
+  // The default IMU (ICM-20602 noise, sim/imu.h) integrated over the L: within 2 deg of the
+  // ground truth's rotation (the turn is 90 deg).
+  ASSERT_GT(imu.size(), 1000u);
+  Eigen::Matrix3d R = imu.front().T_world_imu.linear();
+  for (size_t k = 1; k < imu.size(); ++k) {
+    const Eigen::Vector3d w =
+        0.5 * (imu[k - 1].gyro_radps + imu[k].gyro_radps) * (imu[k].time_s - imu[k - 1].time_s);
+    if (w.norm() > 0) R = R * Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+  }
+  const double gyro_error_deg =
+      Eigen::AngleAxisd(R.transpose() * imu.back().T_world_imu.linear()).angle() * 180.0 / M_PI;
+  RecordProperty("default_imu_gyro_error_deg", std::to_string(gyro_error_deg));
+  EXPECT_LT(gyro_error_deg, 2.0);
   const auto& track = simulator->body_track();
   ASSERT_GT(track.size(), 100u);
   double length = 0.0;
