@@ -155,9 +155,8 @@ TEST(EurocImuFrames, SamplesBetweenTwoStamps) {
   EXPECT_EQ(out.size(), 1u);
 }
 
-// The writer's hook: frames that carry IMU samples give imu0/, body.yaml and the ground truth
-// at the IMU rate; the reader gives each frame its samples again.
-TEST_F(EurocImuTest, WrittenAndReadBackWithTheDatasetWriterAndReader) {
+// The 32x24 stereo camera of the writer tests (f 30 px, baseline 0.1 m).
+vo::StereoCamera SmallCamera() {
   vo::StereoCamera camera;
   camera.width = 32;
   camera.height = 24;
@@ -165,6 +164,13 @@ TEST_F(EurocImuTest, WrittenAndReadBackWithTheDatasetWriterAndReader) {
   camera.cx_px = 15.5;
   camera.cy_px = 11.5;
   camera.baseline_m = 0.1;
+  return camera;
+}
+
+// The writer's hook: frames that carry IMU samples give imu0/, body.yaml and the ground truth
+// at the IMU rate; the reader gives each frame its samples again.
+TEST_F(EurocImuTest, WrittenAndReadBackWithTheDatasetWriterAndReader) {
+  const vo::StereoCamera camera = SmallCamera();
   std::vector<DatasetFrame> frames(3);
   int k = 0;
   for (int i = 0; i < 3; ++i) {
@@ -244,13 +250,7 @@ TEST_F(EurocImuTest, WrittenAndReadBackWithTheDatasetWriterAndReader) {
 // Frames whose IMU samples carry no ground truth (a dataset's, re-written) keep the frames'
 // ground truth at the frame rate; imu0/ is written all the same.
 TEST_F(EurocImuTest, SamplesWithoutGroundTruthLeaveTheFramesGroundTruth) {
-  vo::StereoCamera camera;
-  camera.width = 32;
-  camera.height = 24;
-  camera.fx_px = camera.fy_px = 30;
-  camera.cx_px = 15.5;
-  camera.cy_px = 11.5;
-  camera.baseline_m = 0.1;
+  const vo::StereoCamera camera = SmallCamera();
   DatasetWriter::Options options;
   options.format = DatasetFormat::kEuroc;
   options.stamp_offset_ns = harness::kSimulationEpochNs;  // as render: stamps of one width
