@@ -7,6 +7,7 @@
 #include <opencv2/core/utility.hpp>
 #include <vector>
 
+#include "harness/cli/breakpoint_command.h"
 #include "harness/cli/check_command.h"
 #include "harness/cli/command.h"
 #include "harness/cli/eval_command.h"
@@ -32,9 +33,10 @@ int main(int argc, char** argv) {
 
   // In the order of `vobench --help`.
   const std::vector<harness::Command> commands = {
-      harness::AddRenderCommand(app), harness::AddMatchEvalCommand(app),
-      harness::AddRunCommand(app),    harness::AddEvalCommand(app),
-      harness::AddScoreCommand(app),  harness::AddTuneCommand(app),
+      harness::AddRenderCommand(app),     harness::AddMatchEvalCommand(app),
+      harness::AddRunCommand(app),        harness::AddEvalCommand(app),
+      harness::AddScoreCommand(app),      harness::AddTuneCommand(app),
+      harness::AddBreakpointCommand(app),
       harness::AddSuiteCommand(app),  // suite, suite merge
       harness::AddCheckCommand(app)};
 
