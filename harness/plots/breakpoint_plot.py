@@ -41,10 +41,16 @@ def main(argv):
                     xs.append(p["x"])
                     ys.append(r["metric"])
         ax.plot(xs, ys, ".", color="0.6", markersize=4, label="a seed's run")
-    for crossed, color, label in ((False, "tab:blue", "not crossed"), (True, "tab:red", "crossed")):
-        sel = [p for p in points if p["crossed"] == crossed and p["value"] is not None]
-        ax.plot([p["x"] for p in sel], [p["value"] for p in sel], "o", color=color,
-                label=label + (" (%s of %d seeds)" % (b["aggregate"], seeds) if seeds > 1 else ""))
+    # Crossed by the condition, or by a run that lost tracking or failed (the value may be below).
+    groups = (("not crossed", "o", "tab:blue", lambda p: not p["crossed"]),
+              ("crossed", "o", "tab:red", lambda p: p["crossed"] and p["why"] == "condition met"),
+              ("crossed: a run lost tracking or failed", "s", "tab:purple",
+               lambda p: p["crossed"] and p["why"] != "condition met"))
+    for label, marker, color, member in groups:
+        sel = [p for p in points if member(p) and p["value"] is not None]
+        if sel:
+            ax.plot([p["x"] for p in sel], [p["value"] for p in sel], marker, color=color,
+                    label=label + (" (%s of %d seeds)" % (b["aggregate"], seeds) if seeds > 1 else ""))
     failed = [p for p in points if p["value"] is None or any(r["failed"] for r in p["runs"])]
     if failed:
         ax.plot([p["x"] for p in failed], [top * 1.05 if top > 0 else 1.0] * len(failed), "x",
