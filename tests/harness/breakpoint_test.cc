@@ -38,14 +38,21 @@ harness::EvaluatePoint Crafted(std::function<bool(double)> crossed, std::vector<
   };
 }
 
+// Search options over [lo, hi] with `scan` scan points and the tolerance.
+SearchOptions Options(double lo, double hi, int scan, double tolerance, bool integer = false) {
+  SearchOptions o;
+  o.lo = lo;
+  o.hi = hi;
+  o.scan_points = scan;
+  o.tolerance = tolerance;
+  o.integer = integer;
+  return o;
+}
+
 // A step at 7.3 over [0, 20]: the scan 0, 5, 10, 15, 20 brackets (5, 10]; bisection 7.5 (crossed),
 // 6.25, 6.875, 7.1875 (not) ends at (7.1875, 7.5], 0.3125 <= 0.5 wide: 5 + 4 evaluations.
 TEST(BreakpointSearchTest, AStepIsBracketedExactlyInAKnownNumberOfEvaluations) {
-  SearchOptions o;
-  o.lo = 0;
-  o.hi = 20;
-  o.scan_points = 5;
-  o.tolerance = 0.5;
+  SearchOptions o = Options(0, 20, 5, 0.5);
   std::vector<double> asked;
   SearchResult r;
   std::string error;
@@ -66,12 +73,7 @@ TEST(BreakpointSearchTest, AStepIsBracketedExactlyInAKnownNumberOfEvaluations) {
 
 // Integer keys (the stride): scan 1, 4, 7, 10, then 2 and 3 to the neighbours (3, 4].
 TEST(BreakpointSearchTest, AnIntegerKeyEndsAtNeighbours) {
-  SearchOptions o;
-  o.lo = 1;
-  o.hi = 10;
-  o.scan_points = 4;
-  o.tolerance = 1;
-  o.integer = true;
+  SearchOptions o = Options(1, 10, 4, 1, true);
   std::vector<double> asked;
   SearchResult r;
   std::string error;
@@ -96,11 +98,7 @@ TEST(BreakpointSearchTest, AnIntegerKeyEndsAtNeighbours) {
 // Crossed on [4, 12] only: the scan sees 15 and 20 below the condition again; reported, and the
 // bisection works on the first crossing (0, 5].
 TEST(BreakpointSearchTest, ANonMonotoneMetricIsReported) {
-  SearchOptions o;
-  o.lo = 0;
-  o.hi = 20;
-  o.scan_points = 5;
-  o.tolerance = 1;
+  SearchOptions o = Options(0, 20, 5, 1);
   std::vector<double> asked;
   SearchResult r;
   std::string error;
@@ -115,11 +113,7 @@ TEST(BreakpointSearchTest, ANonMonotoneMetricIsReported) {
 }
 
 TEST(BreakpointSearchTest, NoCrossingInTheRangeIsSaidAndTheBudgetEndsTheBisection) {
-  SearchOptions o;
-  o.lo = 0;
-  o.hi = 1;
-  o.scan_points = 3;
-  o.tolerance = 1e-9;
+  SearchOptions o = Options(0, 1, 3, 1e-9);
   std::vector<double> asked;
   SearchResult r;
   std::string error;
