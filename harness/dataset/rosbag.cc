@@ -19,7 +19,6 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 
-#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #endif
 
@@ -399,41 +398,13 @@ bool RosbagReader::Impl::ReadCalibration(const std::map<std::string, TopicInfo>&
   std::string why;
   if (!c.IsValid(&why))
     return Fail(error, where + why + " (baseline = (P_left[3] - P_right[3]) / fx)");
-  if (IsRectifiedInfo(info[0]) && IsRectifiedInfo(info[1])) return true;  // used as it is
-  // A raw pair: ROS's rectification (image_geometry): undistort with K, D, turn by R, project
-  // with P, for each camera.
-  cv::Mat maps[2][2];
-  for (int cam = 0; cam < 2; ++cam) {
-    const sensor_msgs::CameraInfo& ci = info[cam];
-    const cv::Mat K(3, 3, CV_64F, const_cast<double*>(ci.K.data()));
-    const cv::Mat R(3, 3, CV_64F, const_cast<double*>(ci.R.data()));
-    const cv::Mat P(3, 4, CV_64F, const_cast<double*>(ci.P.data()));
-    const cv::Mat D(1, static_cast<int>(ci.D.size()), CV_64F, const_cast<double*>(ci.D.data()));
-    const cv::Size size(c.width, c.height);
-    if (ci.distortion_model == "equidistant" && ci.D.size() == 4) {
-      cv::fisheye::initUndistortRectifyMap(K, D, R, P, size, CV_32FC1, maps[cam][0], maps[cam][1]);
-    } else if ((ci.distortion_model == "plumb_bob" ||
-                ci.distortion_model == "rational_polynomial") &&
-               (ci.D.empty() || ci.D.size() == 4 || ci.D.size() == 5 || ci.D.size() == 8)) {
-      cv::initUndistortRectifyMap(K, ci.D.empty() ? cv::Mat() : D, R, P, size, CV_32FC1,
-                                  maps[cam][0], maps[cam][1]);
-    } else {
+  for (int cam = 0; cam < 2; ++cam)
+    if (!IsRectifiedInfo(info[cam]))
       return Fail(error,
                   Where(CameraInfoTopic(cam == 0 ? options.topics.left : options.topics.right)) +
-                      "distortion_model '" + ci.distortion_model + "' with " +
-                      std::to_string(ci.D.size()) +
-                      " coefficients, expected plumb_bob (5), rational_polynomial (8) or "
-                      "equidistant (4)");
-    }
-    Eigen::Matrix3d R_rect_cam;
-    for (int r = 0; r < 3; ++r)
-      for (int k = 0; k < 3; ++k) R_rect_cam(r, k) = ci.R[3 * r + k];
-    (cam == 0 ? rectification.R_cam0_rect0 : rectification.R_cam1_rect1) = R_rect_cam.transpose();
-  }
-  rectification.map0_x = maps[0][0];
-  rectification.map0_y = maps[0][1];
-  rectification.map1_x = maps[1][0];
-  rectification.map1_y = maps[1][1];
+                      "not a rectified pinhole (distortion D not all 0, R not the "
+                      "identity or K not P's left 3x3): raw pairs are read with --calib "
+                      "cam0.yaml cam1.yaml (EuRoC sensor.yaml), rectified as --format euroc");
   return true;
 }
 

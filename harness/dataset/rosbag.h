@@ -32,12 +32,12 @@
 // RosbagReader reads EuRoC-style bags: two image topics (mono8 or 8UC1; rgb8/bgr8 are turned
 // grey), stereo frames the stamps present on both; the depth topic (16UC1 mm or 32FC1 m) where a
 // stamp matches; calibration from the topics' camera_info
-// (sibling topic "<namespace>/camera_info"; a rectified pinhole as above is used as it is, other
-// plumb_bob/rational_polynomial ones are rectified as ROS's image_geometry does: K, D, R -> P) or
-// from two EuRoC sensor.yaml files (euroc.h; EuRoC's own bags carry no camera_info), rectified
-// as `eval --format euroc` does; the IMU topic's samples between frames (as EurocReader gives
-// them); the ground-truth topic (TransformStamped of the left camera, its child_frame_id the left
-// images' frame_id) associated with the frame stamps. Errors name the bag and the topic.
+// (sibling topic "<namespace>/camera_info", the first message of each: a rectified pinhole as
+// above, used as it is; a raw one is refused, naming --calib) or from two EuRoC sensor.yaml files
+// (euroc.h; EuRoC's own bags carry no camera_info), rectified as `eval --format euroc` does; the
+// IMU topic's samples between frames (as EurocReader gives them); the ground-truth topic
+// (TransformStamped of the left camera, its child_frame_id the left images' frame_id) associated
+// with the frame stamps. Errors name the bag and the topic.
 //
 // Without VOBENCH_ROSBAG (the packages missing at configure time) every function here refuses
 // with RosbagUnavailable()'s message.
@@ -107,7 +107,7 @@ class RosbagReader {
     // camera_info.
     std::string calib_left, calib_right;
     double gt_max_difference_s = 0.003;  // ground-truth stamp within this of the frame's (s, > 0)
-    RectificationOptions rectification;  // raw pairs (calib files, raw camera_info)
+    RectificationOptions rectification;  // raw pairs (--calib files)
   };
 
   RosbagReader();
