@@ -16,6 +16,9 @@ PACKAGES=(
   libnlopt-cxx-dev                            # derivative-free optimisers (vobench tune)
   parallel                                    # tests: the README's GNU-parallel shard recipe
   clang-format-14                             # tests/format_check.sh (the version it pins)
+  librosbag-dev libsensor-msgs-dev libgeometry-msgs-dev  # --format rosbag (ROS 1 bags)
+  pluginlib-dev libclass-loader-dev           # headers rosbag/bag.h includes (Debian 12)
+  python3-rosbag python3-opencv               # tests: the exported bag read by Debian's rosbag
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -9,6 +9,7 @@
 //   dataset/euroc.h           the EuRoC/ASL layout, ReadEurocSensorYaml, EurocReader (raw pairs)
 //   dataset/euroc_imu.h       EuRoC's imu0/ written and read, the ground truth at the IMU rate
 //   dataset/tum.h             the TUM-style stereo layout, TumReader
+//   dataset/rosbag.h          ROS 1 bags as EuRoC's: RosbagWriter, RosbagReader (VOBENCH_ROSBAG)
 //   dataset/rectification.h   raw pair -> the ideal rectified pair the VO expects (EuRoC)
 //
 // (dataset/internal.h holds the helpers these files share; it is not part of this API.)
@@ -22,5 +23,6 @@
 #include "harness/dataset/kitti.h"
 #include "harness/dataset/rectification.h"
 #include "harness/dataset/rig.h"
+#include "harness/dataset/rosbag.h"
 #include "harness/dataset/tum.h"
 #include "harness/dataset/writer.h"

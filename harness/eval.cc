@@ -144,12 +144,43 @@ bool OpenTum(const std::string& dir, const EvalOptions& options, StereoSequence*
   return true;
 }
 
+bool OpenRosbag(const std::string& path, const EvalOptions& options, StereoSequence* sequence,
+                EvalInfo* info, std::string* error) {
+  if (!options.gt_path.empty())
+    return Fail(error, "--gt: not read with --format rosbag (the ground truth is the bag's " +
+                           options.rosbag_topics.ground_truth + " topic)");
+  auto reader = std::make_shared<RosbagReader>();
+  RosbagReader::Options reader_options;
+  reader_options.topics = options.rosbag_topics;
+  reader_options.calib_left = options.calib_left;
+  reader_options.calib_right = options.calib_right;
+  reader_options.gt_max_difference_s = info->max_difference_s;
+  reader_options.rectification = options.rectification;
+  if (!reader->Open(path, reader_options, error)) return false;
+  info->dataset_frames = reader->size();
+  info->unpaired_frames = reader->unpaired_frames();
+  if (!reader->ground_truth_topic().empty())
+    info->ground_truth_path = path + ":" + reader->ground_truth_topic();
+  info->ground_truth_frames = reader->ground_truth_frames();
+  info->rectified = !reader->rectification().IsIdentity();
+  info->camera = reader->rectification().camera;
+  sequence->camera = info->camera;
+  sequence->has_imu = reader->has_imu();
+  sequence->imu = reader->imu();
+  sequence->expected_frames = static_cast<int>(reader->size());
+  sequence->next = [reader, next = size_t{0}](DatasetFrame* frame, std::string* err) mutable {
+    if (next >= reader->size()) return false;
+    return reader->ReadFrame(next++, frame, err);
+  };
+  return true;
+}
+
 }  // namespace
 
 bool EvalOptions::IsValid(std::string* error) const {
   if (format != DatasetFormat::kKitti && format != DatasetFormat::kEuroc &&
-      format != DatasetFormat::kTum)
-    return Fail(error, "format must be kitti, euroc or tum");
+      format != DatasetFormat::kTum && format != DatasetFormat::kRosbag)
+    return Fail(error, "format must be kitti, euroc, tum or rosbag");
   if (!std::isfinite(max_difference_s) || max_difference_s < 0.0)
     return Fail(error, "max difference must be finite and >= 0 (0 = the format's default), got " +
                            FormatDouble(max_difference_s));
@@ -157,6 +188,7 @@ bool EvalOptions::IsValid(std::string* error) const {
 }
 
 double DefaultMaxDifference(DatasetFormat format) {
+  if (format == DatasetFormat::kRosbag) return RosbagReader::Options().gt_max_difference_s;
   return format == DatasetFormat::kEuroc ? EurocReader::Options().gt_max_difference_s
                                          : TumReader::Options().gt_max_difference_s;
 }
@@ -164,7 +196,8 @@ double DefaultMaxDifference(DatasetFormat format) {
 std::string DatasetName(const std::string& dir) {
   fs::path p = fs::path(dir).lexically_normal();
   if (p.filename().empty()) p = p.parent_path();  // "seq/" -> "seq"
-  const std::string name = p.filename().string();
+  std::string name = p.filename().string();
+  if (p.extension() == ".bag") name = p.stem().string();  // a bag: "seq.bag" -> "seq"
   return name.empty() || name == "." || name == ".." ? "dataset" : name;
 }
 
@@ -185,13 +218,17 @@ bool OpenDataset(const std::string& dir, const EvalOptions& options, StereoSeque
         return OpenEuroc(dir, options, sequence, info, error);
       case DatasetFormat::kTum:
         return OpenTum(dir, options, sequence, info, error);
+      case DatasetFormat::kRosbag:
+        return OpenRosbag(dir, options, sequence, info, error);
     }
     return Fail(error, "unknown dataset format");
   };
   if (!open()) return false;
-  // The camera's mounting, when the folder says (vobench render writes it): a ground vehicle
-  // then takes the rig's axle and pitch (vo::ResolvePlatform).
-  const fs::path rig_path = fs::path(dir) / kRigFileName;
+  // The camera's mounting, when the folder says (vobench render writes it; a bag: its folder):
+  // a ground vehicle then takes the rig's axle and pitch (vo::ResolvePlatform).
+  const fs::path rig_path =
+      (options.format == DatasetFormat::kRosbag ? fs::path(dir).parent_path() : fs::path(dir)) /
+      kRigFileName;
   std::error_code ec;
   if (fs::exists(rig_path, ec)) {
     RigMounting rig;

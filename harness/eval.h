@@ -10,6 +10,9 @@
 //          groundtruth.txt in DIR, or --gt), turned into the rectified left camera's pose
 //          T_world_rect0 = T_world_body * T_BS(cam0) * R_cam0_rect0.
 //   tum    left.txt, right.txt, calib.txt; ground truth: groundtruth.txt (left camera) or --gt.
+//   rosbag one ROS bag (dataset/rosbag.h: RosbagReader) in EuRoC's layout: the image topics,
+//          their camera_info or two EuRoC sensor.yaml files, the IMU topic, the ground-truth
+//          topic (the left camera, TransformStamped); rig.yaml beside the bag when present.
 //
 // Ground truth recorded at another rate is associated with the frame stamps as the TUM tools'
 // associate.py does (max_difference_s). Frames without an associated pose are run and logged,
@@ -35,14 +38,17 @@ struct EvalOptions {
                         // state_groundtruth_estimate0 format). For kitti also a KITTI poses file
                         // (12 numbers per line, one per frame, in the first camera's frame),
                         // told by its field count. "" = the layout's own, if any
-  double max_difference_s = 0.0;       // largest |t_frame - t_gt| associated (seconds), >= 0;
-                                       // 0 = DefaultMaxDifference(format)
-  RectificationOptions rectification;  // EuRoC raw pairs
+  double max_difference_s = 0.0;        // largest |t_frame - t_gt| associated (seconds), >= 0;
+                                        // 0 = DefaultMaxDifference(format)
+  RectificationOptions rectification;   // EuRoC raw pairs (and raw bags)
+  RosbagTopics rosbag_topics;           // rosbag: the topics read
+  std::string calib_left, calib_right;  // rosbag: EuRoC sensor.yaml files instead of camera_info
 
   bool IsValid(std::string* error) const;
 };
 
-// 0.02 s (associate.py's default) for kitti and tum, 0.003 s for euroc (200 Hz ground truth).
+// 0.02 s (associate.py's default) for kitti and tum, 0.003 s for euroc and rosbag (200 Hz
+// ground truth).
 double DefaultMaxDifference(DatasetFormat format);
 
 // What the dataset held, for the report.

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "harness/cli/run_command.h"
 #include "harness/eval.h"
@@ -17,7 +18,9 @@ struct EvalArgs {
   std::string format;
   std::string gt;
   std::string config;
-  std::string out;  // default out/eval/<dataset folder name>
+  std::string out;                 // default out/eval/<dataset folder name>
+  RosbagTopics topics;             // rosbag
+  std::vector<std::string> calib;  // rosbag: cam0.yaml cam1.yaml
   int max_frames = 0;
   double max_difference_s = 0.0;
   bool no_plots = false;
@@ -29,9 +32,18 @@ int RunEval(const EvalArgs& a, bool max_difference_given) {
   std::string error;
   EvalOptions options;
   if (!ParseDatasetFormat(a.format, &options.format)) {
-    std::fprintf(stderr, "vobench eval: --format: expected kitti, euroc or tum, got '%s'\n",
+    std::fprintf(stderr, "vobench eval: --format: expected kitti, euroc, tum or rosbag, got '%s'\n",
                  a.format.c_str());
     return 2;
+  }
+  if (options.format == DatasetFormat::kRosbag && !RosbagSupported()) {
+    std::fprintf(stderr, "vobench eval: --format rosbag: %s\n", RosbagUnavailable().c_str());
+    return 2;
+  }
+  options.rosbag_topics = a.topics;
+  if (!a.calib.empty()) {
+    options.calib_left = a.calib[0];
+    options.calib_right = a.calib[1];
   }
   options.gt_path = a.gt;
   if (max_difference_given && !(a.max_difference_s > 0.0)) {
@@ -106,10 +118,26 @@ Command AddEvalCommand(CLI::App& app) {
   auto a = std::make_shared<EvalArgs>();
   CLI::App* eval = app.add_subcommand(
       "eval",
-      "Run the VO on a recorded stereo sequence (KITTI, EuRoC or TUM-style layout) and, "
+      "Run the VO on a recorded stereo sequence (KITTI, EuRoC or TUM-style layout, or a ROS "
+      "bag) and, "
       "where ground truth is present, compute the same metrics as `run`");
-  eval->add_option("--dataset", a->dataset, "Dataset folder")->required();
-  eval->add_option("--format", a->format, "Dataset layout: kitti, euroc or tum")->required();
+  eval->add_option("--dataset", a->dataset, "Dataset folder (rosbag: the .bag file)")->required();
+  eval->add_option("--format", a->format, "Dataset layout: kitti, euroc, tum or rosbag")
+      ->required();
+  eval->add_option("--left", a->topics.left, "rosbag: left image topic (sensor_msgs/Image)")
+      ->capture_default_str();
+  eval->add_option("--right", a->topics.right, "rosbag: right image topic (sensor_msgs/Image)")
+      ->capture_default_str();
+  eval->add_option("--imu", a->topics.imu, "rosbag: IMU topic (sensor_msgs/Imu; absent = no IMU)")
+      ->capture_default_str();
+  eval->add_option("--gt-topic", a->topics.ground_truth,
+                   "rosbag: ground-truth topic (geometry_msgs/TransformStamped of the left "
+                   "camera; absent = no ground truth)")
+      ->capture_default_str();
+  eval->add_option("--calib", a->calib,
+                   "rosbag: two EuRoC sensor.yaml files (cam0 cam1) instead of the image "
+                   "topics' camera_info (EuRoC's bags have none)")
+      ->expected(2);
   eval->add_option("--gt", a->gt,
                    "Ground truth, TUM format (t tx ty tz qx qy qz qw): the left camera for "
                    "kitti/tum, the body/IMU for euroc; for kitti also KITTI poses (12 numbers "
@@ -122,7 +150,7 @@ Command AddEvalCommand(CLI::App& app) {
       ->check(AtLeast(0));
   eval->add_option("--max-difference", a->max_difference_s,
                    "Largest ground-truth to frame time difference associated (s; default 0.02 "
-                   "for kitti and tum, 0.003 for euroc)");
+                   "for kitti and tum, 0.003 for euroc and rosbag)");
   eval->add_flag("--no-plots", a->no_plots, "Skip the PNG plots");
   eval->add_flag("-q,--quiet", a->quiet, "No progress display");
   return {eval, [a, eval] { return RunEval(*a, eval->count("--max-difference") > 0); }};

@@ -27,8 +27,13 @@ int RunRender(const std::string& scenario_arg, const std::string& out, const std
   }
   RenderOptions options;
   if (!ParseDatasetFormat(format, &options.format)) {
-    std::fprintf(stderr, "vobench render: --format: expected kitti, euroc or tum, got '%s'\n",
+    std::fprintf(stderr,
+                 "vobench render: --format: expected kitti, euroc, tum or rosbag, got '%s'\n",
                  format.c_str());
+    return 2;
+  }
+  if (options.format == DatasetFormat::kRosbag && !RosbagSupported()) {
+    std::fprintf(stderr, "vobench render: --format rosbag: %s\n", RosbagUnavailable().c_str());
     return 2;
   }
   options.overwrite = overwrite;
@@ -40,6 +45,8 @@ int RunRender(const std::string& scenario_arg, const std::string& out, const std
   }
   std::printf("scenario        %s\n", scenario.name.c_str());
   std::printf("output          %s (%s layout)\n", out.c_str(), DatasetFormatName(options.format));
+  if (options.format == DatasetFormat::kRosbag)
+    std::printf("bag             %s\n", RosbagPathInDataset(out).c_str());
   std::printf("frames          %d (%.1f s at %.1f Hz)\n", s.frames, s.sim_time_s, scenario.rate_hz);
   std::printf("image size      %dx%d, baseline %.3f m\n", scenario.camera.width,
               scenario.camera.height, scenario.camera.baseline_m);
@@ -57,7 +64,8 @@ Command AddRenderCommand(CLI::App& app) {
   auto a = std::make_shared<RenderArgs>();
   CLI::App* render = app.add_subcommand(
       "render",
-      "Simulate a scenario and write its stereo sequence (KITTI layout, optionally EuRoC)");
+      "Simulate a scenario and write its stereo sequence (KITTI layout, optionally EuRoC, TUM or "
+      "a ROS bag)");
   render
       ->add_option("scenario", a->scenario,
                    "Scenario YAML file or built-in name (l_hallway, plain_corridor)")
@@ -66,7 +74,8 @@ Command AddRenderCommand(CLI::App& app) {
       ->required();
   render
       ->add_option("--format", a->format,
-                   "Dataset layout: kitti, euroc or tum (euroc and tum also write kitti)")
+                   "Dataset layout: kitti, euroc, tum or rosbag (the others also write kitti; "
+                   "rosbag: OUT/<OUT's name>.bag, EuRoC's topics)")
       ->capture_default_str();
   render->add_flag("--overwrite", a->overwrite,
                    "Replace an existing output folder if it is a dataset vobench wrote");

@@ -11,6 +11,8 @@ bool ParseDatasetFormat(const std::string& name, DatasetFormat* format) {
     *format = DatasetFormat::kEuroc;
   else if (name == "tum")
     *format = DatasetFormat::kTum;
+  else if (name == "rosbag")
+    *format = DatasetFormat::kRosbag;
   else
     return false;
   return true;
@@ -24,6 +26,8 @@ const char* DatasetFormatName(DatasetFormat format) {
       return "euroc";
     case DatasetFormat::kTum:
       return "tum";
+    case DatasetFormat::kRosbag:
+      return "rosbag";
   }
   return "unknown";
 }

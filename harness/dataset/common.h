@@ -36,11 +36,12 @@ struct DatasetFrame {
 };
 
 enum class DatasetFormat {
-  kKitti,  // KITTI odometry layout only
-  kEuroc,  // KITTI layout plus the EuRoC/ASL layout under mav0/
-  kTum,    // KITTI layout plus the TUM-style stereo layout (left.txt, right.txt, left/, right/)
+  kKitti,   // KITTI odometry layout only
+  kEuroc,   // KITTI layout plus the EuRoC/ASL layout under mav0/
+  kTum,     // KITTI layout plus the TUM-style stereo layout (left.txt, right.txt, left/, right/)
+  kRosbag,  // KITTI layout plus one ROS bag (rosbag.h); a reader of one bag file
 };
-// "kitti" / "euroc" / "tum"; false for other names.
+// "kitti" / "euroc" / "tum" / "rosbag"; false for other names.
 bool ParseDatasetFormat(const std::string& name, DatasetFormat* format);
 const char* DatasetFormatName(DatasetFormat format);
 

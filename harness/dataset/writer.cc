@@ -146,8 +146,10 @@ std::string TumStampText(int64_t stamp_ns) {
 
 bool DatasetWriter::Options::IsValid(std::string* error) const {
   if (format != DatasetFormat::kKitti && format != DatasetFormat::kEuroc &&
-      format != DatasetFormat::kTum)
-    return Fail(error, "format must be kitti, euroc or tum");
+      format != DatasetFormat::kTum && format != DatasetFormat::kRosbag)
+    return Fail(error, "format must be kitti, euroc, tum or rosbag");
+  if (format == DatasetFormat::kRosbag && !RosbagSupported())
+    return Fail(error, RosbagUnavailable());
   if (png_compression < 0 || png_compression > 9)
     return Fail(error, "png_compression must be in [0, 9], got " + std::to_string(png_compression));
   if (!T_body_cam0.matrix().allFinite() || !IsRotation(T_body_cam0.linear(), kRotationTolerance))
@@ -168,6 +170,7 @@ DatasetWriter::~DatasetWriter() { RemovePartial(); }
 
 void DatasetWriter::RemovePartial() {
   if (finished_ || partial_dir_.empty()) return;
+  bag_.reset();  // closes the bag before its folder goes
   folder_.Discard();
   partial_dir_.clear();
 }
@@ -205,6 +208,14 @@ bool DatasetWriter::Open(const std::string& dir, const vo::StereoCamera& camera,
       return false;
     }
   }
+  if (options_.format == DatasetFormat::kRosbag) {
+    bag_ = std::make_unique<RosbagWriter>();
+    const std::string name = fs::path(RosbagPathInDataset(dir_)).filename().string();
+    if (!bag_->Open(Join(partial_dir_, name), camera_, options_.imu, error)) {
+      RemovePartial();
+      return false;
+    }
+  }
   compression_params_ = {cv::IMWRITE_PNG_COMPRESSION, options_.png_compression,
                          cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT};
   return true;
@@ -224,7 +235,8 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
   if (index > 0 && stamp_ns <= stamps_ns_.back())
     return Fail(error, what + "time " + FormatDouble(frame.time_s) +
                            " s is not after the previous frame's (need strictly increasing ns)");
-  if (options_.format == DatasetFormat::kEuroc || options_.format == DatasetFormat::kTum) {
+  if (options_.format == DatasetFormat::kEuroc || options_.format == DatasetFormat::kTum ||
+      options_.format == DatasetFormat::kRosbag) {
     // Names that sort in time order: one number of digits for the whole sequence.
     const std::string stamp = std::to_string(stamp_ns);
     if (stamp_ns < 0)
@@ -290,13 +302,16 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
             png, error))
       return false;
   }
+  cv::Mat depth_mm;  // the depth PNG's image (and the bag's depth message)
   if (has_depth_) {
+    depth_mm = DepthToMillimetres(frame.depth_m);
     std::vector<uchar> png;
-    if (!cv::imencode(".png", DepthToMillimetres(frame.depth_m), png, compression_params_))
+    if (!cv::imencode(".png", depth_mm, png, compression_params_))
       return Fail(error, what + "depth PNG encoding failed");
     if (!WriteBytes(Join(partial_dir_, "depth/" + FrameName(index, ".png")), png, error))
       return false;
   }
+  if (bag_ && !bag_->Add(frame, depth_mm, stamp_ns, options_.stamp_offset_ns, error)) return false;
   times_s_.push_back(frame.time_s);
   stamps_ns_.push_back(stamp_ns);
   if (has_gt_) T_world_cam0_.push_back(frame.T_world_cam0);
@@ -440,6 +455,7 @@ bool DatasetWriter::Finish(std::string* error) {
   }
   if (options_.format == DatasetFormat::kEuroc && !WriteEurocSensorFolders(error)) return false;
   if (options_.format == DatasetFormat::kTum && !WriteTumText(error)) return false;
+  if (bag_ && !bag_->Close(error)) return false;
 
   // Publish: rename the partial folder to DIR (replacing an old vobench dataset when allowed).
   if (!folder_.Publish(error)) return false;

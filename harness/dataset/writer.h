@@ -6,7 +6,9 @@
 //     own files have it; vobench's yaml-cpp readers skip it);
 //   - calib.txt holds P0..P3 (P2 = P0, P3 = P1: the grey pair stands in for the colour pair) and
 //     an identity Tr, as pykitti and cv::datasets::SLAM_kitti expect of the odometry calib.txt;
-//   - the EuRoC and TUM stamps are Options::stamp_offset_ns + the frame time in nanoseconds;
+//   - kRosbag: one ROS bag DIR/<DIR's name>.bag in the layout of EuRoC's bags (rosbag.h), its
+//     stamps the EuRoC export's;
+//   - the EuRoC, TUM and bag stamps are Options::stamp_offset_ns + the frame time in nanoseconds;
 //     all stamps of a sequence have the same number of digits, so the file names sort in time
 //     order (`vobench render` starts the simulator's clock at kSimulationEpochNs: 19 digits).
 #pragma once
@@ -14,12 +16,14 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "harness/dataset/common.h"
 #include "harness/dataset/rig.h"
+#include "harness/dataset/rosbag.h"
 #include "harness/output_folder.h"
 #include "vo/camera.h"
 
@@ -47,7 +51,7 @@ class DatasetWriter {
  public:
   struct Options {
     DatasetFormat format = DatasetFormat::kKitti;  // kEuroc also writes the mav0/ layout, kTum
-                                                   // the TUM-style one
+                                                   // the TUM-style one, kRosbag DIR/<name>.bag
     bool overwrite = false;   // replace an existing DIR (on Finish) when it is a vobench
                               // dataset (.vobench.json kind "dataset"); otherwise refuse
     bool write_depth = true;  // write depth/%06d.png for frames that carry depth
@@ -121,6 +125,7 @@ class DatasetWriter {
   std::vector<Eigen::Isometry3d> T_world_cam0_;  // one per frame when has_gt_
   std::vector<sim::ImuSample> imu_;              // the frames' IMU samples (kEuroc)
   std::vector<int> compression_params_;
+  std::unique_ptr<RosbagWriter> bag_;  // kRosbag: the bag in the partial folder
 };
 
 }  // namespace harness

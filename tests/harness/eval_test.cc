@@ -558,8 +558,8 @@ TEST_F(EvalBadInputTest, TumImagesOfDifferentSizesOrMissingList) {
 
 TEST_F(EvalBadInputTest, BadArguments) {
   const std::string data = Data(DatasetFormat::kTum);
-  ExpectCliFailure("--dataset " + data + " --format asl", "--format: expected kitti, euroc or tum",
-                   2);
+  ExpectCliFailure("--dataset " + data + " --format asl",
+                   "--format: expected kitti, euroc, tum or rosbag", 2);
   ExpectCliFailure("--dataset " + data + " --format tum --max-difference -1",
                    "--max-difference: expected seconds > 0", 2);
   ExpectCliFailure("--dataset " + data + " --format tum --gt " + (dir_ / "none.txt").string(),
