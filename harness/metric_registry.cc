@@ -65,7 +65,8 @@ MetricInfo StageMedian(const std::string& stage, const std::string& what) {
 std::vector<MetricInfo> MakeRegistry() {
   using M = TrajectoryMetrics;
   const Better kNeither = Better::kNeither;
-  const MetricGroup kRun = MetricGroup::kRun, kAcc = MetricGroup::kAccuracy;
+  const MetricGroup kRun = MetricGroup::kRun, kAcc = MetricGroup::kAccuracy,
+                    kNav = MetricGroup::kNavigation;
   std::vector<MetricInfo> r = {
       Metric("frames", "frames", kNeither, kRun,
              "frames the VO saw from its first initialised one (after the frame stride)",
@@ -195,6 +196,40 @@ std::vector<MetricInfo> MakeRegistry() {
       Metric("platform", "", kNeither, kRun,
              "what the VO ran as: free (6-DoF) or ground_vehicle (platform auto on a known rig)",
              [](const RunSummary& s) { return json(s.platform); }),
+      // What the robot did (simulated runs; sim/navigation.h).
+      Metric("navigation.mode", "", kNeither, kNav,
+             "what the path follower steered on: ground_truth, or vo (the closed loop)",
+             [](const RunSummary& s) { return json(s.navigation.mode); }),
+      Metric("navigation.reached_goal", "", kNeither, kNav,
+             "the follower believed it reached the last waypoint within max_duration_s",
+             [](const RunSummary& s) { return json(s.navigation.reached_goal); }),
+      Metric("navigation.end_error_m", "m", Better::kLower, kNav,
+             "where the robot's wheel axle stopped vs the path's last waypoint",
+             [](const RunSummary& s) { return NumberOrNull(s.navigation.end_error_m); }),
+      Metric("navigation.max_waypoint_error_m", "m", Better::kLower, kNav,
+             "largest true distance from a waypoint when the follower believed it was there "
+             "(null: none reached)",
+             [](const RunSummary& s) { return NumberOrNull(s.navigation.max_waypoint_error_m); }),
+      Metric("navigation.wall_contacts", "", Better::kLower, kNav,
+             "contact events of the robot with the building's collision geoms (MuJoCo contacts)",
+             [](const RunSummary& s) {
+               return s.navigation.wall_contacts < 0 ? json(nullptr)
+                                                     : json(s.navigation.wall_contacts);
+             }),
+      Metric("navigation.wall_contact_s", "s", Better::kLower, kNav,
+             "simulated time the robot touched the building",
+             [](const RunSummary& s) {
+               return s.navigation.wall_contacts < 0 ? json(nullptr)
+                                                     : json(s.navigation.wall_contact_s);
+             }),
+      Reason("navigation.wall_contacts_reason", kNav, "why the wall contacts are null",
+             [](const RunSummary& s) {
+               return s.navigation.wall_contacts < 0
+                          ? std::string(
+                                "the scene's building has no collision geoms (its walls "
+                                "are drawn only)")
+                          : std::string();
+             }),
   };
   for (MetricInfo& m : r) {
     if (m.key == "end_pose_error_pct") m.label = "end-pose error (% of path)";
@@ -212,6 +247,8 @@ bool MetricWritten(const MetricInfo& m, const RunSummary& s) {
       return s.has_ground_truth;  // without ground truth there is nothing to compare with
     case MetricGroup::kMatches:
       return s.match_stats.matches > 0;
+    case MetricGroup::kNavigation:
+      return s.has_navigation;
     default:
       return true;
   }

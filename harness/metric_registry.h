@@ -24,6 +24,8 @@ enum class MetricGroup {
   kAccuracy,  // written only when the run has ground truth (RunSummary::has_ground_truth)
   kMatches,   // written only when the VO's matches were checked (match_stats.matches > 0)
   kTiming,    // wall-clock times: vary between identical runs, never compared
+  // What a simulated robot did (written when RunSummary::has_navigation; sim/navigation.h).
+  kNavigation,
 };
 
 struct MetricInfo {

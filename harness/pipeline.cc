@@ -32,7 +32,26 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
     *frame = ToDatasetFrame(f);
     return true;
   };
+  sequence->navigation = [simulator] { return simulator->navigation(); };
+  if (scenario.navigation == "vo") {
+    // The follower steers on the VO: each measured estimate, mapped into the world from the
+    // belief at the VO's first frame (the known start), fixes the belief; a lost frame does not.
+    sequence->feedback = [simulator,
+                          fixes = sim::NavigationFixes(simulator->calibration().T_body_cam0,
+                                                       scenario.robot.wheel_radius_m)](
+                             const vo::OdometryResult& result) mutable {
+      if (vo::IsLostFrame(result)) return;
+      simulator->FixAtLastFrame(fixes.Fix(result.T_world_cam0, simulator->BeliefAtLastFrame()));
+    };
+  }
   return true;
+}
+
+std::string ClosedLoopProblem(const sim::Scenario& scenario, const std::string& command) {
+  if (scenario.navigation != "vo") return "";
+  return (scenario.source_path.empty() ? scenario.name : scenario.source_path) +
+         ": navigation: vo steers the robot on the VO frame by frame; `" + command +
+         "` simulates without a VO in the loop (use `vobench run`, or navigation: ground_truth)";
 }
 
 bool ReadAllFrames(const FrameSource& source, int max_frames, int expected_frames,
@@ -98,6 +117,7 @@ bool RunFrames(const std::string& name, const FrameSource& source, vo::StereoOdo
     record.source_index = source_frames - 1;
     record.time_s = frame.time_s;
     record.result = odometry.Process(frame.left, frame.right, frame.time_s);
+    if (options.feedback) options.feedback(record.result);
     record.has_gt = frame.has_gt;
     record.T_world_cam0_gt = frame.T_world_cam0;
     const vo::TrackingStatus status = record.result.status;

@@ -20,6 +20,7 @@
 #include "harness/dataset.h"
 #include "harness/match_eval.h"
 #include "harness/metrics.h"
+#include "sim/navigation.h"
 #include "sim/scenario.h"
 #include "vo/odometry.h"
 
@@ -27,6 +28,11 @@ namespace harness {
 
 // A source of stereo frames: fills *frame, returns false at the end (error empty) or on error.
 using FrameSource = std::function<bool(DatasetFrame* frame, std::string* error)>;
+// The closed loop: the VO's result of the frame the source gave last, handed back to the source
+// before its next frame (a simulated robot steering on the VO, sim/navigation.h).
+using EstimateFeedback = std::function<void(const vo::OdometryResult& result)>;
+// What a simulated robot did (sim/navigation.h), asked once the source is exhausted.
+using NavigationSource = std::function<sim::NavigationReport()>;
 
 // A stereo sequence to run the VO on: its frames, camera and what the run folder records of it.
 struct StereoSequence {
@@ -59,11 +65,22 @@ struct StereoSequence {
   bool has_imu = false;
   sim::ImuOptions imu;                                           // rate and noise numbers
   Eigen::Isometry3d T_imu_cam0 = Eigen::Isometry3d::Identity();  // cam0 in the IMU frame
+  // A simulated scenario: what the robot did (its navigation report); with navigation: vo also
+  // the feedback that steers it on the VO's estimates. Empty otherwise.
+  NavigationSource navigation;
+  EstimateFeedback feedback;
 };
 
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).
+// With navigation: vo the robot steers on the VO: the sequence's feedback must be called with
+// each frame's result (RunFrames does), and its frames cannot be simulated ahead of the VO.
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
                           std::string* error);
+
+// "" when `command` may simulate `scenario` without a VO in the loop (frames rendered ahead,
+// kept in memory or on disk); else why not: navigation: vo steers the robot on the VO's
+// estimates, so only `run` can simulate it. Names the scenario file and key.
+std::string ClosedLoopProblem(const sim::Scenario& scenario, const std::string& command);
 
 // Frames of `source` into memory (up to max_frames, 0 = all), with a progress display named
 // `label` and the interrupt check of every long loop (the message names `out`).
@@ -99,6 +116,8 @@ struct RunFramesOptions {
   bool progress = true;     // progress display on stderr ("vo <name>")
   bool match_stats = true;  // check the VO's matches against the ground-truth depth and poses
   std::string out_dir;      // named in the message of an interrupted run
+  // Called with each frame's result, before the source's next frame (the closed loop), or none.
+  EstimateFeedback feedback;
 
   // False (with the message) for a frame stride below 1.
   bool IsValid(std::string* error) const;
@@ -144,6 +163,8 @@ struct RunSummary {
   int frame_stride = 1;           // RunFramesOptions::frame_stride of the run
   std::string platform;           // the VO's resolved platform ("free", "ground_vehicle"; set by
                                   // RunOdometry, "" when not known)
+  bool has_navigation = false;    // a simulated run: what the robot did (set by RunOdometry)
+  sim::NavigationReport navigation;
 };
 
 // The summary of a run: trajectory metrics over the frames with ground truth from the first

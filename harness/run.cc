@@ -17,6 +17,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   frames_options.expected_frames = expected_frames;
   frames_options.progress = options.progress;
   frames_options.out_dir = options.out_dir;
+  frames_options.feedback = options.feedback;
   if (!frames_options.IsValid(error)) return false;  // before the folder: fail fast
   auto odometry = vo::StereoOdometry::Create(camera, vo_options, error);
   if (!odometry) {
@@ -30,6 +31,10 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
       !Summarize(records, summary, error))
     return false;
   summary->platform = vo::ToString(odometry->options().platform);
+  if (options.navigation) {
+    summary->has_navigation = true;
+    summary->navigation = options.navigation();
+  }
   if (!options.ground_truth_not_gravity_aligned.empty() &&
       summary->initial_orientation_error_reason.empty()) {
     summary->initial_orientation_error_deg = std::numeric_limits<double>::quiet_NaN();
@@ -48,6 +53,8 @@ bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_o
   RunOptions o = options;
   if (o.outline_scene.empty()) o.outline_scene = sequence.outline_scene;
   o.ground_truth_not_gravity_aligned = sequence.ground_truth_not_gravity_aligned;
+  o.feedback = sequence.feedback;
+  o.navigation = sequence.navigation;
   return RunOdometry(
       sequence.name, sequence.camera, sequence.next, sequence.expected_frames,
       vo::ResolvePlatform(vo_options, sequence.axle_behind_camera_m, sequence.camera_pitch_deg), o,

@@ -15,6 +15,7 @@
 //                      metric registry's keys; null + *_reason where not applicable)
 //   vo_options.yaml    effective VO options (accepted by --config)
 //   scenario.yaml      effective scenario (simulated runs)
+//   navigation.csv     closed-loop runs (navigation: vo): believed and true robot path per frame
 //   trajectory.png, errors.png, timing.png, report.md
 #pragma once
 
@@ -35,6 +36,10 @@ struct RunOptions {
   int max_frames = 0;         // stop after this many frames of the source (0 = all)
   int frame_stride = 1;       // the VO sees every k-th source frame (0, k, 2k, ...; less overlap
                               // between its frames), >= 1; metrics are on those frames
+  // The closed loop (StereoSequence::feedback) and what a simulated robot did
+  // (StereoSequence::navigation); empty for none.
+  EstimateFeedback feedback;
+  NavigationSource navigation;
   std::string ground_truth_not_gravity_aligned;  // why the ground truth's world is not
                                                  // gravity-aligned ("" = it is): no
                                                  // initial-orientation error then

@@ -105,6 +105,19 @@ std::string ReportMarkdown(const RunSummary& s, const std::string& options_yaml,
     r << "| frames before the VO initialised (no pose, not evaluated) | "
       << s.frames_not_initialised << " |\n";
   }
+  if (s.has_navigation) {
+    const sim::NavigationReport& n = s.navigation;
+    r << "| navigation (what the follower steered on) | " << n.mode << " |\n";
+    r << "| goal reached / end error of the robot | " << (n.reached_goal ? "yes" : "no") << " / "
+      << FmtOrNa(n.end_error_m, 3, " m", "no end") << " |\n";
+    r << "| largest waypoint error (when believed reached) | "
+      << FmtOrNa(n.max_waypoint_error_m, 3, " m", "none reached") << " |\n";
+    r << "| wall contacts | "
+      << (n.wall_contacts < 0
+              ? std::string("n/a (the scene's walls do not collide)")
+              : std::to_string(n.wall_contacts) + " (" + Fmt(n.wall_contact_s, 2) + " s)")
+      << " |\n";
+  }
   r << "| VO time per frame, median / p95 | " << Fmt(s.vo_ms_median, 2) << " / "
     << Fmt(s.vo_ms_p95, 2) << " ms |\n";
   for (const auto& [k, v] : s.stage_ms_median)
@@ -158,6 +171,21 @@ std::vector<Eigen::Isometry3d> KittiRelativeToFirst(const std::vector<Eigen::Iso
 }
 
 }  // namespace
+
+std::string NavigationCsv(const sim::NavigationReport& n) {
+  std::ostringstream csv;
+  csv << "frame,time_s,believed_x_m,believed_y_m,believed_yaw_deg,true_x_m,true_y_m,true_yaw_deg,"
+         "fixed\n";
+  for (size_t i = 0; i < n.frames.size(); ++i) {
+    const sim::NavigationFrame& f = n.frames[i];
+    csv << i << "," << FormatDouble(f.time_s) << "," << FormatDouble(f.believed.position.x()) << ","
+        << FormatDouble(f.believed.position.y()) << ","
+        << FormatDouble(f.believed.yaw_rad * 180.0 / M_PI) << ","
+        << FormatDouble(f.truth.position.x()) << "," << FormatDouble(f.truth.position.y()) << ","
+        << FormatDouble(f.truth.yaw_rad * 180.0 / M_PI) << "," << (f.fixed ? 1 : 0) << "\n";
+  }
+  return csv.str();
+}
 
 namespace {
 
@@ -242,9 +270,11 @@ void MakePlots(const std::string& folder, bool has_ground_truth, const std::stri
   std::string plot_error;
   bool ok = true;
   if (has_ground_truth) {
+    const fs::path navigation = p / "navigation.csv";  // a closed-loop run's
     ok = RunTrajectoryPlot((p / "groundtruth_tum.txt").string(),
                            (p / "estimate_in_gt_world_tum.txt").string(),
-                           (p / "trajectory.png").string(), outline_scene, &plot_error) &&
+                           (p / "trajectory.png").string(), outline_scene, &plot_error,
+                           fs::exists(navigation) ? navigation.string() : "") &&
          RunPlot({"errors", p.string(), (p / "errors.png").string()}, &plot_error);
   }
   ok = ok && RunPlot({"timing", p.string(), (p / "timing.png").string()}, &plot_error);
@@ -270,6 +300,9 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s,
     return false;
   if (!contents.scenario_yaml.empty() &&
       !WriteTextFile((p / "scenario.yaml").string(), contents.scenario_yaml, error))
+    return false;
+  if (s.has_navigation && s.navigation.mode == "vo" &&
+      !WriteTextFile((p / "navigation.csv").string(), NavigationCsv(s.navigation), error))
     return false;
   if (s.has_ground_truth) {
     std::vector<double> times_at_gt;

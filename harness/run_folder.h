@@ -13,6 +13,7 @@
 //                      metric registry's keys; null + *_reason where not applicable)
 //   vo_options.yaml    effective VO options (accepted by --config)
 //   scenario.yaml      effective scenario (simulated runs)
+//   navigation.csv     closed-loop runs (navigation: vo): believed and true robot path per frame
 //   trajectory.png, errors.png, timing.png, report.md (links the plots that were made)
 //
 // The folder is written as a marked work folder beside DIR and moved into place only when
@@ -50,6 +51,11 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& summary,
 // The plots of a written run folder (trajectory.png and errors.png with ground truth,
 // timing.png); a missing python3-matplotlib gives a warning on stderr, not an error.
 void MakePlots(const std::string& folder, bool has_ground_truth, const std::string& outline_scene);
+
+// A closed-loop run's navigation.csv (navigation: vo): per frame what the follower believed and
+// where the robot was (the wheel axle in the world, m; yaw, deg), and whether the VO's estimate
+// fixed the belief (0: lost, dead-reckoned).
+std::string NavigationCsv(const sim::NavigationReport& navigation);
 
 // The per-frame log (per_frame.csv): one row per frame, frames before the first initialised
 // one marked not_initialised (no pose, no error).

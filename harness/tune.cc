@@ -107,6 +107,8 @@ bool ReadScenarios(YamlReader& r, const YAML::Node& root, const std::string& wha
       return r.Fail(set, where + ".set", "expected a mapping of scenario keys to values");
     if (!ApplyScenarioOverrides(base, set, kOverridesSource, &s.scenario, &why))
       return r.SetError(OverrideErrorAt(r.Where(set.IsDefined() ? set : n), where + ".set", why));
+    if (const std::string closed = ClosedLoopProblem(s.scenario, "tune"); !closed.empty())
+      return r.Fail(n["scenario"], where + ".scenario", closed);
     s.set_yaml = set.IsDefined() && !set.IsNull() ? FlowYaml(set) : "{}";
     s.name = what + "_" + std::to_string(i);
     if (!r.String(n, where, "name", &s.name, false)) return false;

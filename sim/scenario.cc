@@ -172,6 +172,8 @@ bool Scenario::IsValid(std::string* error) const {
     e << "max_duration_s: expected > 0";
   else if (!(settle_s >= 0))
     e << "settle_s: expected >= 0";
+  else if (navigation != "ground_truth" && navigation != "vo")
+    e << "navigation: expected 'ground_truth' or 'vo', got '" << navigation << "'";
   else if (!(robot.speed_mps > 0 && robot.speed_mps <= 3))
     e << "robot.speed_mps: expected in (0, 3], got " << robot.speed_mps;
   else if (!(robot.max_accel_mps2 > 0))
@@ -257,7 +259,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   constexpr int kIntMax = std::numeric_limits<int>::max();
   r.CheckKeys(root, "",
               {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
-               "robot", "scene", "seed", "settle_s", "textures", "imu"});
+               "robot", "scene", "seed", "settle_s", "textures", "imu", "navigation"});
   r.String(root, "", "name", &s.name);
   std::string scene;
   r.String(root, "", "scene", &scene);
@@ -268,6 +270,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   r.Double(root, "", "physics_dt_s", &s.physics_dt_s);
   r.Double(root, "", "max_duration_s", &s.max_duration_s);
   r.Double(root, "", "settle_s", &s.settle_s);
+  r.String(root, "", "navigation", &s.navigation);
+  r.Check(s.navigation == "ground_truth" || s.navigation == "vo", root, "", "navigation",
+          "expected 'ground_truth' or 'vo', got '" + s.navigation + "'");
 
   // path: a sequence of [x, y] pairs.
   std::vector<std::pair<double, double>> path;
@@ -454,6 +459,7 @@ std::string ScenarioToYaml(const Scenario& s) {
   out << YAML::Key << "physics_dt_s" << YAML::Value << s.physics_dt_s;
   out << YAML::Key << "max_duration_s" << YAML::Value << s.max_duration_s;
   out << YAML::Key << "settle_s" << YAML::Value << s.settle_s;
+  out << YAML::Key << "navigation" << YAML::Value << s.navigation;
   out << YAML::Key << "path" << YAML::Value << YAML::BeginSeq;
   for (const auto& p : s.path)
     out << YAML::Flow << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;

@@ -97,6 +97,9 @@ struct Scenario {
   NoiseOptions noise;
   TextureSettings textures;
   ImuOptions imu;
+  // What the path follower steers on (sim/navigation.h): "ground_truth" (the true pose) or "vo"
+  // (the VO's estimate, frame by frame: the closed loop).
+  std::string navigation = "ground_truth";
 
   bool IsValid(std::string* error) const;
 };

@@ -144,6 +144,16 @@ struct Simulator::Impl {
   long imu_every = 1;
   std::unique_ptr<ImuNoiseModel> imu_noise;
   std::vector<ImuSample> imu_pending;
+  // Navigation (sim/navigation.h): the belief the follower steers on in the closed loop, the
+  // commands issued since the last frame's time (replayed on its fix), what the robot did.
+  bool closed_loop = false;
+  PlanarPose belief;
+  PlanarPose belief_at_frame;
+  std::vector<DriveCommand> commands_since_frame;
+  StepEstimator step_estimator;
+  NavigationReport nav;
+  std::vector<char> robot_geom, building_geom;  // per geom: on the robot; the building to touch
+  bool touching = false;                        // in contact with the building at the last step
 
   ~Impl() {
     renderer.reset();
@@ -293,6 +303,23 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   im.d->qpos[qadr + 6] = std::sin(yaw / 2);
   mj_forward(m, im.d);
   im.follower = std::make_unique<PathFollower>(scenario.path, scenario.robot);
+  // Navigation: the belief starts at the known start pose. The building's geoms to touch: those
+  // welded to the world that collide, except planes facing up (the floor).
+  im.closed_loop = scenario.navigation == "vo";
+  im.belief.position = scenario.path[0];
+  im.belief.yaw_rad = yaw;
+  im.belief_at_frame = im.belief;
+  im.nav.mode = scenario.navigation;
+  im.robot_geom.assign(m->ngeom, 0);
+  im.building_geom.assign(m->ngeom, 0);
+  for (int g = 0; g < m->ngeom; ++g) {
+    const int b = m->geom_bodyid[g];
+    im.robot_geom[g] = m->body_rootid[b] == im.body;
+    const bool floor = m->geom_type[g] == mjGEOM_PLANE && im.d->geom_xmat[9 * g + 8] > 0.5;
+    im.building_geom[g] = m->body_weldid[b] == 0 && !floor &&
+                          (m->geom_contype[g] != 0 || m->geom_conaffinity[g] != 0);
+    if (im.building_geom[g]) im.nav.wall_contacts = 0;
+  }
   im.start_step = std::lround(scenario.settle_s / scenario.physics_dt_s);
   im.warnings_at_start = g_warning_count;
   return sim;
@@ -351,6 +378,18 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
     // Kinematics of the current state, consistent with d->time.
     mj_step1(m, d);
     const long step = std::lround(d->time / dt);
+    const PlanarPose truth{Eigen::Vector2d(d->qpos[qadr], d->qpos[qadr + 1]),
+                           YawOf(d->qpos + qadr + 3)};
+    if (im.closed_loop && im.step_estimator && step >= im.start_step)
+      im.belief = im.step_estimator(truth);
+    if (step > im.start_step + std::lround(sc.max_duration_s / dt) && im.closed_loop) {
+      // A robot steering on its estimate may never get there (stuck on a wall, lost): the run
+      // ends at the time limit, the goal not reached.
+      im.nav.reached_goal = false;
+      im.nav.end_error_m = (truth.position - sc.path.back()).norm();
+      im.finished = true;
+      return false;
+    }
     if (step > im.start_step + std::lround(sc.max_duration_s / dt)) {
       *error = sc.source_path + ": the robot did not finish its path within max_duration_s = " +
                std::to_string(sc.max_duration_s) +
@@ -365,6 +404,17 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
     if (step >= im.start_step)
       body_track_.emplace_back(d->xpos[3 * im.body], d->xpos[3 * im.body + 1],
                                d->xpos[3 * im.body + 2]);
+    if (step >= im.start_step && im.nav.wall_contacts >= 0) {  // contacts of mj_step1
+      bool touching = false;
+      for (int i = 0; i < d->ncon && !touching; ++i) {
+        const int g1 = d->contact[i].geom1, g2 = d->contact[i].geom2;
+        touching = (im.robot_geom[g1] && im.building_geom[g2]) ||
+                   (im.robot_geom[g2] && im.building_geom[g1]);
+      }
+      if (touching && !im.touching) ++im.nav.wall_contacts;
+      if (touching) im.nav.wall_contact_s += dt;
+      im.touching = touching;
+    }
 
     // Render the samples that fall on this step.
     for (int i = 0; i < samples; ++i) {
@@ -384,20 +434,46 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
       frame->T_world_body = BodyPose(d, im.body);
       if (blur) im.renderer->Render(m, d, im.cam0, nullptr, &frame->depth_m);
       have_gt = true;
+      NavigationFrame nf;
+      nf.time_s = t_frame;
+      nf.truth = truth;
+      nf.believed = im.closed_loop ? im.belief : truth;
+      im.nav.frames.push_back(nf);
+      im.belief_at_frame = im.belief;
+      im.commands_since_frame.clear();
     }
     // End of the path: once the controller is done and the robot stands still, no new frame
     // starts (a frame already under way is completed above).
-    const Eigen::Vector2d pos(d->qpos[qadr], d->qpos[qadr + 1]);
     const double speed =
         Eigen::Vector3d(d->qvel[vadr], d->qvel[vadr + 1], d->qvel[vadr + 2]).norm();
     if (step >= im.start_step && im.follower->done() && speed < kStoppedSpeedMps && rendered == 0) {
+      im.nav.reached_goal = true;
+      im.nav.end_error_m = (truth.position - sc.path.back()).norm();
       im.finished = true;
       return false;
     }
 
-    // Control: stand still while settling, then follow the path.
+    // Control: stand still while settling, then follow the path on the true pose, or on the
+    // belief (closed loop: an estimator's, dead-reckoned with the commands between its fixes).
     DriveCommand cmd;
-    if (step >= im.start_step) cmd = im.follower->Update(pos, YawOf(d->qpos + qadr + 3), dt);
+    if (step >= im.start_step) {
+      PlanarPose steer = truth;
+      if (im.closed_loop) steer = im.belief;
+      const size_t target = im.follower->target_index();
+      const bool was_done = im.follower->done();
+      cmd = im.follower->Update(steer.position, steer.yaw_rad, dt);
+      // A waypoint the follower believes reached: where the robot really is.
+      const bool reached = im.follower->done() || (im.follower->target_index() != target &&
+                                                   sc.robot.corner_mode == "in_place");
+      if (!was_done && reached) {
+        const double err = (truth.position - sc.path[target]).norm();
+        if (!(err <= im.nav.max_waypoint_error_m)) im.nav.max_waypoint_error_m = err;
+      }
+      if (im.closed_loop) {
+        im.belief = DeadReckon(im.belief, cmd, dt);
+        im.commands_since_frame.push_back(cmd);
+      }
+    }
     double wl, wr;
     WheelSpeeds(cmd, sc.robot.wheel_radius_m, sc.robot.track_m, &wl, &wr);
     d->ctrl[im.act_left] = wl;
@@ -446,5 +522,26 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
   ++im.next_frame;
   return true;
 }
+
+PlanarPose Simulator::BeliefAtLastFrame() const { return impl_->belief_at_frame; }
+
+void Simulator::FixAtLastFrame(const PlanarPose& body) {
+  Impl& im = *impl_;
+  if (!im.closed_loop) return;
+  PlanarPose belief = body;
+  for (const DriveCommand& cmd : im.commands_since_frame)
+    belief = DeadReckon(belief, cmd, scenario_.physics_dt_s);
+  im.belief = belief;
+  if (!im.nav.frames.empty()) {
+    im.nav.frames.back().believed = body;
+    im.nav.frames.back().fixed = true;
+  }
+}
+
+void Simulator::SetStepEstimator(StepEstimator estimator) {
+  impl_->step_estimator = std::move(estimator);
+}
+
+const NavigationReport& Simulator::navigation() const { return impl_->nav; }
 
 }  // namespace sim

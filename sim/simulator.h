@@ -4,12 +4,14 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 #include "sim/imu.h"
+#include "sim/navigation.h"
 #include "sim/scenario.h"
 
 namespace sim {
@@ -60,6 +62,20 @@ class Simulator {
   int EstimatedFrames() const;
   // Robot base position (x, y, z in the world, m) after every physics step since frame 0.
   const std::vector<Eigen::Vector3d>& body_track() const { return body_track_; }
+
+  // Closed loop (navigation: vo; sim/navigation.h). What the follower believed at the time of
+  // the frame Next() gave last, before any fix of it.
+  PlanarPose BeliefAtLastFrame() const;
+  // An estimate of the body pose at the time of the frame Next() gave last: it becomes the
+  // belief, with the commands issued since that time replayed on it. Ignored with
+  // navigation: ground_truth.
+  void FixAtLastFrame(const PlanarPose& body);
+  // An estimator consulted at every control step with the true pose: its answer is the belief
+  // of that step (a perfect or a biased sensor, for tests). navigation: vo only.
+  using StepEstimator = std::function<PlanarPose(const PlanarPose& truth)>;
+  void SetStepEstimator(StepEstimator estimator);
+  // What the robot did so far (complete once Next() returned false without an error).
+  const NavigationReport& navigation() const;
 
  private:
   struct Impl;

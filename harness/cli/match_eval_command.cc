@@ -59,6 +59,10 @@ int RunMatchEval(const MatchEvalArgs& args) {
     std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
     return 2;
   }
+  if (const std::string closed = ClosedLoopProblem(scenario, "match-eval"); !closed.empty()) {
+    std::fprintf(stderr, "vobench match-eval: %s\n", closed.c_str());
+    return 2;
+  }
   MatchEvalOptions options;
   if (!args.config.empty()) {  // the matcher's options and its gate scale; the rest stays as it is
     vo::OdometryOptions vo_options;

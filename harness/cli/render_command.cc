@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "harness/pipeline.h"
 #include "harness/render.h"
 
 namespace harness {
@@ -23,6 +24,10 @@ int RunRender(const std::string& scenario_arg, const std::string& out, const std
   sim::Scenario scenario;
   if (!ResolveScenario(scenario_arg, &scenario, &error)) {
     std::fprintf(stderr, "vobench render: %s\n", error.c_str());
+    return 2;
+  }
+  if (const std::string closed = ClosedLoopProblem(scenario, "render"); !closed.empty()) {
+    std::fprintf(stderr, "vobench render: %s\n", closed.c_str());
     return 2;
   }
   RenderOptions options;

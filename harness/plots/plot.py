@@ -2,10 +2,12 @@
 """Plots for vobench reports (matplotlib, Agg backend, PNG).
 
   plot.py match-eval CSV PNG          precision / recall / F1 vs stride, one line per matcher
-  plot.py trajectory GT_TUM EST_TUM PNG [--outline-file CSV]
+  plot.py trajectory GT_TUM EST_TUM PNG [--outline-file CSV] [--navigation-file CSV]
                                       top-down trajectory, estimate vs ground truth; CSV: the
                                       scene's walls (wall,x0_m,y0_m,x1_m,y1_m), written by the
-                                      harness from the MJCF (harness/plots/plots.h, SceneOutlineCsv)
+                                      harness from the MJCF (harness/plots/plots.h, SceneOutlineCsv);
+                                      a closed-loop run's navigation.csv: the robot's believed
+                                      and driven paths instead (the wheel axle)
   plot.py errors RUN_DIR PNG          translation / rotation error along the path (per_frame.csv)
   plot.py timing RUN_DIR PNG          per-stage time per frame (per_frame.csv)
 """
@@ -84,7 +86,7 @@ def outline_polylines(segments, tol=1e-6):
     return lines
 
 
-def trajectory(gt_path, est_path, png, outline_file=None):
+def trajectory(gt_path, est_path, png, outline_file=None, navigation_file=None):
     gt, est = read_tum(gt_path), read_tum(est_path)
     fig, ax = plt.subplots(figsize=(6.5, 6.5))
     walls = outline_polylines(read_outline(outline_file)) if outline_file else []
@@ -95,15 +97,26 @@ def trajectory(gt_path, est_path, png, outline_file=None):
             xs += [p[0] for p in line] + [float("nan")]
             ys += [p[1] for p in line] + [float("nan")]
         ax.plot(xs, ys, color="0.6", linewidth=1, label="hallway walls")
-    ax.plot([p[1] for p in gt], [p[2] for p in gt], "k-", linewidth=2, label="ground truth")
-    ax.plot([p[1] for p in est], [p[2] for p in est], "r--", linewidth=1.5, label="VO estimate")
-    ax.plot(gt[0][1], gt[0][2], "go", label="start")
+    if navigation_file:
+        # The closed loop: what the follower steered on and where the robot really drove.
+        rows = read_csv(navigation_file)
+        ax.plot([float(r["true_x_m"]) for r in rows], [float(r["true_y_m"]) for r in rows], "k-",
+                linewidth=2, label="true path (driven)")
+        ax.plot([float(r["believed_x_m"]) for r in rows], [float(r["believed_y_m"]) for r in rows],
+                "r--", linewidth=1.5, label="believed path (VO, steered on)")
+        ax.plot(float(rows[0]["true_x_m"]), float(rows[0]["true_y_m"]), "go", label="start")
+        ax.plot(float(rows[-1]["true_x_m"]), float(rows[-1]["true_y_m"]), "ks", label="stopped")
+    else:
+        ax.plot([p[1] for p in gt], [p[2] for p in gt], "k-", linewidth=2, label="ground truth")
+        ax.plot([p[1] for p in est], [p[2] for p in est], "r--", linewidth=1.5, label="VO estimate")
+        ax.plot(gt[0][1], gt[0][2], "go", label="start")
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    ax.set_title("Top-down trajectory (world frame)")
+    ax.set_title("Closed loop: the robot on its VO (world frame, wheel axle)" if navigation_file
+                 else "Top-down trajectory (world frame)")
     fig.tight_layout()
     fig.savefig(png, dpi=110)
 
@@ -158,7 +171,9 @@ def main(argv):
         match_eval(argv[2], argv[3])
     elif cmd == "trajectory":
         outline_file = argv[argv.index("--outline-file") + 1] if "--outline-file" in argv else None
-        trajectory(argv[2], argv[3], argv[4], outline_file)
+        navigation_file = (argv[argv.index("--navigation-file") + 1]
+                           if "--navigation-file" in argv else None)
+        trajectory(argv[2], argv[3], argv[4], outline_file, navigation_file)
     elif cmd == "errors":
         errors(argv[2], argv[3])
     elif cmd == "timing":

@@ -72,8 +72,13 @@ std::string SceneOutlineCsv(const std::vector<sim::SceneWall>& walls) {
 }
 
 bool RunTrajectoryPlot(const std::string& gt_tum, const std::string& est_tum,
-                       const std::string& png, const std::string& scene_path, std::string* error) {
+                       const std::string& png, const std::string& scene_path, std::string* error,
+                       const std::string& navigation_csv) {
   std::vector<std::string> args = {"trajectory", gt_tum, est_tum, png};
+  if (!navigation_csv.empty()) {
+    args.push_back("--navigation-file");
+    args.push_back(navigation_csv);
+  }
   if (scene_path.empty()) return RunPlot(args, error);
   std::vector<sim::SceneWall> walls;
   if (!sim::WallsOfScene(scene_path, &walls, error)) return false;

@@ -25,9 +25,11 @@ bool RunPythonScript(const std::string& script, const std::vector<std::string>& 
 std::string SceneOutlineCsv(const std::vector<sim::SceneWall>& walls);
 
 // `plot.py trajectory GT_TUM EST_TUM PNG`, outlined by the walls of the MJCF scene `scene_path`
-// ("" = no outline; the outline goes through a file next to the PNG, removed afterwards).
+// ("" = no outline; the outline goes through a file next to the PNG, removed afterwards). A
+// closed-loop run's `navigation_csv` (run_folder.h) adds the robot's believed and driven paths.
 bool RunTrajectoryPlot(const std::string& gt_tum, const std::string& est_tum,
-                       const std::string& png, const std::string& scene_path, std::string* error);
+                       const std::string& png, const std::string& scene_path, std::string* error,
+                       const std::string& navigation_csv = "");
 
 // `s` quoted for the POSIX shell (as it is when it holds only safe characters).
 std::string ShellQuoted(const std::string& s);

@@ -31,6 +31,11 @@ harness::RunSummary FullSummary() {
   s.lost_frames = 3;
   s.initial_orientation_ok = true;
   s.initial_orientation_error_deg = 1.5;
+  s.has_navigation = true;
+  s.navigation.reached_goal = true;
+  s.navigation.end_error_m = 0.05;
+  s.navigation.max_waypoint_error_m = 0.02;
+  s.navigation.wall_contacts = 0;
   for (const char* stage :
        {"ba", "depth", "detect", "disparity", "guided", "match", "motion", "predict"})
     s.stage_ms_median[stage] = 1.5;
@@ -64,11 +69,12 @@ TEST(MetricRegistryTest, GroupsDecideWhatARunWithoutGroundTruthWrites) {
   harness::RunSummary s = FullSummary();
   s.has_ground_truth = false;
   s.match_stats.matches = 0;
+  s.has_navigation = false;
   const json j = json::parse(harness::MetricsJson(s));
   for (const harness::MetricInfo& m : RunMetrics()) {
     const bool written = harness::FindMetricValue(j, m.key) != nullptr;
-    EXPECT_EQ(written,
-              m.group != MetricGroup::kAccuracy && m.group != MetricGroup::kMatches && !m.reason)
+    EXPECT_EQ(written, m.group != MetricGroup::kAccuracy && m.group != MetricGroup::kMatches &&
+                           m.group != MetricGroup::kNavigation && !m.reason)
         << m.key;
   }
 }

@@ -246,6 +246,27 @@ TEST_F(ScenarioFileTest, OutOfRangeValues) {
             std::string::npos);
 }
 
+// navigation (sim/navigation.h): ground_truth by default, vo for the closed loop, nothing else.
+TEST_F(ScenarioFileTest, NavigationIsGroundTruthOrVoAndAnythingElseIsRefusedAtItsLine) {
+  sim::Scenario s;
+  ASSERT_EQ(Load(kGood, &s), "");
+  EXPECT_EQ(s.navigation, "ground_truth");
+  ASSERT_EQ(Load(std::string(kGood) + "navigation: vo\n", &s), "");
+  EXPECT_EQ(s.navigation, "vo");
+  EXPECT_NE(sim::ScenarioToYaml(s).find("navigation: vo\n"), std::string::npos);
+  const std::string e = Load(std::string(kGood) + "navigation: slam\n");
+  EXPECT_NE(e.find("s.yaml:12: key 'navigation': expected 'ground_truth' or 'vo', got 'slam'"),
+            std::string::npos)
+      << e;
+  // Built in code: Simulator::Create refuses it through Scenario::IsValid.
+  s.navigation = "odometry";
+  std::string why;
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_NE(why.find("navigation: expected 'ground_truth' or 'vo', got 'odometry'"),
+            std::string::npos)
+      << why;
+}
+
 }  // namespace
 
 namespace {
