@@ -64,6 +64,13 @@ bool ScenarioAt(const BreakpointSpec& spec, double x, uint64_t seed, sim::Scenar
   return ApplyScenarioOverrides(spec.scenario, overrides, "--vary " + spec.key, scenario, error);
 }
 
+// The scenario reader's message about the overrides without its place in the generated text
+// ("--vary k (overrides of l_hallway):13: key 'k': expected ..." -> "key 'k': expected ...").
+std::string ReaderMessage(const std::string& why) {
+  const size_t key = why.find(": key '");
+  return key == std::string::npos ? why : why.substr(key + 2);
+}
+
 // Replaces every occurrence of `from` in `text` by `to` (the work folder's name by the output
 // folder's in failure messages, so breakpoint.json does not depend on the process).
 std::string ReplaceAll(std::string text, const std::string& from, const std::string& to) {
@@ -582,7 +589,7 @@ bool PrepareBreakpoint(BreakpointSpec* spec, std::string* error) {
     for (const double x : {s.lo, s.hi}) {
       s.integer = false;
       if (!ScenarioAt(s, x, s.scenario.seed, &probe, &why)) {
-        *error = "--range: " + s.key + "=" + FormatDouble(x) + " is refused: " + why;
+        *error = "--range: " + s.key + "=" + FormatDouble(x) + " is refused: " + ReaderMessage(why);
         return false;
       }
     }
@@ -591,7 +598,8 @@ bool PrepareBreakpoint(BreakpointSpec* spec, std::string* error) {
     if (inside != s.lo && !ScenarioAt(s, inside, s.scenario.seed, &probe, &why)) {
       s.integer = true;
       if (!ScenarioAt(s, std::round(inside), s.scenario.seed, &probe, &why)) {
-        *error = "--range: " + s.key + "=" + FormatDouble(inside) + " is refused: " + why;
+        *error =
+            "--range: " + s.key + "=" + FormatDouble(inside) + " is refused: " + ReaderMessage(why);
         return false;
       }
       if (s.lo != std::round(s.lo) || s.hi != std::round(s.hi)) {

@@ -17,7 +17,8 @@ data="$prefix/share/vobench"
 for f in bin/vobench share/vobench/scenes/l_hallway.yaml share/vobench/scenes/hallway_l.xml \
          share/vobench/scenes/robot_p2dx.xml share/vobench/suites/ci.yaml \
          share/vobench/harness/plots/plot.py share/vobench/harness/plots/suite_plot.py \
-         share/vobench/harness/plots/tune_plot.py share/vobench/results/baseline.json \
+         share/vobench/harness/plots/tune_plot.py share/vobench/harness/plots/breakpoint_plot.py \
+         share/vobench/results/baseline.json \
          include/vo/odometry.h; do
   [ -e "$prefix/$f" ] || { echo "FAIL: not installed: <prefix>/$f"; status=1; }
 done

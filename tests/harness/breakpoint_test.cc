@@ -212,7 +212,9 @@ TEST(BreakpointInputTest, TheKeyIsAScenarioKeyWhoseParserTakesTheRange) {
   EXPECT_NE(error.find("robot.turn_rate_dps"), std::string::npos) << error;
   s = L("noise.pixel_sigma", -5, 20);
   EXPECT_FALSE(harness::PrepareBreakpoint(&s, &error));
-  EXPECT_NE(error.find("--range: noise.pixel_sigma=-5 is refused: "), std::string::npos) << error;
+  EXPECT_NE(error.find("--range: noise.pixel_sigma=-5 is refused: key 'noise.pixel_sigma': "),
+            std::string::npos)
+      << error;
   s = L("noise.motion_blur_samples", 2, 40.5);
   EXPECT_FALSE(harness::PrepareBreakpoint(&s, &error));
   s = L("stride", 0, 8);

@@ -117,6 +117,16 @@ TEST(PlotScriptsTest, EveryScriptWritesAPngFromTheCommittedResults) {
   ExpectPng(dir / "objective.png");
   ran.insert("tune_plot.py");
 
+  // A breaking point with a bracket, and one without (not crossed in the range).
+  for (const char* result : {"l_hallway_pixel_sigma", "l_hallway_turn_rate"}) {
+    const std::string png = dir / (std::string(result) + ".png");
+    EXPECT_TRUE(harness::RunPythonScript("breakpoint_plot.py",
+                                         {kSource + "/results/breakpoint/" + result, png}, &error))
+        << error;
+    ExpectPng(png);
+  }
+  ran.insert("breakpoint_plot.py");
+
   // A new script in harness/plots/ needs a case here.
   for (const auto& e : fs::directory_iterator(kSource + "/harness/plots")) {
     if (e.path().extension() == ".py") {
