@@ -27,8 +27,9 @@ struct EvalArgs {
   bool quiet = false;
 };
 
-// Runs the parsed command; max_difference_given: --max-difference was on the command line.
-int RunEval(const EvalArgs& a, bool max_difference_given) {
+// Runs the parsed command; max_difference_given: --max-difference was on the command line;
+// rosbag_flag: the first of the rosbag-only flags given ("" = none).
+int RunEval(const EvalArgs& a, bool max_difference_given, const std::string& rosbag_flag) {
   std::string error;
   EvalOptions options;
   if (!ParseDatasetFormat(a.format, &options.format)) {
@@ -38,6 +39,10 @@ int RunEval(const EvalArgs& a, bool max_difference_given) {
   }
   if (options.format == DatasetFormat::kRosbag && !RosbagSupported()) {
     std::fprintf(stderr, "vobench eval: --format rosbag: %s\n", RosbagUnavailable().c_str());
+    return 2;
+  }
+  if (options.format != DatasetFormat::kRosbag && !rosbag_flag.empty()) {
+    std::fprintf(stderr, "vobench eval: %s: only with --format rosbag\n", rosbag_flag.c_str());
     return 2;
   }
   options.rosbag_topics = a.topics;
@@ -153,7 +158,12 @@ Command AddEvalCommand(CLI::App& app) {
                    "for kitti and tum, 0.003 for euroc and rosbag)");
   eval->add_flag("--no-plots", a->no_plots, "Skip the PNG plots");
   eval->add_flag("-q,--quiet", a->quiet, "No progress display");
-  return {eval, [a, eval] { return RunEval(*a, eval->count("--max-difference") > 0); }};
+  return {eval, [a, eval] {
+            std::string rosbag_flag;
+            for (const char* flag : {"--left", "--right", "--imu", "--gt-topic", "--calib"})
+              if (rosbag_flag.empty() && eval->count(flag) > 0) rosbag_flag = flag;
+            return RunEval(*a, eval->count("--max-difference") > 0, rosbag_flag);
+          }};
 }
 
 }  // namespace harness

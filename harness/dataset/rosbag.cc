@@ -295,6 +295,15 @@ struct RosbagReader::Impl {
   std::string left_frame_id;
 
   std::string Where(const std::string& topic) const { return path + ": topic " + topic + ": "; }
+  // Whether `topic` is in the bag (*present); false, naming it, when it holds another type.
+  bool CheckTopic(const std::map<std::string, TopicInfo>& topics, const std::string& topic,
+                  const std::string& type, bool* present, std::string* error) const {
+    const auto it = topics.find(topic);
+    *present = it != topics.end();
+    if (*present && it->second.type != type)
+      return Fail(error, Where(topic) + "type " + it->second.type + ", expected " + type);
+    return true;
+  }
   bool IndexImages(const std::map<std::string, TopicInfo>& topics, std::string* error);
   bool ReadCalibration(const std::map<std::string, TopicInfo>& topics, std::string* error);
   bool ReadImu(const std::map<std::string, TopicInfo>& topics, std::string* error);
@@ -312,12 +321,11 @@ bool RosbagReader::Impl::IndexImages(const std::map<std::string, TopicInfo>& top
   std::map<int64_t, rosbag::MessageInstance> by_stamp[2];
   for (int cam = 0; cam < 2; ++cam) {
     const std::string& topic = cam == 0 ? options.topics.left : options.topics.right;
-    const auto it = topics.find(topic);
-    if (it == topics.end())
+    bool present = false;
+    if (!CheckTopic(topics, topic, "sensor_msgs/Image", &present, error)) return false;
+    if (!present)
       return Fail(error, Where(topic) + "no messages (" + TopicList(topics) +
                              "; choose the image topics with --left / --right)");
-    if (it->second.type != "sensor_msgs/Image")
-      return Fail(error, Where(topic) + "type " + it->second.type + ", expected sensor_msgs/Image");
     rosbag::View view(bag, rosbag::TopicQuery(topic));
     for (const rosbag::MessageInstance& m : view) {
       const sensor_msgs::Image::ConstPtr image = m.instantiate<sensor_msgs::Image>();
@@ -365,14 +373,12 @@ bool RosbagReader::Impl::ReadCalibration(const std::map<std::string, TopicInfo>&
   for (int cam = 0; cam < 2; ++cam) {
     const std::string topic =
         CameraInfoTopic(cam == 0 ? options.topics.left : options.topics.right);
-    const auto it = topics.find(topic);
-    if (it == topics.end())
+    bool present = false;
+    if (!CheckTopic(topics, topic, "sensor_msgs/CameraInfo", &present, error)) return false;
+    if (!present)
       return Fail(error, Where(topic) +
                              "no messages: the calibration comes from camera_info or "
                              "from --calib cam0.yaml cam1.yaml (EuRoC sensor.yaml)");
-    if (it->second.type != "sensor_msgs/CameraInfo")
-      return Fail(error,
-                  Where(topic) + "type " + it->second.type + ", expected sensor_msgs/CameraInfo");
     rosbag::View view(bag, rosbag::TopicQuery(topic));
     const sensor_msgs::CameraInfo::ConstPtr first =
         view.begin()->instantiate<sensor_msgs::CameraInfo>();
@@ -411,10 +417,9 @@ bool RosbagReader::Impl::ReadCalibration(const std::map<std::string, TopicInfo>&
 bool RosbagReader::Impl::ReadImu(const std::map<std::string, TopicInfo>& topics,
                                  std::string* error) {
   const std::string& topic = options.topics.imu;
-  const auto it = topics.find(topic);
-  if (it == topics.end()) return true;  // no IMU
-  if (it->second.type != "sensor_msgs/Imu")
-    return Fail(error, Where(topic) + "type " + it->second.type + ", expected sensor_msgs/Imu");
+  bool present = false;
+  if (!CheckTopic(topics, topic, "sensor_msgs/Imu", &present, error)) return false;
+  if (!present) return true;  // no IMU
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   double gyro_var = 0.0, accel_var = 0.0;
   for (const rosbag::MessageInstance& m : view) {
@@ -456,10 +461,9 @@ bool RosbagReader::Impl::ReadImu(const std::map<std::string, TopicInfo>& topics,
 bool RosbagReader::Impl::IndexDepth(const std::map<std::string, TopicInfo>& topics,
                                     std::string* error) {
   const std::string& topic = options.topics.depth;
-  const auto it = topics.find(topic);
-  if (it == topics.end()) return true;  // no depth
-  if (it->second.type != "sensor_msgs/Image")
-    return Fail(error, Where(topic) + "type " + it->second.type + ", expected sensor_msgs/Image");
+  bool present = false;
+  if (!CheckTopic(topics, topic, "sensor_msgs/Image", &present, error)) return false;
+  if (!present) return true;  // no depth
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& m : view) {
     const sensor_msgs::Image::ConstPtr image = m.instantiate<sensor_msgs::Image>();
@@ -497,11 +501,9 @@ bool RosbagReader::Impl::Depth(size_t index, cv::Mat* depth_m, std::string* erro
 bool RosbagReader::Impl::ReadGroundTruth(const std::map<std::string, TopicInfo>& topics,
                                          std::string* error) {
   const std::string& topic = options.topics.ground_truth;
-  const auto it = topics.find(topic);
-  if (it == topics.end()) return true;  // no ground truth
-  if (it->second.type != "geometry_msgs/TransformStamped")
-    return Fail(error, Where(topic) + "type " + it->second.type +
-                           ", expected geometry_msgs/TransformStamped");
+  bool present = false;
+  if (!CheckTopic(topics, topic, "geometry_msgs/TransformStamped", &present, error)) return false;
+  if (!present) return true;  // no ground truth
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& m : view) {
     const geometry_msgs::TransformStamped::ConstPtr g =

@@ -250,6 +250,14 @@ TEST_F(RosbagTest, SwappedImageTopicsAreRefused) {
                 "--left /cam1/image_raw --right /cam0/image_raw");
 }
 
+TEST_F(RosbagTest, RosbagFlagsOnlyWithTheRosbagFormat) {
+  const auto r = RunVobench("eval --format kitti --dataset " + Kitti() + " --left /cam0/x --out " +
+                            Path("out") + " -q");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--left: only with --format rosbag"));
+  EXPECT_FALSE(fs::exists(Path("out")));
+}
+
 TEST_F(RosbagTest, NotABagIsRefused) {
   vobench_test::WriteText(Path("text.bag"), "this is not a bag\n");
   const auto r = RunVobench("eval --format rosbag --dataset " + Path("text.bag") + " --out " +
