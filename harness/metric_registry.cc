@@ -210,6 +210,14 @@ std::vector<MetricInfo> MakeRegistry() {
              "largest true distance from a waypoint when the follower believed it was there "
              "(null: none reached)",
              [](const RunSummary& s) { return NumberOrNull(s.navigation.max_waypoint_error_m); }),
+      Reason("navigation.error_reason", kNav, "why the end or waypoint error is null",
+             [](const RunSummary& s) {
+               if (!std::isfinite(s.navigation.end_error_m))
+                 return std::string("the run ended before the robot did (--max-frames)");
+               if (!std::isfinite(s.navigation.max_waypoint_error_m))
+                 return std::string("the follower never believed it reached a waypoint");
+               return std::string();
+             }),
       Metric("navigation.wall_contacts", "", Better::kLower, kNav,
              "contact events of the robot with the building's collision geoms (MuJoCo contacts)",
              [](const RunSummary& s) {

@@ -107,6 +107,26 @@ TEST(ClosedLoopTest, AnOpenLoopRunReportsTheFollowersOwnEndError) {
   EXPECT_FALSE(fs::exists(options.out_dir + "/navigation.csv"));
 }
 
+// A run cut short (--max-frames) ends before the robot does: no end error, with the reason.
+TEST(ClosedLoopTest, ARunCutShortHasNoEndErrorAndSaysWhy) {
+  TempDir dir("closed_loop");
+  harness::RunOptions options;
+  options.out_dir = dir / "run";
+  options.progress = false;
+  options.plots = false;
+  options.max_frames = 10;
+  harness::RunSummary s;
+  std::string error;
+  ASSERT_TRUE(harness::RunScenario(ShortClosedLoop(), vo::OdometryOptions(), options, &s, &error))
+      << error;
+  const nlohmann::json m = nlohmann::json::parse(ReadText(options.out_dir + "/metrics.json"));
+  const nlohmann::json& n = m["navigation"];
+  EXPECT_EQ(n["reached_goal"], false);
+  EXPECT_TRUE(n["end_error_m"].is_null());
+  EXPECT_TRUE(n["max_waypoint_error_m"].is_null());
+  EXPECT_EQ(n["error_reason"], "the run ended before the robot did (--max-frames)");
+}
+
 // render, match-eval and tune simulate without a VO in the loop: a closed-loop scenario is
 // refused, naming the file and the key, before anything is written.
 TEST(ClosedLoopTest, CommandsThatSimulateWithoutAVoRefuseIt) {

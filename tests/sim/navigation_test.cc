@@ -88,8 +88,8 @@ TEST(NavigationTest, FixesMapAVoWorldBackToTheBodyThroughTheStartAndTheRig) {
 // solid walls).
 TEST(NavigationTest, APerfectEstimatorDrivesTheOpenLoopRunExactly) {
   TempDir dir("navigation");
-  const std::string scene = WriteScene(dir, Box("south", 1.0, -1.05, 2.5, 0.05) +
-                                                Box("north", 1.0, 2.55, 2.5, 0.05));
+  const std::string scene =
+      WriteScene(dir, Box("south", 1.0, -1.05, 2.5, 0.05) + Box("north", 1.0, 2.55, 2.5, 0.05));
   sim::Scenario open = SmallScenario(scene, 2.0);
   open.path.push_back(Eigen::Vector2d(2.0, 1.5));
   sim::Scenario closed = open;
@@ -146,8 +146,8 @@ TEST(NavigationTest, FixesAtTheFrameRateWithDeadReckoningBetweenReachTheGoal) {
   double belief_error_m = 0.0;  // the dead-reckoned belief at a frame vs the truth
   while (simulator->Next(&frame, &error)) {
     const sim::PlanarPose truth = sim::PlanarPoseOf(frame.T_world_body);
-    belief_error_m = std::max(
-        belief_error_m, (simulator->BeliefAtLastFrame().position - truth.position).norm());
+    belief_error_m =
+        std::max(belief_error_m, (simulator->BeliefAtLastFrame().position - truth.position).norm());
     if (frames++ % 2 == 0) simulator->FixAtLastFrame(truth);  // every other frame "lost"
   }
   ASSERT_TRUE(error.empty()) << error;
