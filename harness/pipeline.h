@@ -21,6 +21,7 @@
 #include "harness/match_eval.h"
 #include "harness/metrics.h"
 #include "sim/scenario.h"
+#include "sim/simulator.h"
 #include "vo/odometry.h"
 
 namespace harness {
@@ -64,6 +65,11 @@ struct StereoSequence {
 // A simulated scenario as a sequence (the simulator lives as long as the sequence's source).
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
                           std::string* error);
+// What such a sequence says of itself, from the scenario and its simulator's calibration:
+// every field but `next` (shared with the cached sequences of sequence_cache.h).
+void DescribeScenarioSequence(const sim::Scenario& scenario,
+                              const sim::StereoCalibration& calibration, int expected_frames,
+                              StereoSequence* sequence);
 
 // Frames of `source` into memory (up to max_frames, 0 = all), with a progress display named
 // `label` and the interrupt check of every long loop (the message names `out`).
