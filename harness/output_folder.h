@@ -5,10 +5,10 @@
 //    "command": ["vobench", "run", "--out", "m"], "created_utc": "2026-12-01T21:46:24Z",
 //    "pid": 4242, "host": "node1"}
 // `kind` says what the folder is: "run" (run, eval), "dataset" (render), "tune", "suite"
-// (suite, suite merge, check), "match-eval", "score", "breakpoint". Before vobench replaces a
-// folder (a re-run, render --overwrite, a suite's runs/<id>) or writes into one (a suite
-// resumes), the folder must be absent, empty, or hold a marker of the same kind; anything else
-// is refused with
+// (suite, suite merge, check), "match-eval", "score", "breakpoint", "sequence" (sequence_cache.h).
+// Before vobench replaces a folder (a re-run, render --overwrite, a suite's runs/<id>) or writes
+// into one (a suite resumes), the folder must be absent, empty, or hold a marker of the same kind;
+// anything else is refused with
 //   "DIR: exists and was not written by vobench (no .vobench.json), so it is not a vobench run
 //    folder; remove it yourself or choose another --out"
 // Folders of vobench versions before the marker have none and are refused the same way.

@@ -15,17 +15,8 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
                           std::string* error) {
   std::shared_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
-  sequence->name = scenario.name;
-  sequence->camera = ToStereoCamera(simulator->calibration());
-  sequence->expected_frames = simulator->EstimatedFrames();
-  sequence->scenario_yaml = sim::ScenarioToYaml(scenario);
-  sequence->outline_scene = scenario.scene_path;
-  sequence->axle_behind_camera_m = scenario.camera.forward_m;
-  sequence->camera_pitch_deg = scenario.camera.pitch_deg;
-  sequence->has_imu = true;
-  sequence->imu = scenario.imu;
-  sequence->T_imu_cam0 =
-      CameraInImuFrame(simulator->calibration().T_body_cam0, simulator->calibration().T_body_imu);
+  DescribeScenarioSequence(scenario, simulator->calibration(), simulator->EstimatedFrames(),
+                           sequence);
   sequence->next = [simulator, f = sim::StereoFrame()](DatasetFrame* frame,
                                                        std::string* err) mutable {
     if (!simulator->Next(&f, err)) return false;
@@ -52,6 +43,21 @@ std::string ClosedLoopProblem(const sim::Scenario& scenario, const std::string& 
   return (scenario.source_path.empty() ? scenario.name : scenario.source_path) +
          ": navigation: vo steers the robot on the VO frame by frame; `" + command +
          "` simulates without a VO in the loop (use `vobench run`, or navigation: ground_truth)";
+}
+
+void DescribeScenarioSequence(const sim::Scenario& scenario,
+                              const sim::StereoCalibration& calibration, int expected_frames,
+                              StereoSequence* sequence) {
+  sequence->name = scenario.name;
+  sequence->camera = ToStereoCamera(calibration);
+  sequence->expected_frames = expected_frames;
+  sequence->scenario_yaml = sim::ScenarioToYaml(scenario);
+  sequence->outline_scene = scenario.scene_path;
+  sequence->axle_behind_camera_m = scenario.camera.forward_m;
+  sequence->camera_pitch_deg = scenario.camera.pitch_deg;
+  sequence->has_imu = true;
+  sequence->imu = scenario.imu;
+  sequence->T_imu_cam0 = CameraInImuFrame(calibration.T_body_cam0, calibration.T_body_imu);
 }
 
 bool ReadAllFrames(const FrameSource& source, int max_frames, int expected_frames,

@@ -22,6 +22,7 @@
 #include "harness/metrics.h"
 #include "sim/navigation.h"
 #include "sim/scenario.h"
+#include "sim/simulator.h"
 #include "vo/odometry.h"
 
 namespace harness {
@@ -76,6 +77,11 @@ struct StereoSequence {
 // each frame's result (RunFrames does), and its frames cannot be simulated ahead of the VO.
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
                           std::string* error);
+// What such a sequence says of itself, from the scenario and its simulator's calibration:
+// every field but `next` (shared with the cached sequences of sequence_cache.h).
+void DescribeScenarioSequence(const sim::Scenario& scenario,
+                              const sim::StereoCalibration& calibration, int expected_frames,
+                              StereoSequence* sequence);
 
 // "" when `command` may simulate `scenario` without a VO in the loop (frames rendered ahead,
 // kept in memory or on disk); else why not: navigation: vo steers the robot on the VO's

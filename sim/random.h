@@ -24,6 +24,11 @@ class SplitMix64 {
   double Normal() {
     const double u1 = 1.0 - Uniform();  // (0, 1]
     const double u2 = Uniform();
+    return BoxMuller(u1, u2);
+  }
+  // The transform itself: u1 in (0, 1], u2 in [0, 1), drawn in that order (noise.cc's fast path
+  // draws them itself and calls this where it needs the exact value).
+  static double BoxMuller(double u1, double u2) {
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
   }
 

@@ -8,6 +8,7 @@
 #include "harness/path_names.h"
 #include "harness/render.h"
 #include "harness/run.h"
+#include "harness/sequence_cache.h"
 #include "harness/vo_config.h"
 
 namespace harness {
@@ -17,7 +18,8 @@ struct RunArgs {
   std::string scenario = "l_hallway";
   std::string config;
   std::string dataset;
-  std::string out;  // "" = out/run/<scenario or dataset folder name>
+  std::string out;             // "" = out/run/<scenario or dataset folder name>
+  std::string sequence_cache;  // "" = simulate here; else the shared sequences' folder
   int max_frames = 0;
   int stride = 1;
   bool no_plots = false;
@@ -25,7 +27,8 @@ struct RunArgs {
 };
 
 int RunRun(const std::string& scenario_arg, const std::string& config, const std::string& dataset,
-           std::string out, int max_frames, int stride, bool no_plots, bool quiet) {
+           std::string out, const std::string& sequence_cache, int max_frames, int stride,
+           bool no_plots, bool quiet) {
   std::string error;
   if (max_frames < 0) {  // also refused by the option's check; kept for callers of RunRun
     std::fprintf(stderr, "vobench run: --max-frames: must be >= 0, got %d\n", max_frames);
@@ -43,6 +46,12 @@ int RunRun(const std::string& scenario_arg, const std::string& config, const std
   options.frame_stride = stride;
   RunSummary summary;
   bool ok;
+  if (!dataset.empty() && !sequence_cache.empty()) {
+    std::fprintf(stderr,
+                 "vobench run: --sequence-cache: only for a simulated scenario, not "
+                 "with --dataset\n");
+    return 2;
+  }
   if (!dataset.empty()) {
     if (out.empty()) {
       const std::string name = DatasetName(dataset);
@@ -74,7 +83,14 @@ int RunRun(const std::string& scenario_arg, const std::string& config, const std
       out = "out/run/" + scenario.name;
     }
     options.out_dir = out;
-    ok = RunScenario(scenario, vo_options, options, &summary, &error);
+    if (sequence_cache.empty()) {
+      ok = RunScenario(scenario, vo_options, options, &summary, &error);
+    } else {
+      StereoSequence sequence;  // the first max_frames frames, simulated once for every run
+      ok = OpenSharedScenarioSequence(scenario, max_frames, sequence_cache, !quiet, &sequence,
+                                      &error) &&
+           RunSequence(sequence, vo_options, options, &summary, &error);
+    }
   }
   if (!ok) {
     std::fprintf(stderr, "vobench run: %s\n", error.c_str());
@@ -149,11 +165,16 @@ Command AddRunCommand(CLI::App& app) {
   run->add_option("--stride", a->stride,
                   "The VO sees every k-th frame (less overlap); --max-frames counts all frames")
       ->check(AtLeast(1));
+  run->add_option("--sequence-cache", a->sequence_cache,
+                  "Folder of simulated sequences shared by runs of the same scenario, seed and "
+                  "--max-frames (a suite's): the first run simulates the sequence into it, the "
+                  "others (other --config or --stride) read its frames, bit for bit the same")
+      ->check(NonEmpty());
   run->add_flag("--no-plots", a->no_plots, "Skip the PNG plots");
   run->add_flag("-q,--quiet", a->quiet, "No progress display");
   return {run, [a] {
-            return RunRun(a->scenario, a->config, a->dataset, a->out, a->max_frames, a->stride,
-                          a->no_plots, a->quiet);
+            return RunRun(a->scenario, a->config, a->dataset, a->out, a->sequence_cache,
+                          a->max_frames, a->stride, a->no_plots, a->quiet);
           }};
 }
 

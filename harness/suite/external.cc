@@ -25,6 +25,7 @@
 #include "harness/interrupt.h"
 #include "harness/output_folder.h"
 #include "harness/render.h"
+#include "harness/sequence_cache.h"
 #include "harness/sim_adapter.h"
 #include "harness/suite/child_process.h"
 #include "harness/suite/folder.h"
@@ -38,9 +39,8 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
-constexpr auto kPoll = std::chrono::milliseconds(20);       // polling period of the command
-constexpr double kKillGraceS = 2.0;                         // SIGTERM -> SIGKILL
-constexpr auto kLockPoll = std::chrono::milliseconds(100);  // waiting for a sequence's writer
+constexpr auto kPoll = std::chrono::milliseconds(20);  // polling period of the command
+constexpr double kKillGraceS = 2.0;                    // SIGTERM -> SIGKILL
 
 // argv with every placeholder replaced.
 std::vector<std::string> Expand(const std::vector<std::string>& argv,
@@ -53,23 +53,6 @@ std::vector<std::string> Expand(const std::vector<std::string>& argv,
     out.push_back(a);
   }
   return out;
-}
-
-// Waits for the lock of a sequence's writer (another run may be writing it).
-bool LockSequence(const fs::path& dir, FolderLock* lock, std::string* error) {
-  for (std::string why; !lock->Acquire(dir.string() + ".writer.lock", dir.string(), &why);) {
-    if (why.find("another vobench") == std::string::npos) {
-      *error = why;
-      return false;
-    }
-    if (InterruptSignal() != 0) {
-      *error = "interrupted by signal " + std::to_string(InterruptSignal()) +
-               " while waiting for the sequence " + dir.string();
-      return false;
-    }
-    std::this_thread::sleep_for(kLockPoll);
-  }
-  return true;
 }
 
 // The writer's options for the sequence of `scenario` seen at `stride`.
@@ -96,7 +79,7 @@ bool SharedSequence(const ExternalRunSpec& spec, const fs::path& datasets_dir, f
   fs::create_directories(datasets_dir, ec);
   {
     FolderLock lock;
-    if (!LockSequence(full, &lock, error)) return false;
+    if (!LockSharedFolder(full.string(), &lock, error)) return false;
     ExternalRunSpec whole = spec;
     whole.stride = 1;
     if (!HasFolderMarker(full.string(), "dataset") && !WriteSequence(whole, full.string(), error))
@@ -108,7 +91,7 @@ bool SharedSequence(const ExternalRunSpec& spec, const fs::path& datasets_dir, f
   }
   *dir = full.string() + "_k" + std::to_string(spec.stride);
   FolderLock lock;
-  if (!LockSequence(*dir, &lock, error)) return false;
+  if (!LockSharedFolder(dir->string(), &lock, error)) return false;
   return HasFolderMarker(dir->string(), "dataset") ||
          WriteStridedCopy(spec, full.string(), dir->string(), error);
 }

@@ -15,6 +15,9 @@
 //                   tmp/shard<i>of<N>/<id>, the suite adds suite_run.json and renames it into
 //                   runs/ (shards sharing one output folder keep out of each other's tmp/);
 //                   an existing runs/<id> is replaced only when it is a marked run folder.
+//   tmp/shard<i>of<N>/     the work folder of a call: its children's run folders, the
+//                   sequences its runs share (sequences/: harness/sequence_cache.h; datasets/:
+//                   external configurations); removed when the call ends
 //   runs/<id>.failed.txt   a failed run: command, exit status, the tail of its log
 //   logs/<id>.log   stdout and stderr of the child
 //   summary.csv, summary.md, summary.png   the table across runs (written atomically)

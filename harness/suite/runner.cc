@@ -113,9 +113,23 @@ std::vector<std::string> RunArgv(const std::string& binary, const fs::path& out,
                                    std::to_string(r.max_frames),
                                    "--stride",
                                    std::to_string(r.stride),
+                                   "--sequence-cache",
+                                   (tmp.parent_path() / "sequences").string(),
                                    "-q"};
   if (!plots) argv.push_back("--no-plots");
   return argv;
+}
+
+// The queue with the first run of each sequence (scenario, seed: the runs of all configurations
+// and strides share its frames) first, the others after them, each part in suite order: with
+// several jobs at once, the children simulate different sequences rather than wait on one.
+std::deque<Job> FirstOfEachSequenceFirst(const std::deque<Job>& queue) {
+  std::deque<Job> first, rest;
+  std::set<std::pair<std::string, uint64_t>> seen;
+  for (const Job& job : queue)
+    (seen.insert({job.run.scenario, job.run.seed}).second ? first : rest).push_back(job);
+  first.insert(first.end(), rest.begin(), rest.end());
+  return first;
 }
 
 std::string SelfExecutable() {
@@ -174,6 +188,7 @@ bool RunSuite(const Suite& suite, const SuiteOptions& options, SuiteResult* resu
     }
     queue.push_back({r, RunArgv(binary, out, work / r.id, r, options.run_plots), work / r.id, {}});
   }
+  queue = FirstOfEachSequenceFirst(queue);
   const int total = static_cast<int>(queue.size());
   if (options.progress)
     std::fprintf(

@@ -2,6 +2,15 @@
 // once) writing into the suite's output folder (folder.h), resumable, and the merge of the
 // folders of a suite's shards. The summary (summary.h) is written at the end of both.
 //
+// Each sequence is simulated once per call: the built-in runs get `--sequence-cache
+// tmp/<shard>/sequences` (harness/sequence_cache.h), so the first run of a scenario and seed
+// simulates it into that folder under a lock and the runs of the other configurations and
+// strides read its frames, bit for bit the same (their run folders equal those of runs that
+// simulate for themselves). The first run of each sequence is started first, so that with
+// several jobs the children simulate different sequences rather than wait on one. The cache
+// goes with the work folder when the call ends (a resumed call simulates again the sequences
+// of the runs it still has to do).
+//
 // Resume: a run whose runs/<id>/suite_run.json records the same spec hash (effective scenario,
 // VO options, stride, max_frames) is kept; anything else is redone; the shard's tmp/ folder and
 // marked runs/*.partial leftovers are removed. The hash does not cover the vobench binary: use

@@ -471,6 +471,10 @@ TEST(SuiteRunTest, WritesEveryRunAndResumesOnlyUnfinishedRuns) {
   fs::remove_all(out / "runs" / (gone + ".partial"));  // not part of the summary below
   EXPECT_FALSE(fs::exists(out / "tmp"));
   EXPECT_EQ(WithoutTimingColumns(ReadAll(out / "summary.csv")), WithoutTimingColumns(csv));
+  // The two runs redone are of different sequences: each simulated its own (the cache of the
+  // first call went with its work folder).
+  for (const std::string& id : {gone, stale})
+    EXPECT_NE(ReadAll(out / "logs" / (id + ".log")).find(": simulating"), std::string::npos) << id;
 
   // Nothing left to do: a third call runs nothing and writes the same summary; --force redoes
   // (here: the one run of shard 1/8).
@@ -484,6 +488,48 @@ TEST(SuiteRunTest, WritesEveryRunAndResumesOnlyUnfinishedRuns) {
   ASSERT_EQ(forced.exit_code, 0) << forced.output;
   EXPECT_NE(forced.output.find("(1 run now, 0 kept)"), std::string::npos) << forced.output;
   EXPECT_NE(MTime(out / "runs/l_hallway__paper__s1__k1/metrics.json"), first);
+}
+
+// How many of the suite's run logs say the run simulated its sequence, and how many that it read
+// the sequence another run simulated (harness/sequence_cache.h).
+std::pair<int, int> SimulatedAndReadLogs(const fs::path& out) {
+  int simulated = 0, read = 0;
+  for (const auto& e : fs::directory_iterator(out / "logs")) {
+    const std::string log = ReadAll(e.path().string());
+    simulated += log.find(": simulating") != std::string::npos;
+    read += log.find("simulated before, reading it") != std::string::npos;
+  }
+  return {simulated, read};
+}
+
+TEST(SuiteRunTest, EachSequenceIsSimulatedOnceAndTheRunsEqualSimulatingRuns) {
+  TempDir dir("suite_once");
+  RunFullSuite(dir);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const fs::path full = dir / "full";
+  // Two sequences (the two scenarios, one seed), each simulated by one of its four runs.
+  EXPECT_EQ(SimulatedAndReadLogs(full), std::make_pair(2, 6));
+  EXPECT_FALSE(fs::exists(full / "tmp"));  // the cache went with the work folder
+  // Each run equals the run of its spec that simulates for itself (as suites did before).
+  for (const auto& e : fs::directory_iterator(full / "runs")) {
+    const std::string id = e.path().filename().string();
+    const nlohmann::json stamp = nlohmann::json::parse(ReadAll(e.path() / "suite_run.json"));
+    const std::string plain = dir / ("plain_" + id);
+    const auto r =
+        RunVobench("run " + (full / "specs" / (id + ".scenario.yaml")).string() + " --config " +
+                   (full / "specs" / (id + ".vo.yaml")).string() + " --max-frames 6 --stride " +
+                   stamp["stride"].dump() + " --no-plots -q --out " + plain);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const char* f : {"trajectory_tum.txt", "groundtruth_tum.txt", "trajectory_kitti.txt",
+                          "estimate_in_gt_world_tum.txt", "vo_options.yaml", "scenario.yaml"})
+      EXPECT_EQ(ReadAll(e.path() / f), ReadAll(fs::path(plain) / f)) << id << " " << f;
+    auto metrics = [](const fs::path& run) {
+      nlohmann::json j = nlohmann::json::parse(ReadAll(run / "metrics.json"));
+      for (const char* k : {"vo_ms_median", "vo_ms_p95", "stage_ms_median"}) j.erase(k);
+      return j;
+    };
+    EXPECT_EQ(metrics(e.path()), metrics(plain)) << id;
+  }
 }
 
 TEST(SuiteRunTest, ShardsMergedEqualTheUnshardedSuite) {
