@@ -35,6 +35,8 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using vobench_test::RunVobench;
 
+#ifdef VOBENCH_ROSBAG
+
 nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
@@ -48,8 +50,6 @@ nlohmann::json WithoutTimings(nlohmann::json j) {
   }
   return j;
 }
-
-#ifdef VOBENCH_ROSBAG
 
 // The short hallway (0.5 m, 19 frames at 10 Hz, the default IMU), rendered once per process as
 // a bag (with the KITTI layout beside it) and in the EuRoC layout (for --calib).
