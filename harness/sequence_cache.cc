@@ -2,11 +2,13 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -169,6 +171,58 @@ bool CalibrationFromJson(const json& j, sim::StereoCalibration* c) {
          PoseFromJson(j.at("T_body_imu"), &c->T_body_imu);
 }
 
+// The follower's report (sim/navigation.h) of the simulation, which a run on the entry reports as
+// one that simulates would; NaN as null.
+json NumberJson(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+double NumberFromJson(const json& j) {
+  return j.is_null() ? std::numeric_limits<double>::quiet_NaN() : j.get<double>();
+}
+json PlanarJson(const sim::PlanarPose& p) {
+  return json::array(
+      {NumberJson(p.position.x()), NumberJson(p.position.y()), NumberJson(p.yaw_rad)});
+}
+sim::PlanarPose PlanarFromJson(const json& j) {
+  sim::PlanarPose p;
+  p.position = Eigen::Vector2d(NumberFromJson(j.at(0)), NumberFromJson(j.at(1)));
+  p.yaw_rad = NumberFromJson(j.at(2));
+  return p;
+}
+json NavigationJson(const sim::NavigationReport& n) {
+  json j;
+  j["mode"] = n.mode;
+  j["reached_goal"] = n.reached_goal;
+  j["end_error_m"] = NumberJson(n.end_error_m);
+  j["max_waypoint_error_m"] = NumberJson(n.max_waypoint_error_m);
+  j["wall_contacts"] = n.wall_contacts;
+  j["wall_contact_s"] = NumberJson(n.wall_contact_s);
+  json frames = json::array();
+  for (const sim::NavigationFrame& f : n.frames)
+    frames.push_back({{"time_s", NumberJson(f.time_s)},
+                      {"believed", PlanarJson(f.believed)},
+                      {"truth", PlanarJson(f.truth)},
+                      {"fixed", f.fixed}});
+  j["frames"] = frames;
+  return j;
+}
+sim::NavigationReport NavigationFromJson(const json& j) {
+  sim::NavigationReport n;
+  n.mode = j.at("mode").get<std::string>();
+  n.reached_goal = j.at("reached_goal").get<bool>();
+  n.end_error_m = NumberFromJson(j.at("end_error_m"));
+  n.max_waypoint_error_m = NumberFromJson(j.at("max_waypoint_error_m"));
+  n.wall_contacts = j.at("wall_contacts").get<int>();
+  n.wall_contact_s = NumberFromJson(j.at("wall_contact_s"));
+  for (const json& f : j.at("frames")) {
+    sim::NavigationFrame frame;
+    frame.time_s = NumberFromJson(f.at("time_s"));
+    frame.believed = PlanarFromJson(f.at("believed"));
+    frame.truth = PlanarFromJson(f.at("truth"));
+    frame.fixed = f.at("fixed").get<bool>();
+    n.frames.push_back(frame);
+  }
+  return n;
+}
+
 // One frame's place in frames.bin.
 struct RecordPlace {
   uint64_t offset = 0;
@@ -179,6 +233,7 @@ struct RecordPlace {
 // What sequence.json says, read and checked against the scenario; false with *why otherwise.
 struct CacheIndex {
   sim::StereoCalibration calibration;
+  sim::NavigationReport navigation;
   std::vector<RecordPlace> records;
 };
 bool ReadIndex(const sim::Scenario& scenario, int max_frames, const fs::path& dir,
@@ -204,6 +259,7 @@ bool ReadIndex(const sim::Scenario& scenario, int max_frames, const fs::path& di
       throw std::runtime_error("simulated for another scenario or max_frames");
     if (!CalibrationFromJson(j.at("calibration"), &index->calibration))
       throw std::runtime_error("calibration: a pose without 16 numbers");
+    index->navigation = NavigationFromJson(j.at("navigation"));
     index->records.clear();
     uint64_t end = 0;
     for (const json& r : j.at("frames")) {
@@ -282,6 +338,7 @@ bool WriteSequenceCache(const sim::Scenario& scenario, int max_frames, const std
   index["scenario_yaml"] = KeyYaml(scenario);
   index["max_frames"] = max_frames;
   index["calibration"] = CalibrationJson(simulator->calibration());
+  index["navigation"] = NavigationJson(simulator->navigation());
   index["frames"] = frames;
   return WriteTextFile((fs::path(folder.path()) / kIndexFile).string(), index.dump(1) + "\n",
                        error) &&
@@ -306,6 +363,7 @@ bool OpenCachedSequence(const sim::Scenario& scenario, int max_frames, const std
   }
   DescribeScenarioSequence(scenario, index->calibration, static_cast<int>(index->records.size()),
                            sequence);
+  sequence->navigation = [index] { return index->navigation; };
   sequence->next = [index, in, frames_path, next = size_t{0}, record = std::string()](
                        DatasetFrame* frame, std::string* err) mutable {
     if (next >= index->records.size()) return false;

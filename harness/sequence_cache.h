@@ -5,7 +5,9 @@
 // A cache entry is a marked folder of kind "sequence" (output_folder.h), written as a work
 // folder and published only when every frame is in it:
 //   sequence.json   format, the vobench version, the effective scenario (YAML, without its
-//                   name) and max_frames it was simulated for, the calibration, and per frame
+//                   name) and max_frames it was simulated for, the calibration, the path
+//                   follower's report (sim/navigation.h: a run on the entry reports what the
+//                   robot did as one that simulates), and per frame
 //                   the offset, size and FNV-1a hash (spec.h's Fnv1aHex) of its record
 //   frames.bin      the frames' records, one after the other, in this machine's byte order:
 //                   time, ground-truth flag and pose (16 doubles), the left, right and depth
@@ -24,7 +26,9 @@
 // match (the file changed after it was written) fails the run with a message naming the file
 // and frame. The entry is not tied to the code that simulated it beyond the version string:
 // `git describe` does not see uncommitted changes, so remove a cache folder kept across builds
-// (a suite's lives in its work folder and is removed when the call ends).
+// (a suite's lives in its work folder and is removed when the call ends). A closed-loop scenario
+// (navigation: vo) is never cached: its frames depend on the VO (`run --sequence-cache`
+// simulates it in the loop).
 #pragma once
 
 #include <string>
@@ -36,7 +40,7 @@
 
 namespace harness {
 
-constexpr int kSequenceCacheFormat = 1;  // sequence.json's "format"
+constexpr int kSequenceCacheFormat = 2;  // sequence.json's "format"
 
 // The name of the entry of `scenario` (its name ignored) simulated for max_frames (0 = all)
 // in a cache folder: 16 hex digits.

@@ -83,7 +83,8 @@ int RunRun(const std::string& scenario_arg, const std::string& config, const std
       out = "out/run/" + scenario.name;
     }
     options.out_dir = out;
-    if (sequence_cache.empty()) {
+    // A closed-loop run's frames depend on its VO: it simulates in the loop, never from a cache.
+    if (sequence_cache.empty() || !ClosedLoopProblem(scenario, "").empty()) {
       ok = RunScenario(scenario, vo_options, options, &summary, &error);
     } else {
       StereoSequence sequence;  // the first max_frames frames, simulated once for every run

@@ -101,6 +101,21 @@ void ExpectSameAsSimulated(const sim::Scenario& scenario, StereoSequence& cached
   }
   EXPECT_FALSE(cached.next(&a, &error));  // the entry holds max_frames frames
   EXPECT_EQ(error, "");
+  // What the robot did (the follower's report) as the simulation after the same frames.
+  ASSERT_TRUE(cached.navigation && simulated.navigation);
+  const sim::NavigationReport n = cached.navigation(), m = simulated.navigation();
+  EXPECT_EQ(n.mode, m.mode);
+  EXPECT_EQ(n.reached_goal, m.reached_goal);
+  EXPECT_TRUE(SameBits(n.end_error_m, m.end_error_m) &&
+              SameBits(n.max_waypoint_error_m, m.max_waypoint_error_m) &&
+              SameBits(n.wall_contact_s, m.wall_contact_s));
+  EXPECT_EQ(n.wall_contacts, m.wall_contacts);
+  ASSERT_EQ(n.frames.size(), m.frames.size());
+  for (size_t k = 0; k < n.frames.size(); ++k)
+    EXPECT_TRUE(SameBits(n.frames[k].time_s, m.frames[k].time_s) &&
+                SameBits(n.frames[k].truth.position, m.frames[k].truth.position) &&
+                SameBits(n.frames[k].believed.yaw_rad, m.frames[k].believed.yaw_rad))
+        << "navigation frame " << k;
 }
 
 TEST(SequenceCacheTest, TheCachedFramesEqualTheSimulatedOnesBitForBit) {
@@ -229,6 +244,14 @@ TEST(SequenceCacheTest, ConcurrentRunsWaitOnOneSimulationAndEqualASimulatingRun)
     };
     EXPECT_EQ(metrics(cached), metrics(plain)) << stride;
   }
+  // A closed-loop run's frames depend on its VO: it simulates in the loop, nothing cached.
+  const std::string closed = dir / "closed";
+  const auto c = RunVobench(
+      "run " + std::string(VOBENCH_SOURCE_DIR) + "/scenes/l_hallway_closed_loop.yaml" +
+      " --max-frames 5 --no-plots -q --sequence-cache " + (dir / "cache2") + " --out " + closed);
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_FALSE(fs::exists(dir / "cache2") && !fs::is_empty(dir / "cache2"));
+  EXPECT_EQ(nlohmann::json::parse(ReadAll(closed + "/metrics.json"))["navigation"]["mode"], "vo");
   // Not for a dataset folder.
   const auto r = RunVobench("run --dataset " + (dir / "cached_k1") + " --sequence-cache " + cache);
   EXPECT_EQ(r.exit_code, 2) << r.output;
