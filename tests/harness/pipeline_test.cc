@@ -217,8 +217,8 @@ TEST(PipelineTest, PlatformAutoIsAGroundVehicleOnAKnownRig) {
 }
 
 // A ground vehicle whose rig's camera pitch is known takes its up from the mounting when the
-// first frame shows no floor: orientation_up_from_mounting on, expected_up_cam0 the up of that
-// pitch (cv axes: y down; a camera tilted down by p sees the up as (0, −cos p, −sin p)). An
+// first frame shows no floor: initial_orientation.up_from_mounting on, expected_up_cam0 the up of
+// that pitch (cv axes: y down; a camera tilted down by p sees the up as (0, −cos p, −sin p)). An
 // unknown pitch, the free platform or an up given in the options change nothing of it.
 TEST(PipelineTest, AGroundVehicleTakesItsUpFromTheRigsPitch) {
   vo::OdometryOptions o;
