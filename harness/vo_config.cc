@@ -106,7 +106,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
   vo::DisparityOptions& disp = o->disparity;
   vo::MatcherOptions& m = o->matcher;
   vo::RansacOptions& r = o->ransac;
-  vo::BundleAdjustmentOptions& ba = o->ba;
+  vo::BundleAdjustmentOptions& ba = o->back_end.ba;
   vo::PlaneOrientationOptions& po = o->orientation;
   vo::PlaneRefinementOptions& fr = o->floor_refinement;
   vo::RobustTrackingOptions& t = o->tracking;
@@ -384,12 +384,12 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"recovery.vehicle_direct.min_depth_m", Number(&t.vehicle_direct.min_depth_m, 1e-9, 1e6)},
       {"recovery.vehicle_direct.max_depth_m", Number(&t.vehicle_direct.max_depth_m, 1e-9, 1e6)},
       {"recovery.reinit_after_lost_frames", Number(&o->reinit_after_lost_frames, 1, 100000)},
-      {"back_end.bundle_adjustment", Bool(&o->use_bundle_adjustment)},
-      {"back_end.window_frames", Number(&o->ba_window_frames, 3, 10)},
-      {"back_end.max_points", Number(&o->ba_max_points, 0, 100000)},
-      {"back_end.max_correction_m", Number(&o->ba_max_correction_m, 1e-9, kInf)},
-      {"back_end.max_correction_deg", Number(&o->ba_max_correction_deg, 1e-9, 360.0)},
-      {"back_end.prior_weight", Number(&o->prior_weight, 0.0, 1.0)},
+      {"back_end.bundle_adjustment", Bool(&o->back_end.bundle_adjustment)},
+      {"back_end.window_frames", Number(&o->back_end.window_frames, 3, 10)},
+      {"back_end.max_points", Number(&o->back_end.max_points, 0, 100000)},
+      {"back_end.max_correction_m", Number(&o->back_end.max_correction_m, 1e-9, kInf)},
+      {"back_end.max_correction_deg", Number(&o->back_end.max_correction_deg, 1e-9, 360.0)},
+      {"back_end.prior_weight", Number(&o->back_end.prior_weight, 0.0, 1.0)},
       {"back_end.ba.max_num_iterations", Number(&ba.max_num_iterations, 1, 1000)},
       {"back_end.ba.function_tolerance", Number(&ba.function_tolerance, 0.0, 1.0)},
       {"back_end.ba.gradient_tolerance", Number(&ba.gradient_tolerance, 0.0, 1.0)},
@@ -405,13 +405,18 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
        Enum(&ba.linear_solver,
             {BaLinearSolver::kAuto, BaLinearSolver::kSparseSchur, BaLinearSolver::kDenseSchur})},
       {"back_end.ba.analytic_jacobians", Bool(&ba.analytic_jacobians)},
-      {"back_end.vehicle_planar.enabled", Bool(&t.vehicle_planar_ba)},
-      {"back_end.vehicle_planar.tilt_sigma_deg", Number(&t.vehicle_ba_tilt_sigma_deg, 1e-9, 180.0)},
-      {"back_end.vehicle_planar.lift_sigma_m", Number(&t.vehicle_ba_lift_sigma_m, 1e-9, 100.0)},
-      {"back_end.vehicle_planar.slip_sigma_m", Number(&t.vehicle_ba_slip_sigma_m, 1e-9, 100.0)},
-      {"back_end.flat_floor.enabled", Bool(&t.vehicle_flat_floor)},
-      {"back_end.flat_floor.tilt_sigma_deg", Number(&t.vehicle_floor_tilt_sigma_deg, 1e-9, 180.0)},
-      {"back_end.flat_floor.height_sigma_m", Number(&t.vehicle_floor_height_sigma_m, 1e-9, 100.0)},
+      {"back_end.vehicle_planar.enabled", Bool(&o->back_end.vehicle_planar.enabled)},
+      {"back_end.vehicle_planar.tilt_sigma_deg",
+       Number(&o->back_end.vehicle_planar.tilt_sigma_deg, 1e-9, 180.0)},
+      {"back_end.vehicle_planar.lift_sigma_m",
+       Number(&o->back_end.vehicle_planar.lift_sigma_m, 1e-9, 100.0)},
+      {"back_end.vehicle_planar.slip_sigma_m",
+       Number(&o->back_end.vehicle_planar.slip_sigma_m, 1e-9, 100.0)},
+      {"back_end.flat_floor.enabled", Bool(&o->back_end.flat_floor.enabled)},
+      {"back_end.flat_floor.tilt_sigma_deg",
+       Number(&o->back_end.flat_floor.tilt_sigma_deg, 1e-9, 180.0)},
+      {"back_end.flat_floor.height_sigma_m",
+       Number(&o->back_end.flat_floor.height_sigma_m, 1e-9, 100.0)},
   };
 }
 

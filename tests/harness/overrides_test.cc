@@ -65,12 +65,12 @@ TEST(OverridesTest, ScenarioOverridesAreCheckedStrictly) {
 
 TEST(OverridesTest, VoOverridesApplyOnTopOfTheGivenOptions) {
   vo::OdometryOptions options;
-  options.ba_window_frames = 7;
+  options.back_end.window_frames = 7;
   std::string error;
   ASSERT_TRUE(harness::ApplyVoOverrides(YAML::Load("{tracker.matcher.type: ncc_mutual}"), "t",
                                         &options, &error))
       << error;
-  EXPECT_EQ(options.ba_window_frames, 7);
+  EXPECT_EQ(options.back_end.window_frames, 7);
   EXPECT_EQ(options.matcher.type, vo::MatcherType::kNccMutual);
   vo::OdometryOptions bad = options;
   EXPECT_FALSE(harness::ApplyVoOverrides(YAML::Load("{tracker.matcher.type: nonsense}"),

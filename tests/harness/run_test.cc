@@ -175,13 +175,13 @@ TEST(VoConfigTest, RoundTripAndErrors) {
       << error;
   EXPECT_EQ(o.matcher.type, vo::MatcherType::kNccMutual);
   EXPECT_DOUBLE_EQ(o.matcher.svd.sigma_px, 14);
-  EXPECT_FALSE(o.use_bundle_adjustment);
-  EXPECT_EQ(o.ba_window_frames, 7);
+  EXPECT_FALSE(o.back_end.bundle_adjustment);
+  EXPECT_EQ(o.back_end.window_frames, 7);
   // The effective file reads back to the same options, every key away from its default (a key
   // written twice, e.g. a nested map split in two, would lose one of them).
-  o.ba.max_num_iterations = 7;
-  o.ba.loss_scale_px = 2.5;
-  o.ba_max_points = 55;
+  o.back_end.ba.max_num_iterations = 7;
+  o.back_end.ba.loss_scale_px = 2.5;
+  o.back_end.max_points = 55;
   o.disparity.algorithm = vo::DisparityAlgorithm::kSemiGlobal;
   o.disparity_mode = vo::DisparityMode::kDense;  // at_features needs the one-volume matcher
   o.disparity_range_margin_px = 4.0;
@@ -199,9 +199,9 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   ASSERT_TRUE(harness::ParseVoConfig(harness::VoConfigToYaml(o), "effective.yaml", &again, &error))
       << error;
   EXPECT_EQ(harness::VoConfigToYaml(again), harness::VoConfigToYaml(o));
-  EXPECT_EQ(again.ba.max_num_iterations, 7);
-  EXPECT_EQ(again.ba.loss_scale_px, 2.5);
-  EXPECT_EQ(again.ba_max_points, 55);
+  EXPECT_EQ(again.back_end.ba.max_num_iterations, 7);
+  EXPECT_EQ(again.back_end.ba.loss_scale_px, 2.5);
+  EXPECT_EQ(again.back_end.max_points, 55);
   EXPECT_EQ(again.disparity.algorithm, vo::DisparityAlgorithm::kSemiGlobal);
   EXPECT_EQ(again.disparity_min_depth_m, 0.6);
 

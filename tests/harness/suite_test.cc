@@ -141,7 +141,7 @@ TEST(SuiteFileTest, ScenarioAndConfigFilesAreRelativeToTheSuite) {
   std::string error;
   ASSERT_TRUE(harness::LoadSuite(dir / "suite.yaml", &suite, &error)) << error;
   EXPECT_EQ(suite.scenarios[0].name, "short");
-  EXPECT_EQ(suite.configs[0].options.ba_window_frames, 7);
+  EXPECT_EQ(suite.configs[0].options.back_end.window_frames, 7);
   EXPECT_EQ(suite.configs[0].options.matcher.type, vo::MatcherType::kLucasKanade);
 }
 

@@ -312,7 +312,7 @@ TEST(TuneSpecTest, ReadsAValidFile) {
   for (size_t i = 0; i < o.matcher.gabor.wavelengths_px.size(); ++i)
     EXPECT_EQ(o.matcher.gabor.wavelengths_px[i], 1.5 * defaults.matcher.gabor.wavelengths_px[i]);
   EXPECT_EQ(o.ransac.inlier_threshold_px, 3.0);
-  EXPECT_EQ(o.ba_window_frames, 7);
+  EXPECT_EQ(o.back_end.window_frames, 7);
   ASSERT_TRUE(harness::ApplyParameters(spec, spec.start_values, &o, &error)) << error;
   EXPECT_EQ(harness::VoConfigToYaml(o), harness::VoConfigToYaml(defaults));
 }

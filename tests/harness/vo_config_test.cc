@@ -47,7 +47,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
   CountLeaves(yaml, "", &counts);
   const Recorded recorded[] = {
       {"OdometryOptions", sizeof(vo::OdometryOptions), 1648},
-      {"RobustTrackingOptions", sizeof(vo::RobustTrackingOptions), 512},
+      {"RobustTrackingOptions", sizeof(vo::RobustTrackingOptions), 456},
       {"DetectorOptions", sizeof(vo::DetectorOptions), 128},
       {"HarrisOptions", sizeof(vo::HarrisOptions), 64},
       {"SiftOptions", sizeof(vo::SiftOptions), 40},
@@ -63,6 +63,9 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
       {"SiftRatioMatcherOptions", sizeof(vo::SiftRatioMatcherOptions), 24},
       {"RansacOptions", sizeof(vo::RansacOptions), 88},
       {"BundleAdjustmentOptions", sizeof(vo::BundleAdjustmentOptions), 80},
+      {"BackEndOptions", sizeof(vo::BackEndOptions), 176},
+      {"VehiclePlanarBaOptions", sizeof(vo::VehiclePlanarBaOptions), 32},
+      {"FlatFloorOptions", sizeof(vo::FlatFloorOptions), 24},
       {"PlaneOrientationOptions", sizeof(vo::PlaneOrientationOptions), 80},
       {"PlaneRefinementOptions", sizeof(vo::PlaneRefinementOptions), 88},
       {"PriorMotionOptions", sizeof(vo::PriorMotionOptions), 64},
@@ -75,8 +78,9 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
         << "vo::" << r.type << " changed size: register its new field in harness/vo_config.cc "
         << "(Registry), count it below and update the recorded size here";
   // The keys per group of vo_options.yaml, by stage (docs/DESIGN.md, "VO options by stage"):
-  // the groups' fields of OdometryOptions, RobustTrackingOptions (spread over the stages) and
-  // the nested Options structs (PriorMotionOptions' vehicle fields under `vehicle`).
+  // the groups' fields of OdometryOptions, RobustTrackingOptions (spread over the stages),
+  // BackEndOptions (`back_end`, field for field) and the nested Options structs
+  // (PriorMotionOptions' vehicle fields under `vehicle`).
   const std::map<std::string, int> expected = {
       {"", 1},  // platform
       {"vehicle", 3},
@@ -209,7 +213,7 @@ TEST(VoConfigTest, OldGroupsAreRefusedAtTheirLine) {
       "v.yaml", &o, &error))
       << error;
   EXPECT_EQ(o.matcher.type, vo::MatcherType::kNccMutual);
-  EXPECT_EQ(o.ba_window_frames, 3);
+  EXPECT_EQ(o.back_end.window_frames, 3);
   EXPECT_TRUE(o.tracking.few_point_motion);
   EXPECT_EQ(harness::RenamedVoKey("front_end.detector.type"), "");  // a new key is no old one
   EXPECT_EQ(harness::RenamedVoKey("disparity_mode"), "front_end.disparity_mode");
