@@ -156,11 +156,11 @@ std::vector<MetricInfo> MakeRegistry() {
              [](const RunSummary& s) { return json(s.reinitialisations); }),
       Metric("bridge_aligned_frames", "frames", Better::kNeither, kRun,
              "lost frames whose bridged forward step or yaw was measured against the previous "
-             "frame's features (tracking.vehicle_bridge_alignment)",
+             "frame's features (recovery.vehicle_bridge.enabled)",
              [](const RunSummary& s) { return json(s.bridge_aligned_frames); }),
       Metric("direct_motion_frames", "frames", Better::kNeither, kRun,
              "frames too poor in features for the matchers whose motion was measured by "
-             "direct image alignment (tracking.vehicle_direct_alignment; not lost frames)",
+             "direct image alignment (recovery.vehicle_direct.enabled; not lost frames)",
              [](const RunSummary& s) { return json(s.direct_motion_frames); }),
       Metric("vo_ms_median", "ms", Better::kLower, MetricGroup::kTiming,
              "median VO time per frame (the first frame excluded)",

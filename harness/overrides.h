@@ -1,5 +1,5 @@
 // Overrides of scenario and VO option keys, as suites and tuning use them: a YAML mapping whose
-// keys are dotted paths ("noise.pixel_sigma: 3", "matcher.svd.sigma_px: 12") or nested maps
+// keys are dotted paths ("noise.pixel_sigma: 3", "tracker.matcher.svd.sigma_px: 12") or nested maps
 // ("noise: {pixel_sigma: 3}"), deep-merged onto the effective YAML of the base and parsed again
 // by the strict readers, so an unknown key or a bad value is refused with its name.
 #pragma once

@@ -206,7 +206,7 @@ bool ReadParameters(YamlReader& r, const YAML::Node& root, TuneSpec* spec) {
         return r.Fail(n["key"], where + ".key",
                       who +
                           "type scale needs a list-valued option (such as "
-                          "matcher.gabor.wavelengths_px), this one holds " +
+                          "tracker.matcher.gabor.wavelengths_px), this one holds " +
                           FlowYaml(option));
       start = 1.0;
     } else if (!option.IsScalar() || !ParseDouble(option.Scalar(), &start)) {

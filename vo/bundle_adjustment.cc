@@ -77,8 +77,6 @@ bool BundleAdjustmentOptions::IsValid(std::string* error) const {
     msg << "num_fixed_poses must be >= 1 (it fixes the gauge), got " << num_fixed_poses;
   else if (min_frames_per_point < 1)
     msg << "min_frames_per_point must be >= 1, got " << min_frames_per_point;
-  else if (!(min_depth_m > 0.0) || !std::isfinite(min_depth_m))
-    msg << "min_depth_m must be finite and > 0, got " << min_depth_m;
   if (msg.tellp() == 0) return true;
   if (error) *error = msg.str();
   return false;
@@ -499,7 +497,7 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
       const BaObservation& o = input.observations[k];
       Eigen::Vector2d e_l, e_r;
       if (!ObservationErrors(cam, T_cam0_world[o.frame_index], input.points_world[o.point_index], o,
-                             options.min_depth_m, &e_l, &e_r)) {
+                             BundleAdjustmentOptions::kMinDepthM, &e_l, &e_r)) {
         s.observation_is_outlier[k] = true;  // behind the camera: left out
         continue;
       }
@@ -605,7 +603,7 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
         sq_after += sq_error[k];
         count_after += o.has_right ? 2 : 1;
       }
-      s.observation_is_outlier[k] = !(depth_m > options.min_depth_m) ||
+      s.observation_is_outlier[k] = !(depth_m > BundleAdjustmentOptions::kMinDepthM) ||
                                     e_l.norm() > options.outlier_threshold_px ||
                                     e_r.norm() > options.outlier_threshold_px;
     }

@@ -100,8 +100,9 @@ struct BundleAdjustmentOptions {
   bool analytic_jacobians = true;  // kCeres only: hand-derived Jacobians of the residuals
                                    // (faster); false = ceres::AutoDiffCostFunction (the
                                    // reference; same values)
-  double min_depth_m = 1e-3;       // observations whose initial depth (z in cam0) is below this
-                                   // (metres) are left out and flagged as outliers, > 0
+  // Observations whose initial depth (z in cam0) is below this (metres) are left out and
+  // flagged as outliers: a numerical guard, not a setting (it was the key ba.min_depth_m).
+  static constexpr double kMinDepthM = 1e-3;
 
   bool IsValid(std::string* error) const;
 };

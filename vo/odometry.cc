@@ -15,7 +15,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The vehicle's up in the camera frame (tracking.vehicle_planar_ba): σ of a reliable tracked
+// The vehicle's up in the camera frame (back_end.vehicle_planar): σ of a reliable tracked
 // RANSAC motion's translation (metres) and rotation (degrees) as evidence of it (a translation
 // across up, a rotation about it; the first frame's floor fit starts it, initial_orientation.h).
 // The RANSAC motions (before the window BA) jitter by ~1 cm sideways and ~0.3° per frame; with
@@ -24,18 +24,6 @@ using Clock = std::chrono::steady_clock;
 // fit over tens of frames (seed 7: 0.77° -> 0.35° off).
 constexpr double kVehicleUpTranslationSigmaM = 1e-2;
 constexpr double kVehicleUpRotationSigmaDeg = 0.3;
-
-// The back end's options from the pipeline's.
-SlidingWindowOptions WindowOptions(const OdometryOptions& o) {
-  SlidingWindowOptions w;
-  w.window_frames = o.ba_window_frames;
-  w.use_bundle_adjustment = o.use_bundle_adjustment;
-  w.max_points = o.ba_max_points;
-  w.max_correction_m = o.ba_max_correction_m;
-  w.max_correction_deg = o.ba_max_correction_deg;
-  w.ba = o.ba;
-  return w;
-}
 
 }  // namespace
 
@@ -58,7 +46,7 @@ StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions
     : camera_(camera),
       options_(EffectiveOdometryOptions(camera, options)),
       recovery_(camera, options_),
-      window_(WindowOptions(options_)) {
+      back_end_(options_.back_end) {
   std::string why;
   if (!camera_.IsValid(&why)) {
     std::fprintf(stderr, "vo::StereoOdometry: invalid camera: %s\n", why.c_str());
@@ -79,7 +67,7 @@ StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions
 StereoOdometry::~StereoOdometry() = default;
 
 void StereoOdometry::Reset() {
-  window_.Reset();
+  back_end_.Reset();
   tracker_->Reset();
   recovery_.Reset();
   frame_index_ = 0;
@@ -140,7 +128,7 @@ Eigen::Isometry3d StereoOdometry::PredictedPose(const MotionPrior* prior) const 
 }
 
 const Eigen::Vector3d* StereoOdometry::VehicleUpAtReference(Eigen::Vector3d* storage) const {
-  const Eigen::Isometry3d* T_world_ref = window_.Pose(reference_.frame_index);
+  const Eigen::Isometry3d* T_world_ref = back_end_.Pose(reference_.frame_index);
   if (!options_.tracking.ground_vehicle || !world_up_known_ || T_world_ref == nullptr) {
     return nullptr;
   }
@@ -184,28 +172,15 @@ std::string StereoOdometry::OrientFirstFrame(const std::vector<Eigen::Vector3d>&
   return result->floor_refinement_message;
 }
 
-PlanarMotionPrior StereoOdometry::WindowPlanarPrior() const {
-  const RobustTrackingOptions& o = options_.tracking;
-  PlanarMotionPrior prior;
-  prior.enabled = o.ground_vehicle && o.vehicle_planar_ba && world_up_known_ && vehicle_up_.known();
-  if (!prior.enabled) return prior;
-  prior.up_cam = vehicle_up_.up();
-  prior.axle_behind_camera_m = o.few_point.axle_behind_camera_m;
-  prior.tilt_sigma_rad = o.vehicle_ba_tilt_sigma_deg * M_PI / 180.0;
-  prior.lift_sigma_m = o.vehicle_ba_lift_sigma_m;
-  prior.slip_sigma_m = o.vehicle_ba_slip_sigma_m;
-  // The floor's up is the vehicle's (as refined so far) at the first pose, (R_hall_cam0_initial_,
-  // 0) (Initialise), so that a turn about the refined up keeps it; the world's z (the first
-  // floor fit) would tilt every pose by what the refinement has moved the up since.
-  // Only when the first frame found a floor: an up from the ceiling is off by 1-1.5°
-  // (plain_corridor, where no floor is found: strides 1/2/3/5 0.72/0.52/2.75/1.04 % without the
-  // flat floor, 2.10/1.56/2.01/1.44 % with it on the refined ceiling's up).
-  prior.flat_floor = o.vehicle_flat_floor && orientation_result_.floor_index >= 0;
-  prior.floor_up_world = R_hall_cam0_initial_ * vehicle_up_.up();
-  prior.floor_height_m = 0.0;
-  prior.floor_tilt_sigma_rad = o.vehicle_floor_tilt_sigma_deg * M_PI / 180.0;
-  prior.floor_height_sigma_m = o.vehicle_floor_height_sigma_m;
-  return prior;
+VehicleGeometry StereoOdometry::Geometry() const {
+  VehicleGeometry g;
+  g.vehicle = options_.tracking.ground_vehicle;
+  g.up_known = world_up_known_ && vehicle_up_.known();
+  g.up_cam = vehicle_up_.up();
+  g.R_world_cam0_initial = R_hall_cam0_initial_;
+  g.floor_found = orientation_result_.floor_index >= 0;
+  g.axle_behind_camera_m = options_.tracking.few_point.axle_behind_camera_m;
+  return g;
 }
 
 OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame frame,
@@ -228,7 +203,8 @@ OdometryResult StereoOdometry::Initialise(OdometryResult result, MatchFrame fram
     if (result.direct_motion) result.message += "; motion measured by direct image alignment";
   }
   tracker_->Reset();
-  const TrackUpdateResult update = window_.Start(result.frame_index, &frame.features, T_world_cam0);
+  const TrackUpdateResult update =
+      back_end_.Start(result.frame_index, &frame.features, T_world_cam0);
   if (!update.ok()) {  // cannot happen on a new window; keep going without tracks
     result.message +=
         (result.message.empty() ? "" : "; ") + std::string("tracks: ") + update.message;
@@ -258,7 +234,7 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
 
   // The frame's motion: RANSAC's, or the few-point motion with the prior (motion_estimation.h).
   const RobustTrackingOptions& tracking = options_.tracking;
-  const Eigen::Isometry3d* T_world_ref = window_.Pose(reference_.frame_index);
+  const Eigen::Isometry3d* T_world_ref = back_end_.Pose(reference_.frame_index);
   Eigen::Vector3d up_storage;
   const FrameMotion motion =
       ResolveFrameMotion(camera_, options_, static_cast<int>(frame.features.size()), ref_features,
@@ -315,31 +291,21 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     return lost;
   }
 
-  // Initial pose: blend of the RANSAC/Horn motion and the constant-velocity prediction.
+  // The back end (back_end.h): the initial pose (the measured motion blended with the prior's),
+  // the tracks from the inlier matches, the windowed bundle adjustment.
   const int64_t gap = result.frame_index - reference_.frame_index;
   const double inlier_ratio =
       static_cast<double>(ransac.num_inliers) / std::max<size_t>(1, matches.size());
-  // (A few-point motion already is the prior's fit to the matches: no second blend.)
-  const double w = T_ref_curr_prior != nullptr && !result.few_point_motion
-                       ? options_.prior_weight * (1.0 - std::min(1.0, inlier_ratio))
-                       : 0.0;
-  const Eigen::Isometry3d T_ref_curr_initial = T_ref_curr_prior != nullptr
-                                                   ? Blend(ransac.T_prev_curr, *T_ref_curr_prior, w)
-                                                   : ransac.T_prev_curr;
-
-  // Tracks from the inlier matches (track ids and ages written into the features), the
-  // frame's initial pose into the window.
-  if (T_world_ref == nullptr) {  // cannot happen: the reference is the window's newest frame
+  const BackEndAdd add =
+      back_end_.Add(result.frame_index, reference_.frame_index, &frame.features, inlier_matches,
+                    ransac.T_prev_curr, T_ref_curr_prior, inlier_ratio, result.few_point_motion);
+  if (!add.update.ok()) {
     result.times.motion_ms += ElapsedMs(motion_start);
-    return Lost(std::move(result), "the reference frame has no pose in the window", start, prior);
+    return Lost(std::move(result),
+                T_world_ref == nullptr ? add.update.message : "tracks: " + add.update.message,
+                start, prior);
   }
-  Eigen::Isometry3d T_world_curr = *T_world_ref * T_ref_curr_initial;
-  const TrackUpdateResult update =
-      window_.Add(result.frame_index, &frame.features, inlier_matches, T_world_curr);
-  if (!update.ok()) {
-    result.times.motion_ms += ElapsedMs(motion_start);
-    return Lost(std::move(result), "tracks: " + update.message, start, prior);
-  }
+  Eigen::Isometry3d T_world_curr = add.T_world_curr;
   result.times.motion_ms += ElapsedMs(motion_start);
   result.rms_reprojection_px = ransac.rms_reprojection_px;
 
@@ -347,12 +313,12 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const Clock::time_point ba_start = Clock::now();
   const WindowRefinement refinement =
       result.few_point_motion ? WindowRefinement()
-                              : window_.Refine(camera_, result.frame_index, WindowPlanarPrior());
+                              : back_end_.Refine(camera_, result.frame_index, Geometry());
   if (refinement.attempted) result.times.ba_ms = ElapsedMs(ba_start);
   const bool ba_rejected = refinement.rejected;
   if (ba_rejected) result.message = refinement.message;
   if (refinement.ran) {
-    T_world_curr = *window_.Pose(result.frame_index);
+    T_world_curr = *back_end_.Pose(result.frame_index);
     result.ba_ran = true;
     result.ba_num_frames = refinement.num_frames;
     result.ba_num_points = refinement.num_points;
@@ -362,10 +328,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   // Constant-velocity model: the (refined) motion from the reference, per frame, blended into
   // the prior by its support, so one weak estimate before a loss is not extrapolated over the
   // gap.
-  const Eigen::Isometry3d* T_world_ref_now = window_.Pose(reference_.frame_index);
   const Eigen::Isometry3d T_ref_curr =
-      T_world_ref_now != nullptr ? Eigen::Isometry3d(T_world_ref_now->inverse() * T_world_curr)
-                                 : T_ref_curr_initial;
+      back_end_.MotionFromReference(reference_.frame_index, T_world_curr, add.T_ref_curr_initial);
   const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
   // Weight of this motion in the prior: 1 from reliable_min_inliers inliers up, less below
   // (a weak motion moves the prior only part of the way), 0 when the BA was rejected.
@@ -378,8 +342,9 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   result.motion_measured = true;
   // A reliable measured motion refines the vehicle's up (not a few-point or bundle-adjusted
   // one: both are made planar about the current estimate).
-  if (tracking.ground_vehicle && tracking.vehicle_planar_ba && !result.few_point_motion &&
-      !ba_rejected && ransac.num_inliers >= tracking.reliable_min_inliers)
+  if (tracking.ground_vehicle && options_.back_end.vehicle_planar.enabled &&
+      !result.few_point_motion && !ba_rejected &&
+      ransac.num_inliers >= tracking.reliable_min_inliers)
     vehicle_up_.AddMotion(ransac.T_prev_curr, kVehicleUpTranslationSigmaM,
                           kVehicleUpRotationSigmaDeg * M_PI / 180.0);
 
@@ -474,7 +439,7 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
 
   // Match against the reference frame (its cues are cached in reference_.frame), with the
   // search predicted from the motion prior (tracker.h).
-  const Eigen::Isometry3d* ref_pose = window_.Pose(reference_.frame_index);
+  const Eigen::Isometry3d* ref_pose = back_end_.Pose(reference_.frame_index);
   const Eigen::Isometry3d T_world_ref = ref_pose != nullptr ? *ref_pose : T_world_prev_;
   const Eigen::Isometry3d T_ref_curr_prior = T_world_ref.inverse() * PredictedPose(prior);
   const bool has_prior = (prior != nullptr || velocity_.known()) && IsFinitePose(T_ref_curr_prior);

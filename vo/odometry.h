@@ -14,7 +14,7 @@
 //                 → initial pose = blend of that motion and the constant-velocity
 //                 prediction (slerp on the rotation, linear on the translation)
 //                 → tracks (inlier matches only), windowed bundle adjustment,
-//                 oldest pose fixed, divergence guard                         sliding_window.h
+//                 oldest pose fixed, divergence guard          back_end.h (sliding_window.h)
 //                 → T_world_cam0
 //   no motion     the pose bridged (prior, image shift, lost-frame chain, a
 //                 ground vehicle's bridge and direct alignment)               recovery.h
@@ -35,7 +35,7 @@
 // motion T_R and the constant-velocity prediction T_V (the last bundle-adjusted frame-to-
 // frame motion, repeated once per frame since the reference), the initial T_ref_curr has
 //   rotation    = slerp(q_R, q_V, w),   translation = (1 − w) t_R + w t_V,
-//   w           = prior_weight · (1 − inlier_ratio),   inlier_ratio = inliers / matches
+//   w           = back_end.prior_weight · (1 − inlier_ratio),   inlier_ratio = inliers / matches
 // So a motion supported by every match is taken as it is, and the prediction gains weight as
 // the consensus weakens (w <= prior_weight). Without bundle adjustment this blend is the
 // output; with it, the blend is where the solver starts.
@@ -72,6 +72,7 @@
 #include <string>
 #include <vector>
 
+#include "vo/back_end.h"
 #include "vo/camera.h"
 #include "vo/front_end.h"
 #include "vo/matcher.h"
@@ -171,9 +172,9 @@ class StereoOdometry {
   std::string OrientFirstFrame(const std::vector<Eigen::Vector3d>& points, const cv::Mat& left,
                                const cv::Mat& right, const cv::Mat& disparity_px,
                                OdometryResult* result);
-  // The window BA's planar motion prior (disabled unless ground_vehicle, vehicle_planar_ba and
-  // a known up).
-  PlanarMotionPrior WindowPlanarPrior() const;
+  // The vehicle's geometry for the back end's planar prior (back_end.h): the vehicle model,
+  // its up, the first pose, the floor, the axle.
+  VehicleGeometry Geometry() const;
   // Everything after matching: the frame's motion, tracks, blend, BA. `result` carries the
   // counts so far. T_ref_curr_prior: the prior's motion from the reference to this frame (null
   // = none), the blend's partner; `prior`: the caller's prior (for a lost frame), may be null.
@@ -189,13 +190,13 @@ class StereoOdometry {
   std::unique_ptr<FrontEnd> front_end_;  // disparity, features, depth
   std::unique_ptr<Tracker> tracker_;     // the matcher and its prediction passes
   Recovery recovery_;                    // bridges, the lost-frame chain
-  SlidingWindow window_;  // tracks, window poses and the bundle adjustment (sliding_window.h)
+  BackEnd back_end_;                     // the window, the blend, the BA (back_end.h)
 
   int64_t frame_index_ = 0;      // index of the next call
   bool initialised_ = false;     // a reference was set at least once since Reset
   bool world_up_known_ = false;  // the world's z is up (the first frame's orientation found
                                  // the floor or a ceiling)
-  // The vehicle's up in the camera frame (tracking.vehicle_planar_ba): the floor fit refined
+  // The vehicle's up in the camera frame (back_end.vehicle_planar): the floor fit refined
   // by the reliable tracked motions.
   VehicleUpEstimate vehicle_up_;
   int consecutive_lost_ = 0;        // lost frames since the last good one

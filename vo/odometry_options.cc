@@ -38,19 +38,10 @@ OdometryOptions EffectiveOdometryOptions(const StereoCamera& camera,
     effective.disparity.num_disparities = DerivedNumDisparities(camera, options);
   }
   effective.ransac.min_inliers = std::max(options.ransac.min_inliers, options.min_inliers);
-  if (options.use_bundle_adjustment && !options.ransac_refine_with_ba) {
+  if (options.back_end.bundle_adjustment && !options.ransac_refine_with_ba) {
     effective.ransac.refine_nonlinear = false;
   }
   return effective;
-}
-
-BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions() {
-  BundleAdjustmentOptions options;
-  options.min_frames_per_point = 2;
-  options.max_num_iterations = 10;
-  options.solver = BaSolver::kSchurLm;
-  options.linear_solver = BaLinearSolver::kDenseSchur;  // when solver = kCeres
-  return options;
 }
 
 ImageShiftOptions DefaultTrackingImageShiftOptions() {
@@ -137,20 +128,6 @@ bool RobustTrackingOptions::IsValid(std::string* error) const {
              !std::isfinite(vehicle_max_vertical_shift_ratio)) {
     msg << "vehicle_max_vertical_shift_ratio must be finite and >= 0, got "
         << vehicle_max_vertical_shift_ratio;
-  } else if (!(vehicle_ba_tilt_sigma_deg > 0.0) || !std::isfinite(vehicle_ba_tilt_sigma_deg) ||
-             !(vehicle_ba_lift_sigma_m > 0.0) || !std::isfinite(vehicle_ba_lift_sigma_m) ||
-             !(vehicle_ba_slip_sigma_m > 0.0) || !std::isfinite(vehicle_ba_slip_sigma_m)) {
-    msg << "vehicle_ba_tilt_sigma_deg, vehicle_ba_lift_sigma_m and vehicle_ba_slip_sigma_m must "
-           "be finite and > 0, got "
-        << vehicle_ba_tilt_sigma_deg << ", " << vehicle_ba_lift_sigma_m << ", "
-        << vehicle_ba_slip_sigma_m;
-  } else if (!(vehicle_floor_tilt_sigma_deg > 0.0) ||
-             !std::isfinite(vehicle_floor_tilt_sigma_deg) ||
-             !(vehicle_floor_height_sigma_m > 0.0) ||
-             !std::isfinite(vehicle_floor_height_sigma_m)) {
-    msg << "vehicle_floor_tilt_sigma_deg and vehicle_floor_height_sigma_m must be finite and > 0, "
-           "got "
-        << vehicle_floor_tilt_sigma_deg << ", " << vehicle_floor_height_sigma_m;
   } else if (few_point_min_features < 1) {
     msg << "few_point_min_features must be >= 1, got " << few_point_min_features;
   } else if (!(few_point_prior_update >= 0.0 && few_point_prior_update <= 1.0)) {
@@ -169,8 +146,8 @@ bool OdometryOptions::IsValid(std::string* error) const {
   if (!depth.IsValid(&part_error)) return FailPart("depth", part_error, error);
   if (!matcher.IsValid(&part_error)) return FailPart("matcher", part_error, error);
   if (!ransac.IsValid(&part_error)) return FailPart("ransac", part_error, error);
-  if (!ba.IsValid(&part_error)) return FailPart("ba", part_error, error);
   if (!tracking.IsValid(&part_error)) return FailPart("tracking", part_error, error);
+  if (!back_end.IsValid(&part_error)) return FailPart("back_end", part_error, error);
   if (estimate_initial_orientation && !orientation.IsValid(&part_error)) {
     return FailPart("orientation", part_error, error);
   }
@@ -197,18 +174,6 @@ bool OdometryOptions::IsValid(std::string* error) const {
              !(disparity_range_margin_px >= 0.0) || !std::isfinite(disparity_range_margin_px)) {
     msg << "disparity_range_margin and disparity_range_margin_px must be finite and >= 0, got "
         << disparity_range_margin << " and " << disparity_range_margin_px;
-  } else if (ba_window_frames < 3 || ba_window_frames > 10) {
-    msg << "ba_window_frames must be in [3, 10], got " << ba_window_frames;
-  } else if (ba.num_fixed_poses >= ba_window_frames) {
-    msg << "ba.num_fixed_poses (" << ba.num_fixed_poses << ") must be < ba_window_frames ("
-        << ba_window_frames << ")";
-  } else if (!(prior_weight >= 0.0 && prior_weight <= 1.0)) {
-    msg << "prior_weight must be in [0, 1], got " << prior_weight;
-  } else if (!(ba_max_correction_m > 0.0) || !(ba_max_correction_deg > 0.0)) {
-    msg << "ba_max_correction_m and ba_max_correction_deg must be > 0, got " << ba_max_correction_m
-        << " and " << ba_max_correction_deg;
-  } else if (ba_max_points < 0) {
-    msg << "ba_max_points must be >= 0 (0 = no limit), got " << ba_max_points;
   } else if (orientation_sample_step_px < 1) {
     msg << "orientation_sample_step_px must be >= 1, got " << orientation_sample_step_px;
   } else if (adaptive_min_features < 0) {
@@ -256,8 +221,8 @@ OdometryOptions ResolvePlatform(const OdometryOptions& options, double rig_axle_
   if (o.platform == Platform::kGroundVehicle) {
     o.tracking.few_point_motion = true;
     o.tracking.ground_vehicle = true;
-    o.tracking.vehicle_planar_ba = true;
-    o.tracking.vehicle_flat_floor = true;
+    o.back_end.vehicle_planar.enabled = true;
+    o.back_end.flat_floor.enabled = true;
   }
   if (o.tracking.ground_vehicle && o.tracking.few_point.axle_behind_camera_m == 0.0 &&
       rig_axle_behind_camera_m >= 0.0)

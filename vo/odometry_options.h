@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include "vo/back_end.h"
 #include "vo/bridge_alignment.h"
 #include "vo/bundle_adjustment.h"
 #include "vo/camera.h"
@@ -24,13 +25,6 @@
 
 namespace vo {
 
-// Bundle-adjustment defaults for the pipeline: points seen in a single frame of the window
-// carry no pose information, so they are left out (min_frames_per_point = 2); 10 LM
-// iterations suffice from the blended initial pose; a window of 3–10 poses makes the reduced
-// camera system tiny, so the hand-written Schur-complement solver (BaSolver::kSchurLm) is
-// ~5× faster than Ceres there, and for the Ceres reference DENSE_SCHUR beats the sparse
-// factorisation.
-BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions();
 // Detector defaults for the pipeline: Harris, at most 300 features, bucketed on an 8 × 6 grid
 // (at most 10 per cell) so they spread over the image, Harris quality_level 0.001.
 DetectorOptions DefaultOdometryDetectorOptions();
@@ -196,44 +190,8 @@ struct RobustTrackingOptions {
   // stride 1: 1-14 a frame for 21 frames) is measured from its edges, shadows and specks.
   bool vehicle_direct_alignment = true;
   DirectAlignmentOptions vehicle_direct;
-  // With ground_vehicle and vehicle_planar_ba, the window's bundle adjustment links
-  // consecutive poses by a planar motion prior (planar_motion_prior.h): no change of roll or
-  // pitch (σ vehicle_ba_tilt_sigma_deg), no step along up (σ vehicle_ba_lift_sigma_m), no
-  // sideways slip of the axle (few_point.axle_behind_camera_m; σ vehicle_ba_slip_sigma_m), all
-  // > 0, each σ weighing the prior against one pixel of reprojection error. The up in the
-  // camera frame is the vehicle's: the first frame's floor fit (σ 1°) refined by every reliable
-  // tracked RANSAC motion (its translation lies across up, σ 1 cm; its rotation axis along up,
-  // σ 0.3°), so a floor fit that is off does not tilt every turn. Off by default: it needs the
-  // rig's axle; with the axle at 0 for a camera 0.15 m ahead of it, the no-slip residual fights
-  // every turn's swing (texture seed 7, stride 1: 0.31 -> 4.3 %). Measured with few_point_motion
-  // and the rig's axle (0.15 m) on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs): mean
-  // end-pose error 0.294 -> 0.270 m, median 0.139 -> 0.133 m, stride-1 max 0.588 -> 0.507 m;
-  // camera.pitch_deg 10: 1.13 -> 0.33 %; 640x480: 0.51 -> 0.03 %; but seed 7 stride 1 0.31 -> 0.61
-  // %. The 6-DoF window BA lets each weak step trade yaw against a sideways step (the pitched
-  // camera's drift); the no-slip residual removes that trade, the tilt and lift ones the pitch
-  // against a vertical step.
-  bool vehicle_planar_ba = false;
-  double vehicle_ba_tilt_sigma_deg = 0.1;
-  double vehicle_ba_lift_sigma_m = 0.002;
-  double vehicle_ba_slip_sigma_m = 0.002;
-  // With vehicle_planar_ba: the floor is flat (one plane), so every pose of the window keeps
-  // the first pose's vehicle up (as refined so far; σ vehicle_floor_tilt_sigma_deg) and the
-  // first camera's height (σ vehicle_floor_height_sigma_m), both > 0 (planar_motion_prior.h,
-  // "Flat floor"; the σ are an indoor floor's and a vehicle's suspension's, not tuned). The
-  // planar prior links only neighbours, so the tilt and the height wander a little with every
-  // window. Only when the first frame found a floor (an up from a ceiling is 1-1.5° off). Off on
-  // the free platform (a library cannot assume a flat floor); platform ground_vehicle says so.
-  // Measured with few_point_motion, the axle and vehicle_planar_ba on l_hallway texture seeds 1-10
-  // x strides 1/2/3/5 (40 runs), against vehicle_planar_ba alone: with the first frame's floor
-  // refined on the images (orientation_floor_refinement) and the vehicle's up starting from it at σ
-  // 0.15°, median end-pose error 0.108 -> 0.097 m, stride 1 median 0.108 -> 0.079 m, seed 7 stride
-  // 1 0.60 -> 0.46 %, mean 0.211 -> 0.211 m, plain_corridor (no floor found: off) unchanged. Before
-  // that refinement, on the block matcher's floor fit (up to 0.8° off in pitch), it was worse:
-  // median 0.108 -> 0.132 m, corridor 1.21/0.79/2.84/1.31 -> 2.99/2.44/3.02/2.23 % (README, "Flat
-  // floor" and "The first frame's floor refined").
-  bool vehicle_flat_floor = false;
-  double vehicle_floor_tilt_sigma_deg = 0.3;
-  double vehicle_floor_height_sigma_m = 0.01;
+  // The vehicle's planar bundle adjustment and flat floor: the back end's (back_end.h,
+  // BackEndOptions::vehicle_planar and flat_floor).
   // A lost frame with at least min_features features is matched against the previous lost
   // frame that had them (the chain), when matching against the reference failed: a turn in
   // front of a plain wall takes the camera past the reference's view, and the frames of the
@@ -288,8 +246,8 @@ enum class Platform {
                    // anything else kFree. StereoOdometry alone knows no rig: kFree
   kFree,           // 6-DoF: the options as given (the paper's form; a drone, a hand-held rig)
   kGroundVehicle,  // a wheeled robot on one flat floor: the ground-vehicle options on
-                   // (tracking.few_point_motion, ground_vehicle, vehicle_planar_ba,
-                   // vehicle_flat_floor; the axle from the rig when the options leave it at 0)
+                   // (tracking.few_point_motion, ground_vehicle, back_end.vehicle_planar,
+                   // back_end.flat_floor; the axle from the rig when the options leave it at 0)
 };
 // "auto", "free", "ground_vehicle".
 const char* ToString(Platform platform);
@@ -329,29 +287,11 @@ struct OdometryOptions {
   DepthSamplingOptions depth;          // how features read the disparity map
   MatcherOptions matcher;              // inter-frame matcher (default: SVD · NCC · Gabor)
   RansacOptions ransac;                // robust frame-to-frame motion
-  BundleAdjustmentOptions ba = DefaultOdometryBundleAdjustmentOptions();  // windowed BA
-
-  bool use_bundle_adjustment = true;  // refine with the windowed BA; false = the blended
-                                      // RANSAC/Horn estimate is the output
-  int ba_max_points = 100;  // at most this many points in the BA (those seen in the most frames
-                            // of the window, then the oldest tracks), >= 0; 0 = every point
-                            // seen in at least ba.min_frames_per_point frames. 100 costs
-                            // ~0.4 ms at 5 frames (~2 ms with ba.solver = ceres) and loses no
-                            // accuracy on the synthetic corridor
-  double ba_max_correction_m = 0.25;   // a BA result that moves the newest pose farther than
-                                       // this from its initial value (metres) is rejected
-                                       // (divergence guard; the blend is kept), > 0
-  double ba_max_correction_deg = 5.0;  // the same for the rotation (degrees), > 0
   bool ransac_refine_with_ba = false;  // keep RANSAC's nonlinear refinement
                                        // (ransac.refine_nonlinear) when the BA runs after it;
                                        // false = skip it then (the BA refines anyway; saves
                                        // ~3 ms at 300 features). Without BA it always runs
                                        // as ransac.refine_nonlinear says
-  int ba_window_frames = 5;            // frames in the BA window (and kept by the track
-                                       // manager), 3..10 (paper: 3–5, 10 wished for)
-  double prior_weight = 0.5;  // weight of the constant-velocity prediction in the initial pose
-                              // is prior_weight · (1 − inlier_ratio), in [0, 1]; 0 = the
-                              // RANSAC/Horn estimate alone (see the header comment)
   bool estimate_initial_orientation = true;  // hallway frame from the first frame's planes
                                              // (floor/walls); false = world is the first camera
   PlaneOrientationOptions orientation;       // plane extraction for the initial orientation
@@ -399,6 +339,7 @@ struct OdometryOptions {
                                       // frame (wide, coarse-to-fine search), so the motion
                                       // across the gap is measured, not extrapolated
   RobustTrackingOptions tracking;     // predicted matching, coarse-to-fine search, guided pass
+  BackEndOptions back_end;            // the window, its bundle adjustment, the blend (back_end.h)
 
   bool IsValid(std::string* error) const;
 };
@@ -407,8 +348,8 @@ struct OdometryOptions {
 // kGroundVehicle when rig_axle_behind_camera_m >= 0 (the caller knows the rig is a ground
 // vehicle and where its wheel axle is: a simulated robot, a dataset with the rig's
 // description), kFree otherwise. kGroundVehicle switches tracking.few_point_motion,
-// ground_vehicle, vehicle_planar_ba and vehicle_flat_floor on (so on that platform they cannot
-// be switched off one by one: use kFree and set them). With ground_vehicle on (either way),
+// ground_vehicle, back_end.vehicle_planar and back_end.flat_floor on (so on that platform they
+// cannot be switched off one by one: use kFree and set them). With ground_vehicle on (either way),
 // tracking.few_point.axle_behind_camera_m left at 0 takes the rig's axle when it is known.
 // On kGroundVehicle with the rig's camera pitch known (rig_pitch_deg finite: the optical axis's
 // downward tilt, degrees), orientation_up_from_mounting is switched on and

@@ -83,7 +83,9 @@ int Classify(const StereoCamera& camera, const std::vector<StereoCorrespondence>
   mask->assign(corr.size(), false);
   for (size_t i = 0; i < corr.size(); ++i) {
     Eigen::Vector2d el, er;
-    if (!StereoReprojectionErrors(camera, T_curr_prev, corr[i], o.min_depth_m, &el, &er)) continue;
+    if (!StereoReprojectionErrors(camera, T_curr_prev, corr[i], PriorMotionOptions::kMinDepthM, &el,
+                                  &er))
+      continue;
     if (el.squaredNorm() > thr_sq || er.squaredNorm() > thr_sq) continue;
     (*mask)[i] = true;
     ++n;
@@ -102,7 +104,8 @@ Eigen::VectorXd Residuals(const StereoCamera& camera, const std::vector<StereoCo
   const double inv_px = 1.0 / o.measurement_sigma_px;
   for (size_t k = 0; k < inliers.size(); ++k) {
     Eigen::Vector2d el, er;
-    if (!StereoReprojectionErrors(camera, T_curr_prev, corr[inliers[k]], o.min_depth_m, &el, &er)) {
+    if (!StereoReprojectionErrors(camera, T_curr_prev, corr[inliers[k]],
+                                  PriorMotionOptions::kMinDepthM, &el, &er)) {
       // Behind the camera: a constant penalty of the inlier threshold (no gradient).
       el = Eigen::Vector2d::Constant(o.inlier_threshold_px);
       er = el;
@@ -128,7 +131,8 @@ bool FitVehicleToOnePoint(const StereoCamera& camera, const StereoCorrespondence
   const Basis& B = model.B;
   auto residual = [&](const Eigen::Vector2d& y, Eigen::Vector3d* r) {
     Eigen::Vector2d el, er;
-    if (!StereoReprojectionErrors(camera, model.At(B * y).inverse(), c, o.min_depth_m, &el, &er))
+    if (!StereoReprojectionErrors(camera, model.At(B * y).inverse(), c,
+                                  PriorMotionOptions::kMinDepthM, &el, &er))
       return false;
     *r << el.x(), el.y(), er.x();
     return true;
@@ -224,8 +228,6 @@ bool PriorMotionOptions::IsValid(std::string* error) const {
     msg << "prior_translation_sigma_m must be finite and > 0, got " << prior_translation_sigma_m;
   } else if (max_iterations < 1) {
     msg << "max_iterations must be >= 1, got " << max_iterations;
-  } else if (!(min_depth_m > 0.0) || !std::isfinite(min_depth_m)) {
-    msg << "min_depth_m must be finite and > 0, got " << min_depth_m;
   } else if (!std::isfinite(axle_behind_camera_m)) {
     msg << "axle_behind_camera_m must be finite, got " << axle_behind_camera_m;
   }

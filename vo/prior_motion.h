@@ -54,8 +54,9 @@ struct PriorMotionOptions {
   double prior_rotation_sigma_deg = 2.0;    // σ_rot of the prior's rotation (degrees), > 0
   double prior_translation_sigma_m = 0.01;  // σ_t of the prior's translation (metres), > 0
   int max_iterations = 10;                  // Gauss-Newton iterations per refinement, >= 1
-  double min_depth_m = 1e-3;                // transformed points closer than this (z, metres)
-                                            // are outliers, > 0
+  // Transformed points closer than this (z, metres) are outliers: a numerical guard, not a
+  // setting (it was the key tracking.few_point.min_depth_m).
+  static constexpr double kMinDepthM = 1e-3;
   bool no_sideways_slip = true;       // with an up direction (ground vehicle): the vehicle's wheels
                                       // do not slide sideways, the motion is a yaw and a forward
                                       // distance (VehicleMotion, 2 parameters) instead of a yaw and

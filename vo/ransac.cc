@@ -41,8 +41,6 @@ bool RansacOptions::IsValid(std::string* error) const {
     msg << "local_optimization_iterations must be >= 0, got " << local_optimization_iterations;
   else if (refine_max_iterations < 1)
     msg << "refine_max_iterations must be >= 1, got " << refine_max_iterations;
-  else if (!(min_depth_m > 0.0) || !std::isfinite(min_depth_m))
-    msg << "min_depth_m must be finite and > 0, got " << min_depth_m;
   if (msg.tellp() == 0) return true;
   if (error) *error = msg.str();
   return false;
@@ -134,7 +132,7 @@ Score Classify(const StereoCamera& cam, const std::vector<StereoCorrespondence>&
   if (mask) mask->assign(corr.size(), false);
   Eigen::Vector2d e_left, e_right;
   for (size_t i = 0; i < corr.size(); ++i) {
-    if (!StereoReprojectionErrors(cam, T_curr_prev, corr[i], options.min_depth_m, &e_left,
+    if (!StereoReprojectionErrors(cam, T_curr_prev, corr[i], RansacOptions::kMinDepthM, &e_left,
                                   &e_right))
       continue;
     const double sq_left = e_left.squaredNorm();

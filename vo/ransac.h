@@ -163,7 +163,9 @@ struct RansacOptions {
   bool refine_points = true;       // refine the points of correspondences that carry their previous
                                    // observation (two-frame bundle adjustment); false = hold every
                                    // p_prev fixed
-  double min_depth_m = 1e-3;  // transformed points closer than this (z, metres) are outliers, > 0
+  // Transformed points closer than this (z, metres) are outliers: a numerical guard against a
+  // point at or behind the camera, not a setting (it was the key ransac.min_depth_m).
+  static constexpr double kMinDepthM = 1e-3;
 
   bool IsValid(std::string* error) const;
 };

@@ -1,5 +1,12 @@
-// Recovery: the pose of a frame whose motion the reference cannot measure, and what the next
-// frames need to measure it after all.
+// Recovery: the stage for a frame whose motion the reference cannot measure. It gives that
+// frame a pose that is never NaN (the prior's bridge, its rotation corrected by the image
+// shift), measures what it can of the gap instead (the lost-frame chain between the lost frames
+// themselves; for a ground vehicle the bridge alignment on the previous frame's features and
+// the direct alignment of the previous image), and keeps what the next frames need for that
+// (the previous frame's features, image and planes, the chain). It receives the previous
+// output, the prior, this frame and the constant velocity (BridgeContext), and the tracker for
+// the chain's matching; the re-initialisation itself is StereoOdometry's. Its options are the
+// `recovery` group of vo_options.yaml. In detail:
 //
 // A lost frame's pose is the prior's prediction from the previous output, never NaN —
 // corrected, when the image shift from the previous frame is found (tracking.

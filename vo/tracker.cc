@@ -70,7 +70,7 @@ MotionAttempt Tracker::MatchAndEstimate(const MatchFrame& ref, const MatchFrame&
   PredictionSource source = PredictionSource::kNone;
   if (T_ref_curr_prior != nullptr) {
     prediction.uv_px = PredictFeaturePositions(camera_, ref.features, *T_ref_curr_prior,
-                                               options_.ransac.min_depth_m);
+                                               RansacOptions::kMinDepthM);
     prediction.radius_scale = o.prior_radius_scale;
     source = PredictionSource::kMotionPrior;
   }
@@ -140,7 +140,7 @@ MotionAttempt Tracker::MatchAndEstimate(const MatchFrame& ref, const MatchFrame&
     t = Clock::now();
     MatchPrediction measured;
     measured.uv_px = PredictFeaturePositions(
-        camera_, ref.features, context.velocity->last_measured(), options_.ransac.min_depth_m);
+        camera_, ref.features, context.velocity->last_measured(), RansacOptions::kMinDepthM);
     measured.radius_scale = o.prior_radius_scale;
     times.predict_ms += ElapsedMs(t);
     MotionAttempt attempt;
@@ -157,7 +157,7 @@ MotionAttempt Tracker::MatchAndEstimate(const MatchFrame& ref, const MatchFrame&
     t = Clock::now();
     MatchPrediction guided;
     guided.uv_px = PredictFeaturePositions(camera_, ref.features, best.ransac.T_prev_curr,
-                                           options_.ransac.min_depth_m);
+                                           RansacOptions::kMinDepthM);
     guided.radius_scale = o.guided_radius_scale;
     guided.coherence_test = false;
     double match_ms = 0.0, motion_ms = 0.0;

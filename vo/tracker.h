@@ -1,6 +1,13 @@
-// The tracker: a frame matched against the reference (or the lost-frame chain) with the
-// prediction passes, each followed by RANSAC (motion_estimation.h); it owns the inter-frame
-// matcher (matcher.h: SVD · NCC · Gabor by default, the baselines).
+// The tracker: the stage that finds a frame's matches against the reference (or against the
+// previous lost frame, for the lost-frame chain). It owns the inter-frame matcher (matcher.h:
+// SVD · NCC · Gabor by default, the baselines) and runs it in up to four passes, each centred
+// on a different guess of where the reference's features went: the motion prior's prediction,
+// the coarse-to-fine image shift, the reference's own last motion, and — a guided pass — the
+// motion just estimated; each pass is followed by RANSAC (motion_estimation.h), the pass with
+// the most inliers is kept and OdometryResult::prediction says which. It receives the two
+// frames, the prior's motion, the constant velocity and the reference's up (TrackingContext),
+// nothing else of the pipeline; its options are the `tracker` group of vo_options.yaml
+// (tracker.matcher, the gates, the confidence thresholds). The passes in detail:
 //
 // Predicted matching (matcher.prediction = kMotionPrior, the default; kNone = the paper's
 // unpredicted form, every position gate centred on the previous position). Beyond the paper,

@@ -33,7 +33,7 @@ bool ParseSets(const std::vector<std::string>& sets, YAML::Node* overrides, std:
   for (const auto& s : sets) {
     const size_t eq = s.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == s.size()) {
-      *error = "--set: expected key=value (e.g. matcher.type=ncc_mutual), got '" + s + "'";
+      *error = "--set: expected key=value (e.g. tracker.matcher.type=ncc_mutual), got '" + s + "'";
       return false;
     }
     const std::string key = s.substr(0, eq);

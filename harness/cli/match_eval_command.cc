@@ -195,7 +195,7 @@ Command AddMatchEvalCommand(CLI::App& app) {
       ->capture_default_str();
   match_eval->add_option("--config", a->config,
                          "VO options (YAML): its matcher.* options (the type is set by "
-                         "--matchers) and tracking.prior_radius_scale are evaluated");
+                         "--matchers) and tracker.prior_radius_scale are evaluated");
   match_eval->add_option("--out,-o", a->out, "Output folder (default out/match_eval/<scenario>)");
   match_eval->add_option("--max-frames", a->max_frames, "Use only the first N frames (0 = all)")
       ->check(AtLeast(0));

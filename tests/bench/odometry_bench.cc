@@ -242,7 +242,7 @@ BENCHMARK(BM_OdometryAtSize)
 
 void BM_OdometryNoBundleAdjustment(benchmark::State& state) {
   vo::OdometryOptions options;
-  options.use_bundle_adjustment = false;
+  options.back_end.bundle_adjustment = false;
   RunPipeline(state, options);
 }
 BENCHMARK(BM_OdometryNoBundleAdjustment)->Unit(benchmark::kMillisecond)->Iterations(3);
@@ -258,7 +258,7 @@ BENCHMARK(BM_OdometryNoLeftRightCheck)->Unit(benchmark::kMillisecond)->Iteration
 
 void BM_OdometryWindow10(benchmark::State& state) {
   vo::OdometryOptions options;
-  options.ba_window_frames = 10;
+  options.back_end.window_frames = 10;
   RunPipeline(state, options);
 }
 BENCHMARK(BM_OdometryWindow10)->Unit(benchmark::kMillisecond)->Iterations(3);

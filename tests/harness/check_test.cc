@@ -224,7 +224,7 @@ TEST(CheckCommandTest, PassesOnItsOwnBaselineAndCatchesADegradedConfiguration) {
   EXPECT_EQ(none.exit_code, 2) << none.output;
   EXPECT_NE(none.output.find("no such baseline"), std::string::npos) << none.output;
   const auto refused = RunVobench("check --update --suite " + (dir / "ci.yaml") +
-                                  " --set use_bundle_adjustment=false" + common);
+                                  " --set back_end.bundle_adjustment=false" + common);
   EXPECT_EQ(refused.exit_code, 2) << refused.output;
   EXPECT_FALSE(fs::exists(baseline));
   EXPECT_FALSE(fs::exists(dir / "out"));
@@ -249,8 +249,8 @@ TEST(CheckCommandTest, PassesOnItsOwnBaselineAndCatchesADegradedConfiguration) {
   // on the corner, so the end-pose error alone no longer shows it): some metric of each run
   // gets worse than its tolerance.
   const auto degraded = RunVobench(
-      "check --set use_bundle_adjustment=false --set matcher.type=ncc_mutual"
-      " --set matcher.prediction=none" +
+      "check --set back_end.bundle_adjustment=false --set tracker.matcher.type=ncc_mutual"
+      " --set tracker.matcher.prediction=none" +
       common);
   EXPECT_EQ(degraded.exit_code, 1) << degraded.output;
   EXPECT_NE(degraded.output.find("FAILED"), std::string::npos) << degraded.output;
@@ -267,9 +267,9 @@ TEST(CheckCommandTest, PassesOnItsOwnBaselineAndCatchesADegradedConfiguration) {
   EXPECT_EQ(ReadAll(baseline), recorded);  // a failing check never rewrites the baseline
 
   // A bad override is bad input.
-  const auto typo = RunVobench("check --set matcher.typo=1" + common);
+  const auto typo = RunVobench("check --set tracker.matcher.typo=1" + common);
   EXPECT_EQ(typo.exit_code, 2) << typo.output;
-  EXPECT_NE(typo.output.find("matcher.typo"), std::string::npos) << typo.output;
+  EXPECT_NE(typo.output.find("tracker.matcher.typo"), std::string::npos) << typo.output;
 }
 
 }  // namespace

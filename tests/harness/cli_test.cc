@@ -86,8 +86,9 @@ TEST(CliTest, ConfigThatIsAFolderOrMissingIsAnErrorNamingIt) {
 // matcher do not matter there, and a bad key is refused naming the file.
 TEST(CliTest, MatchEvalTakesTheMatcherOptionsOfAVoConfig) {
   TempDir dir("cli_match_eval_config");
-  WriteText(dir / "strict.yaml", "platform: free\nmatcher:\n  svd:\n    gabor_min_ncc: 0.99\n");
-  WriteText(dir / "bad.yaml", "matcher:\n  svd:\n    min_ncc: 2\n");
+  WriteText(dir / "strict.yaml",
+            "platform: free\ntracker.matcher:\n  svd:\n    gabor_min_ncc: 0.99\n");
+  WriteText(dir / "bad.yaml", "tracker.matcher:\n  svd:\n    min_ncc: 2\n");
   const std::string common =
       " --strides 1 --matchers svd_ncc_gabor --max-frames 4 -q --out " + (dir / "out");
   auto matches = [&](const std::string& config) {
@@ -108,7 +109,8 @@ TEST(CliTest, MatchEvalTakesTheMatcherOptionsOfAVoConfig) {
   EXPECT_LT(strict, plain);
   const CommandResult bad = RunVobench("match-eval" + common + " --config " + (dir / "bad.yaml"));
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
-  EXPECT_NE(bad.output.find(dir / "bad.yaml" + ":3: key 'matcher.svd.min_ncc'"), std::string::npos)
+  EXPECT_NE(bad.output.find(dir / "bad.yaml" + ":3: key 'tracker.matcher.svd.min_ncc'"),
+            std::string::npos)
       << bad.output;
 }
 

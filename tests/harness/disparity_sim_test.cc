@@ -57,8 +57,8 @@ TEST(DisparitySimTest, HallwayDisparityAgreesWithGroundTruthDepth) {
 
 }  // namespace
 
-// The disparity at single pixels (the pipeline's default, disparity_mode at_features) equals
-// the dense map without its speckle filter at every pixel of rendered hallway frames.
+// The disparity at single pixels (the pipeline's default, front_end.disparity_mode at_features)
+// equals the dense map without its speckle filter at every pixel of rendered hallway frames.
 TEST(DisparitySimTest, DisparityAtPixelsEqualsTheDenseMapOnTheHallway) {
   sim::Scenario s;
   std::string error;

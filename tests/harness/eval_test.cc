@@ -442,8 +442,8 @@ TEST_F(EvalBadInputTest, GroundVehicleRunTakesTheRigFilesAxle) {
   WriteText(data + "/rig.yaml",
             "camera_forward_m: 0.2\ncamera_height_m: 0.4\ncamera_pitch_deg: 0\n");
   const std::string config = (dir_ / "gv.yaml").string();
-  for (const char* axle : {"", "  few_point:\n    axle_behind_camera_m: 0.05\n"}) {
-    WriteText(config, std::string("tracking:\n  ground_vehicle: true\n") + axle);
+  for (const char* axle : {"", "  axle_behind_camera_m: 0.05\n"}) {
+    WriteText(config, std::string("vehicle:\n  enabled: true\n") + axle);
     const CommandResult r = RunVobench("eval --dataset " + data + " --format kitti --config " +
                                        config + " --out " + Out() + " -q --no-plots");
     ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -477,8 +477,8 @@ TEST_F(EvalBadInputTest, PlatformAutoFollowsTheRigFile) {
     const std::string options = ReadAll(Out() + "/vo_options.yaml");
     EXPECT_THAT(options, HasSubstr("platform: " + c.platform));
     const bool vehicle = c.platform == "ground_vehicle";
-    EXPECT_THAT(options,
-                HasSubstr(std::string("vehicle_flat_floor: ") + (vehicle ? "true" : "false")));
+    EXPECT_THAT(options, HasSubstr(std::string("flat_floor:\n    enabled: ") +
+                                   (vehicle ? "true" : "false")));
     EXPECT_THAT(options,
                 HasSubstr(std::string("axle_behind_camera_m: ") + (vehicle ? "0.2" : "0")));
   }
@@ -566,7 +566,7 @@ TEST_F(EvalBadInputTest, BadArguments) {
                    (dir_ / "none.txt").string() + ": file not found");
   ExpectCliFailure("--dataset " + (dir_ / "nowhere").string() + " --format euroc",
                    (dir_ / "nowhere").string() + ": dataset folder not found");
-  WriteText((dir_ / "vo.yaml").string(), "matcher:\n  typo: 1\n");
+  WriteText((dir_ / "vo.yaml").string(), "tracker.matcher:\n  typo: 1\n");
   ExpectCliFailure("--dataset " + data + " --format tum --config " + (dir_ / "vo.yaml").string(),
                    (dir_ / "vo.yaml").string() + ":2", 2);
   // A ground truth on another clock: nothing associates.

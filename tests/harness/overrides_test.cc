@@ -65,16 +65,16 @@ TEST(OverridesTest, ScenarioOverridesAreCheckedStrictly) {
 
 TEST(OverridesTest, VoOverridesApplyOnTopOfTheGivenOptions) {
   vo::OdometryOptions options;
-  options.ba_window_frames = 7;
+  options.back_end.window_frames = 7;
   std::string error;
-  ASSERT_TRUE(
-      harness::ApplyVoOverrides(YAML::Load("{matcher.type: ncc_mutual}"), "t", &options, &error))
+  ASSERT_TRUE(harness::ApplyVoOverrides(YAML::Load("{tracker.matcher.type: ncc_mutual}"), "t",
+                                        &options, &error))
       << error;
-  EXPECT_EQ(options.ba_window_frames, 7);
+  EXPECT_EQ(options.back_end.window_frames, 7);
   EXPECT_EQ(options.matcher.type, vo::MatcherType::kNccMutual);
   vo::OdometryOptions bad = options;
-  EXPECT_FALSE(
-      harness::ApplyVoOverrides(YAML::Load("{matcher.type: nonsense}"), "tune.yaml", &bad, &error));
+  EXPECT_FALSE(harness::ApplyVoOverrides(YAML::Load("{tracker.matcher.type: nonsense}"),
+                                         "tune.yaml", &bad, &error));
   EXPECT_NE(error.find("tune.yaml"), std::string::npos) << error;
 }
 
@@ -82,10 +82,10 @@ TEST(OverridesTest, VoOverridesApplyOnTopOfTheGivenOptions) {
 TEST(OverridesTest, ErrorsOfFileOverridesNameTheFileLineAndFullKey) {
   vo::OdometryOptions options;
   std::string error;
-  EXPECT_FALSE(harness::ApplyVoOverrides(YAML::Load("{matcher.type: nonsense}"),
+  EXPECT_FALSE(harness::ApplyVoOverrides(YAML::Load("{tracker.matcher.type: nonsense}"),
                                          harness::kOverridesSource, &options, &error));
   EXPECT_EQ(harness::OverrideErrorAt("s.yaml:6", "configs[0].set", error)
-                .rfind("s.yaml:6: key 'configs[0].set.matcher.type': expected one of ", 0),
+                .rfind("s.yaml:6: key 'configs[0].set.tracker.matcher.type': expected one of ", 0),
             0u)
       << error;
   sim::Scenario base, s;

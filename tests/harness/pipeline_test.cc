@@ -189,12 +189,12 @@ TEST(PipelineTest, PlatformAutoIsAGroundVehicleOnAKnownRig) {
   const vo::OdometryOptions known = vo::ResolvePlatform(o, 0.15);
   EXPECT_EQ(known.platform, vo::Platform::kGroundVehicle);
   EXPECT_TRUE(known.tracking.few_point_motion && known.tracking.ground_vehicle &&
-              known.tracking.vehicle_planar_ba && known.tracking.vehicle_flat_floor);
+              known.back_end.vehicle_planar.enabled && known.back_end.flat_floor.enabled);
   EXPECT_EQ(known.tracking.few_point.axle_behind_camera_m, 0.15);
   const vo::OdometryOptions unknown = vo::ResolvePlatform(o, -1.0);
   EXPECT_EQ(unknown.platform, vo::Platform::kFree);
   EXPECT_FALSE(unknown.tracking.few_point_motion || unknown.tracking.ground_vehicle ||
-               unknown.tracking.vehicle_planar_ba || unknown.tracking.vehicle_flat_floor);
+               unknown.back_end.vehicle_planar.enabled || unknown.back_end.flat_floor.enabled);
   EXPECT_EQ(unknown.tracking.few_point.axle_behind_camera_m, 0.0);
 
   o.platform = vo::Platform::kFree;
@@ -204,7 +204,7 @@ TEST(PipelineTest, PlatformAutoIsAGroundVehicleOnAKnownRig) {
   EXPECT_EQ(free_on_rig.tracking.few_point.axle_behind_camera_m, 0.0);
   o.tracking.ground_vehicle = true;  // by hand, on the free platform
   EXPECT_EQ(vo::ResolvePlatform(o, 0.15).tracking.few_point.axle_behind_camera_m, 0.15);
-  EXPECT_FALSE(vo::ResolvePlatform(o, 0.15).tracking.vehicle_flat_floor);
+  EXPECT_FALSE(vo::ResolvePlatform(o, 0.15).back_end.flat_floor.enabled);
   EXPECT_EQ(vo::ResolvePlatform(o, -1.0).tracking.few_point.axle_behind_camera_m, 0.0);
   o.tracking.few_point.axle_behind_camera_m = 0.05;  // given: kept
   EXPECT_EQ(vo::ResolvePlatform(o, 0.15).tracking.few_point.axle_behind_camera_m, 0.05);
@@ -212,13 +212,13 @@ TEST(PipelineTest, PlatformAutoIsAGroundVehicleOnAKnownRig) {
   vo::OdometryOptions g;
   g.platform = vo::Platform::kGroundVehicle;  // without a rig: the options on, the axle as given
   const vo::OdometryOptions forced = vo::ResolvePlatform(g, -1.0);
-  EXPECT_TRUE(forced.tracking.vehicle_flat_floor && forced.tracking.few_point_motion);
+  EXPECT_TRUE(forced.back_end.flat_floor.enabled && forced.tracking.few_point_motion);
   EXPECT_EQ(forced.tracking.few_point.axle_behind_camera_m, 0.0);
 }
 
 // A ground vehicle whose rig's camera pitch is known takes its up from the mounting when the
-// first frame shows no floor: orientation_up_from_mounting on, expected_up_cam0 the up of that
-// pitch (cv axes: y down; a camera tilted down by p sees the up as (0, −cos p, −sin p)). An
+// first frame shows no floor: initial_orientation.up_from_mounting on, expected_up_cam0 the up of
+// that pitch (cv axes: y down; a camera tilted down by p sees the up as (0, −cos p, −sin p)). An
 // unknown pitch, the free platform or an up given in the options change nothing of it.
 TEST(PipelineTest, AGroundVehicleTakesItsUpFromTheRigsPitch) {
   vo::OdometryOptions o;

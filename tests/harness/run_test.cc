@@ -168,27 +168,29 @@ TEST(RunTest, RefusesToReplaceAFolderThatIsNotARun) {
 TEST(VoConfigTest, RoundTripAndErrors) {
   vo::OdometryOptions o;
   std::string error;
-  ASSERT_TRUE(
-      harness::ParseVoConfig("matcher:\n  type: ncc_mutual\n  svd:\n    sigma_px: 14\n"
-                             "use_bundle_adjustment: false\nba_window_frames: 7\n",
-                             "cfg.yaml", &o, &error))
+  ASSERT_TRUE(harness::ParseVoConfig(
+      "tracker:\n  matcher:\n    type: ncc_mutual\n    svd:\n      sigma_px: 14\n"
+      "back_end.bundle_adjustment: false\nback_end.window_frames: 7\n",
+      "cfg.yaml", &o, &error))
       << error;
   EXPECT_EQ(o.matcher.type, vo::MatcherType::kNccMutual);
   EXPECT_DOUBLE_EQ(o.matcher.svd.sigma_px, 14);
-  EXPECT_FALSE(o.use_bundle_adjustment);
-  EXPECT_EQ(o.ba_window_frames, 7);
+  EXPECT_FALSE(o.back_end.bundle_adjustment);
+  EXPECT_EQ(o.back_end.window_frames, 7);
   // The effective file reads back to the same options, every key away from its default (a key
   // written twice, e.g. a nested map split in two, would lose one of them).
-  o.ba.max_num_iterations = 7;
-  o.ba.loss_scale_px = 2.5;
-  o.ba_max_points = 55;
+  o.back_end.ba.max_num_iterations = 7;
+  o.back_end.ba.loss_scale_px = 2.5;
+  o.back_end.max_points = 55;
   o.disparity.algorithm = vo::DisparityAlgorithm::kSemiGlobal;
   o.disparity_mode = vo::DisparityMode::kDense;  // at_features needs the one-volume matcher
   o.disparity_range_margin_px = 4.0;
   o.disparity.block_size = 7;
   o.disparity_min_depth_m = 0.6;
   const std::string effective = harness::VoConfigToYaml(o);
-  for (const char* top : {"\nba:", "\ndisparity:", "\nmatcher:", "\ndetector:", "\nransac:"}) {
+  for (const char* top :
+       {"\n  ba:", "\n  disparity:", "\n  matcher:", "\n  detector:", "\n  ransac:", "\nfront_end:",
+        "\ntracker:", "\nmotion:", "\nrecovery:", "\nback_end:"}) {
     const size_t first = effective.find(top);
     EXPECT_EQ(effective.find(top, first + 1), std::string::npos) << top << " twice in\n"
                                                                  << effective;
@@ -197,22 +199,25 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   ASSERT_TRUE(harness::ParseVoConfig(harness::VoConfigToYaml(o), "effective.yaml", &again, &error))
       << error;
   EXPECT_EQ(harness::VoConfigToYaml(again), harness::VoConfigToYaml(o));
-  EXPECT_EQ(again.ba.max_num_iterations, 7);
-  EXPECT_EQ(again.ba.loss_scale_px, 2.5);
-  EXPECT_EQ(again.ba_max_points, 55);
+  EXPECT_EQ(again.back_end.ba.max_num_iterations, 7);
+  EXPECT_EQ(again.back_end.ba.loss_scale_px, 2.5);
+  EXPECT_EQ(again.back_end.max_points, 55);
   EXPECT_EQ(again.disparity.algorithm, vo::DisparityAlgorithm::kSemiGlobal);
   EXPECT_EQ(again.disparity_min_depth_m, 0.6);
 
   vo::OdometryOptions bad;
-  EXPECT_FALSE(harness::ParseVoConfig("matcher:\n  typo: 1\n", "cfg.yaml", &bad, &error));
-  EXPECT_NE(error.find("cfg.yaml:2"), std::string::npos) << error;
-  EXPECT_NE(error.find("matcher.typo"), std::string::npos) << error;
-  EXPECT_FALSE(harness::ParseVoConfig("ba_window_frames: 11\n", "cfg.yaml", &bad, &error));
-  EXPECT_NE(error.find("ba_window_frames"), std::string::npos) << error;
   EXPECT_FALSE(
-      harness::ParseVoConfig("ransac:\n  inlier_threshold_px: .nan\n", "cfg.yaml", &bad, &error));
-  EXPECT_FALSE(harness::ParseVoConfig("matcher:\n  type: magic\n", "cfg.yaml", &bad, &error));
-  EXPECT_FALSE(harness::ParseVoConfig("use_bundle_adjustment: maybe\n", "cfg.yaml", &bad, &error));
+      harness::ParseVoConfig("tracker:\n  matcher:\n    typo: 1\n", "cfg.yaml", &bad, &error));
+  EXPECT_NE(error.find("cfg.yaml:3"), std::string::npos) << error;
+  EXPECT_NE(error.find("tracker.matcher.typo"), std::string::npos) << error;
+  EXPECT_FALSE(harness::ParseVoConfig("back_end.window_frames: 11\n", "cfg.yaml", &bad, &error));
+  EXPECT_NE(error.find("back_end.window_frames"), std::string::npos) << error;
+  EXPECT_FALSE(harness::ParseVoConfig("motion:\n  ransac:\n    inlier_threshold_px: .nan\n",
+                                      "cfg.yaml", &bad, &error));
+  EXPECT_FALSE(
+      harness::ParseVoConfig("tracker.matcher:\n  type: magic\n", "cfg.yaml", &bad, &error));
+  EXPECT_FALSE(
+      harness::ParseVoConfig("back_end.bundle_adjustment: maybe\n", "cfg.yaml", &bad, &error));
   EXPECT_FALSE(harness::ParseVoConfig("a: [1\n", "cfg.yaml", &bad, &error));
   EXPECT_NE(error.find("malformed"), std::string::npos);
 }
@@ -222,13 +227,15 @@ TEST(VoConfigTest, RoundTripAndErrors) {
 TEST(VoConfigTest, DuplicateKeysAndFoldersAreRefused) {
   vo::OdometryOptions o;
   std::string error;
-  EXPECT_FALSE(harness::ParseVoConfig("matcher:\n  type: ncc_mutual\nmatcher:\n  type: kalman\n",
-                                      "cfg.yaml", &o, &error));
-  EXPECT_EQ(error, "cfg.yaml:3: key 'matcher': duplicate (first at line 1)");
+  EXPECT_FALSE(harness::ParseVoConfig(
+      "tracker:\n  matcher: {type: ncc_mutual}\ntracker:\n  matcher: {type: kalman}\n", "cfg.yaml",
+      &o, &error));
+  EXPECT_EQ(error, "cfg.yaml:3: key 'tracker': duplicate (first at line 1)");
   // The same option dotted and nested.
-  EXPECT_FALSE(harness::ParseVoConfig("matcher.type: kalman\nmatcher:\n  type: ncc_mutual\n",
-                                      "cfg.yaml", &o, &error));
-  EXPECT_EQ(error, "cfg.yaml:3: key 'matcher.type': duplicate (first at line 1)");
+  EXPECT_FALSE(harness::ParseVoConfig(
+      "tracker.matcher.type: kalman\ntracker:\n  matcher:\n    type: ncc_mutual\n", "cfg.yaml", &o,
+      &error));
+  EXPECT_EQ(error, "cfg.yaml:4: key 'tracker.matcher.type': duplicate (first at line 1)");
   const std::string folder = ::testing::TempDir();
   EXPECT_FALSE(harness::LoadVoConfig(folder, &o, &error));
   EXPECT_EQ(error, folder + ": is a folder, expected a YAML VO config file");

@@ -58,7 +58,7 @@ scenarios:
 configs:
   - name: paper
   - name: ncc
-    set: {matcher.type: ncc_mutual}
+    set: {tracker.matcher.type: ncc_mutual}
 strides: [1, 2]
 )";
 
@@ -132,15 +132,16 @@ TEST(SuiteFileTest, ScenarioAndConfigFilesAreRelativeToTheSuite) {
   fs::create_directories(dir / "sub");
   WriteText(dir / "sub/short.yaml", "name: short\nscene: " + std::string(VOBENCH_SOURCE_DIR) +
                                         "/scenes/hallway_l.xml\npath:\n  - [0, 0]\n  - [0.5, 0]\n");
-  WriteText(dir / "sub/vo.yaml", "ba_window_frames: 7\n");
-  WriteText(dir / "suite.yaml",
-            "name: rel\nscenarios:\n  - scenario: sub/short.yaml\nconfigs:\n"
-            "  - name: w7\n    config: sub/vo.yaml\n    set: {matcher.type: lucas_kanade}\n");
+  WriteText(dir / "sub/vo.yaml", "back_end.window_frames: 7\n");
+  WriteText(
+      dir / "suite.yaml",
+      "name: rel\nscenarios:\n  - scenario: sub/short.yaml\nconfigs:\n"
+      "  - name: w7\n    config: sub/vo.yaml\n    set: {tracker.matcher.type: lucas_kanade}\n");
   harness::Suite suite;
   std::string error;
   ASSERT_TRUE(harness::LoadSuite(dir / "suite.yaml", &suite, &error)) << error;
   EXPECT_EQ(suite.scenarios[0].name, "short");
-  EXPECT_EQ(suite.configs[0].options.ba_window_frames, 7);
+  EXPECT_EQ(suite.configs[0].options.back_end.window_frames, 7);
   EXPECT_EQ(suite.configs[0].options.matcher.type, vo::MatcherType::kLucasKanade);
 }
 
@@ -163,11 +164,11 @@ TEST(SuiteFileTest, BadSuiteFilesNameTheFileLineAndKey) {
        "a\n",
        {"bad.yaml:4", "rate_hz"}},
       {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n    set:\n      "
-       "matcher: {typo: 1}\n",
-       {"bad.yaml:7", "configs[0].set.matcher.typo", "unknown VO option key"}},
+       "tracker: {matcher: {typo: 1}}\n",
+       {"bad.yaml:7", "configs[0].set.tracker.matcher.typo", "unknown VO option key"}},
       {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n    set: "
-       "{matcher.type: magic}\n",
-       {"bad.yaml:6", "matcher.type", "magic"}},
+       "{tracker.matcher.type: magic}\n",
+       {"bad.yaml:6", "tracker.matcher.type", "magic"}},
       {"name: b\nscenarios:\n  - scenario: l_hallway\nconfigs:\n  - name: a\n    config: "
        "none.yaml\n",
        {"bad.yaml:6", "configs[0].config", "none.yaml"}},
@@ -285,7 +286,7 @@ TEST(SuiteFileTest, ExternalConfigsAreReadAndChecked) {
   const std::vector<Bad> bad = {
       {"  - name: x\n    external: {command: [vo.sh, \"{data}\"], trajectory: t, format: tum}\n",
        {"e.yaml:6", "configs[0].external.command[1]", "unknown placeholder {data}"}},
-      {"  - name: x\n    set: {ba_window_frames: 4}\n    external: {command: [vo.sh], "
+      {"  - name: x\n    set: {back_end.window_frames: 4}\n    external: {command: [vo.sh], "
        "trajectory: t, format: tum}\n",
        {"e.yaml:6", "configs[0].set", "not with external"}},
       {"  - name: x\n    external: {command: [vo.sh], format: tum}\n",

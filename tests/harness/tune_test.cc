@@ -271,10 +271,10 @@ std::string TuneFileText(
          max_frames +
          "}\n"
          "parameters:\n"
-         "  - {key: matcher.svd.sigma_px, min: 4, max: 30, log: true}\n"
-         "  - {key: matcher.ncc.window_px, type: int, min: 5, max: 21, step: 2}\n"
-         "  - {key: matcher.gabor.wavelengths_px, type: scale, min: 0.7, max: 1.5}\n"
-         "  - {key: ransac.inlier_threshold_px, min: 0.5, max: 5, log: true}\n" +
+         "  - {key: tracker.matcher.svd.sigma_px, min: 4, max: 30, log: true}\n"
+         "  - {key: tracker.matcher.ncc.window_px, type: int, min: 5, max: 21, step: 2}\n"
+         "  - {key: tracker.matcher.gabor.wavelengths_px, type: scale, min: 0.7, max: 1.5}\n"
+         "  - {key: motion.ransac.inlier_threshold_px, min: 0.5, max: 5, log: true}\n" +
          extra_parameters +
          "objective: {metric: ate_rmse_m, lost_frame_penalty: 0.05, aggregate: mean}\n"
          "optimizer: " +
@@ -285,8 +285,8 @@ TEST(TuneSpecTest, ReadsAValidFile) {
   harness::TuneSpec spec;
   std::string error;
   ASSERT_TRUE(harness::ParseTuneSpec(
-      TuneFileText("6", "  - {key: ba_window_frames, type: int, min: 3, max: 10}\n"), "t.yaml", ".",
-      &spec, &error))
+      TuneFileText("6", "  - {key: back_end.window_frames, type: int, min: 3, max: 10}\n"),
+      "t.yaml", ".", &spec, &error))
       << error;
   EXPECT_EQ(spec.name, "tiny");
   ASSERT_EQ(spec.train.size(), 1u);
@@ -312,7 +312,7 @@ TEST(TuneSpecTest, ReadsAValidFile) {
   for (size_t i = 0; i < o.matcher.gabor.wavelengths_px.size(); ++i)
     EXPECT_EQ(o.matcher.gabor.wavelengths_px[i], 1.5 * defaults.matcher.gabor.wavelengths_px[i]);
   EXPECT_EQ(o.ransac.inlier_threshold_px, 3.0);
-  EXPECT_EQ(o.ba_window_frames, 7);
+  EXPECT_EQ(o.back_end.window_frames, 7);
   ASSERT_TRUE(harness::ApplyParameters(spec, spec.start_values, &o, &error)) << error;
   EXPECT_EQ(harness::VoConfigToYaml(o), harness::VoConfigToYaml(defaults));
 }
@@ -337,11 +337,11 @@ std::vector<BadFile> BadFiles() {
        replace("max_frames: 6}", "max_frame: 6}"),
        {":3:", "key 'train[0].max_frame': unknown key"}},
       {"unknown VO key",
-       replace("matcher.svd.sigma_px", "matcher.svd.sigmaa"),
-       {":7:", "'matcher.svd.sigmaa'", "not a VO option"}},
+       replace("tracker.matcher.svd.sigma_px", "tracker.matcher.svd.sigmaa"),
+       {":7:", "'tracker.matcher.svd.sigmaa'", "not a VO option"}},
       {"min >= max",
        replace("min: 4, max: 30", "min: 30, max: 4"),
-       {":7:", "matcher.svd.sigma_px", "min < max"}},
+       {":7:", "tracker.matcher.svd.sigma_px", "min < max"}},
       {"empty training set",
        "name: x\ntrain: []\nvalidation: []\nparameters: []\n",
        {":2:", "'train'", "empty"}},
@@ -350,25 +350,25 @@ std::vector<BadFile> BadFiles() {
        {":5:", "'va_a'", "'tr_a'"}},
       {"even NCC window",
        replace("min: 5, max: 21, step: 2", "min: 5, max: 21"),
-       {":8:", "matcher.ncc.window_px", "value 6", "odd"}},
+       {":8:", "tracker.matcher.ncc.window_px", "value 6", "odd"}},
       {"real on an integer key",
        replace("type: int, min: 5, max: 21, step: 2", "min: 5, max: 21"),
-       {":8:", "matcher.ncc.window_px"}},
+       {":8:", "tracker.matcher.ncc.window_px"}},
       {"scale on a scalar key",
-       replace("matcher.gabor.wavelengths_px", "ransac.confidence"),
-       {":9:", "ransac.confidence", "list-valued"}},
+       replace("tracker.matcher.gabor.wavelengths_px", "motion.ransac.confidence"),
+       {":9:", "motion.ransac.confidence", "list-valued"}},
       {"non-numeric key",
-       replace("key: matcher.svd.sigma_px, min: 4, max: 30, log: true",
-               "key: matcher.type, min: 0, max: 1"),
-       {":7:", "matcher.type", "not a numeric"}},
+       replace("key: tracker.matcher.svd.sigma_px, min: 4, max: 30, log: true",
+               "key: tracker.matcher.type, min: 0, max: 1"),
+       {":7:", "tracker.matcher.type", "not a numeric"}},
       {"start outside the range",
        replace("min: 0.5, max: 5", "min: 2.5, max: 5"),
-       {":10:", "ransac.inlier_threshold_px", "outside"}},
+       {":10:", "motion.ransac.inlier_threshold_px", "outside"}},
       {"key given twice",
        good.substr(0, good.find("objective")) +
-           "  - {key: matcher.svd.sigma_px, min: 5, max: 20}\n" +
+           "  - {key: tracker.matcher.svd.sigma_px, min: 5, max: 20}\n" +
            good.substr(good.find("objective")),
-       {":11:", "matcher.svd.sigma_px", "twice"}},
+       {":11:", "tracker.matcher.svd.sigma_px", "twice"}},
       {"unknown metric", replace("metric: ate_rmse_m", "metric: ate"), {":11:", "'ate'"}},
       {"unknown algorithm", replace("algorithm: random", "algorithm: LN_FOO"), {":12:", "LN_FOO"}},
       {"bad scenario override",
@@ -490,10 +490,11 @@ TEST(TuneCommandTest, TunesDeterministicallyAndWritesALoadableBestConfig) {
     for (std::string l; std::getline(csv, l);) lines.push_back(l);
   }
   ASSERT_EQ(lines.size(), 5u);
-  EXPECT_EQ(
-      lines[0],
-      "eval,origin,matcher.svd.sigma_px,matcher.ncc.window_px,matcher.gabor.wavelengths_px:scale,"
-      "ransac.inlier_threshold_px,tr_a:ate_rmse_m,tr_a:lost_frames,objective,best_objective");
+  EXPECT_EQ(lines[0],
+            "eval,origin,tracker.matcher.svd.sigma_px,tracker.matcher.ncc.window_px,tracker."
+            "matcher.gabor.wavelengths_px:scale,"
+            "motion.ransac.inlier_threshold_px,tr_a:ate_rmse_m,tr_a:lost_frames,objective,best_"
+            "objective");
   EXPECT_EQ(lines[1].rfind("0,start,10,11,1,2,", 0), 0u) << lines[1];
 
   // Never worse than the start on training; the tuned values are the best evaluation's.

@@ -130,8 +130,8 @@ TEST_P(OdometrySeamTest, ExactMatchesReproduceTheTrajectory) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
   options.estimate_initial_orientation = false;  // world = first camera = ground truth world
-  options.use_bundle_adjustment = GetParam().use_ba;
-  options.prior_weight = GetParam().prior_weight;
+  options.back_end.bundle_adjustment = GetParam().use_ba;
+  options.back_end.prior_weight = GetParam().prior_weight;
   std::string error;
   std::unique_ptr<StereoOdometry> vo = StereoOdometry::Create(cam, options, &error);
   ASSERT_NE(vo, nullptr) << error;
@@ -732,7 +732,7 @@ TEST(OdometryRenderedTest, WithoutOrientationTheWorldIsTheFirstCamera) {
 
 TEST(OdometryRenderedTest, WithoutBundleAdjustmentStillTracks) {
   OdometryOptions options;
-  options.use_bundle_adjustment = false;
+  options.back_end.bundle_adjustment = false;
   const std::vector<OdometryResult> results = RunCorridor(options);
   for (size_t i = 1; i < results.size(); ++i) {
     EXPECT_EQ(results[i].status, TrackingStatus::kTracking) << results[i].message;
@@ -1044,8 +1044,8 @@ std::vector<SeamFrame> NoisyVehicleDrive(const StereoCamera& cam, uint64_t seed,
 OdometryOptions DriveOptions(bool flat_floor) {
   OdometryOptions options;
   options.tracking.ground_vehicle = true;
-  options.tracking.vehicle_planar_ba = true;
-  options.tracking.vehicle_flat_floor = flat_floor;
+  options.back_end.vehicle_planar.enabled = true;
+  options.back_end.flat_floor.enabled = flat_floor;
   options.tracking.few_point.axle_behind_camera_m = kDriveAxleM;
   return options;
 }
@@ -1498,9 +1498,9 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
     EXPECT_THAT(error, ::testing::HasSubstr(expected));
     EXPECT_EQ(StereoOdometry::Create(HallwayCamera(), options), nullptr);
   };
-  rejects([](OdometryOptions* o) { o->ba_window_frames = 2; }, "ba_window_frames");
-  rejects([](OdometryOptions* o) { o->ba_window_frames = 11; }, "ba_window_frames");
-  rejects([](OdometryOptions* o) { o->prior_weight = -0.1; }, "prior_weight");
+  rejects([](OdometryOptions* o) { o->back_end.window_frames = 2; }, "window_frames");
+  rejects([](OdometryOptions* o) { o->back_end.window_frames = 11; }, "window_frames");
+  rejects([](OdometryOptions* o) { o->back_end.prior_weight = -0.1; }, "prior_weight");
   rejects([](OdometryOptions* o) { o->tracking.prior_update_exponent = 0.5; },
           "prior_update_exponent");
   rejects([](OdometryOptions* o) { o->tracking.vehicle_rotation_min_shift_score = 1.5; },
@@ -1516,28 +1516,28 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
         o->tracking.vehicle_max_weak_lift_m = std::numeric_limits<double>::infinity();
       },
       "vehicle_max_weak_lift_m");
-  rejects([](OdometryOptions* o) { o->tracking.vehicle_ba_tilt_sigma_deg = 0.0; },
-          "vehicle_ba_tilt_sigma_deg");
-  rejects([](OdometryOptions* o) { o->tracking.vehicle_ba_slip_sigma_m = NAN; },
-          "vehicle_ba_slip_sigma_m");
-  rejects([](OdometryOptions* o) { o->tracking.vehicle_floor_tilt_sigma_deg = -1.0; },
-          "vehicle_floor_tilt_sigma_deg");
-  rejects([](OdometryOptions* o) { o->tracking.vehicle_floor_height_sigma_m = NAN; },
-          "vehicle_floor_height_sigma_m");
-  rejects([](OdometryOptions* o) { o->prior_weight = 1.5; }, "prior_weight");
+  rejects([](OdometryOptions* o) { o->back_end.vehicle_planar.tilt_sigma_deg = 0.0; },
+          "vehicle_planar.tilt_sigma_deg");
+  rejects([](OdometryOptions* o) { o->back_end.vehicle_planar.slip_sigma_m = NAN; },
+          "slip_sigma_m");
+  rejects([](OdometryOptions* o) { o->back_end.flat_floor.tilt_sigma_deg = -1.0; },
+          "flat_floor.tilt_sigma_deg");
+  rejects([](OdometryOptions* o) { o->back_end.flat_floor.height_sigma_m = NAN; },
+          "height_sigma_m");
+  rejects([](OdometryOptions* o) { o->back_end.prior_weight = 1.5; }, "prior_weight");
   rejects([](OdometryOptions* o) { o->min_inliers = 2; }, "min_inliers");
   rejects([](OdometryOptions* o) { o->min_features = 0; }, "min_features");
   rejects([](OdometryOptions* o) { o->disparity_min_depth_m = 0.0; }, "disparity_min_depth_m");
   rejects([](OdometryOptions* o) { o->max_num_disparities = 40; }, "max_num_disparities");
   rejects([](OdometryOptions* o) { o->reinit_after_lost_frames = 0; }, "reinit_after_lost");
-  rejects([](OdometryOptions* o) { o->ba_max_points = -1; }, "ba_max_points");
-  rejects([](OdometryOptions* o) { o->ba_max_correction_m = 0.0; }, "ba_max_correction");
+  rejects([](OdometryOptions* o) { o->back_end.max_points = -1; }, "max_points");
+  rejects([](OdometryOptions* o) { o->back_end.max_correction_m = 0.0; }, "max_correction");
   rejects([](OdometryOptions* o) { o->orientation_sample_step_px = 0; }, "orientation_sample");
   rejects([](OdometryOptions* o) { o->matcher.type = MatcherType::kSiftRatio; }, "kSift");
   rejects([](OdometryOptions* o) { o->detector.max_features = -1; }, "detector");
   rejects([](OdometryOptions* o) { o->ransac.confidence = 1.0; }, "ransac");
-  rejects([](OdometryOptions* o) { o->ba.num_fixed_poses = 0; }, "ba");
-  rejects([](OdometryOptions* o) { o->ba.num_fixed_poses = 5; }, "num_fixed_poses");
+  rejects([](OdometryOptions* o) { o->back_end.ba.num_fixed_poses = 0; }, "ba");
+  rejects([](OdometryOptions* o) { o->back_end.ba.num_fixed_poses = 5; }, "num_fixed_poses");
   rejects([](OdometryOptions* o) { o->disparity.algorithm = DisparityAlgorithm::kBlockMatching; },
           "disparity_mode at_features needs disparity.algorithm block_matching_one_volume");
   rejects([](OdometryOptions* o) { o->disparity_range_margin = -0.1; }, "disparity_range_margin");

@@ -16,46 +16,15 @@ namespace {
 
 using test::TestCamera;
 
+using test::ForwardFrameFeatures;
+using test::OneToOneMatches;
+
 // Camera i: 0.1 m forward per frame along the optical axis.
-Eigen::Isometry3d TruePose(int i) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = Eigen::Vector3d(0.0, 0.0, 0.1 * i);
-  return T;
-}
+Eigen::Isometry3d TruePose(int i) { return test::ForwardPose(i); }
 
-// A fixed cloud of points 3-8 m ahead, seen by every frame.
-std::vector<Eigen::Vector3d> WorldPoints() {
-  std::vector<Eigen::Vector3d> points;
-  SplitMix64 rng(3);
-  for (int k = 0; k < 60; ++k) {
-    points.emplace_back(-1.5 + 3.0 * rng.Uniform(), -1.0 + 2.0 * rng.Uniform(),
-                        3.0 + 5.0 * rng.Uniform());
-  }
-  return points;
-}
-
-// Exact stereo features of frame i (feature k = point k).
+// Exact stereo features of frame i (feature k = point k of a fixed cloud 3-8 m ahead).
 std::vector<Feature> FeaturesOf(int i, const StereoCamera& cam) {
-  std::vector<Feature> features;
-  for (const Eigen::Vector3d& p_world : WorldPoints()) {
-    Feature f;
-    f.p_cam0 = TruePose(i).inverse() * p_world;
-    EXPECT_TRUE(cam.ProjectLeft(f.p_cam0, &f.uv_px));
-    f.disparity_px = cam.DisparityFromDepth(f.p_cam0.z());
-    features.push_back(f);
-  }
-  return features;
-}
-
-std::vector<Match> Identity(size_t n) {
-  std::vector<Match> matches;
-  for (size_t k = 0; k < n; ++k) {
-    Match m;
-    m.prev = static_cast<int>(k);
-    m.curr = static_cast<int>(k);
-    matches.push_back(m);
-  }
-  return matches;
+  return ForwardFrameFeatures(i, cam);
 }
 
 SlidingWindowOptions Options() {
@@ -75,7 +44,7 @@ SlidingWindow Window(const StereoCamera& cam, const Eigen::Vector3d& offset,
     std::vector<Feature> f = FeaturesOf(i, cam);
     Eigen::Isometry3d initial = TruePose(i);
     if (i == 3) initial.translation() += offset;
-    EXPECT_TRUE(w.Add(i, &f, Identity(f.size()), initial).ok()) << "frame " << i;
+    EXPECT_TRUE(w.Add(i, &f, OneToOneMatches(f.size()), initial).ok()) << "frame " << i;
   }
   return w;
 }

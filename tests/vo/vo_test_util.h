@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <vector>
 
 #include "vo/camera.h"
 #include "vo/ransac.h"
@@ -60,6 +61,39 @@ inline Feature FeatureAt(const StereoCamera& camera, const Eigen::Vector3d& p) {
   f.disparity_px = camera.DisparityFromDepth(p.z());
   f.p_cam0 = p;
   return f;
+}
+
+// A window's sequence (sliding_window_test, back_end_test): camera i 0.1 m forward per frame
+// along the optical axis.
+inline Eigen::Isometry3d ForwardPose(int i) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(0.0, 0.0, 0.1 * i);
+  return T;
+}
+
+// Exact stereo features of that sequence's frame i: a fixed cloud of 60 points 3-8 m ahead,
+// seen by every frame (feature k = point k).
+inline std::vector<Feature> ForwardFrameFeatures(int i, const StereoCamera& camera) {
+  std::vector<Feature> features;
+  SplitMix64 rng(3);
+  for (int k = 0; k < 60; ++k) {
+    const Eigen::Vector3d p_world(-1.5 + 3.0 * rng.Uniform(), -1.0 + 2.0 * rng.Uniform(),
+                                  3.0 + 5.0 * rng.Uniform());
+    features.push_back(FeatureAt(camera, ForwardPose(i).inverse() * p_world));
+  }
+  return features;
+}
+
+// Matches k -> k for n features.
+inline std::vector<Match> OneToOneMatches(size_t n) {
+  std::vector<Match> matches;
+  for (size_t k = 0; k < n; ++k) {
+    Match m;
+    m.prev = static_cast<int>(k);
+    m.curr = static_cast<int>(k);
+    matches.push_back(m);
+  }
+  return matches;
 }
 
 }  // namespace test
