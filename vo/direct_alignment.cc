@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "vo/bilinear.h"
 #include "vo/prior_motion.h"
 
 namespace vo {
@@ -83,14 +84,7 @@ std::vector<Level> Pyramid(const cv::Mat& image8, const StereoCamera& camera, in
 // Bilinear sample of a CV_32F image; false outside [0, size − 1).
 bool Sample(const cv::Mat& m, double x, double y, double* value) {
   if (!(x >= 0.0 && y >= 0.0 && x < m.cols - 1.0 && y < m.rows - 1.0)) return false;
-  const int x0 = static_cast<int>(x);
-  const int y0 = static_cast<int>(y);
-  const double ax = x - x0;
-  const double ay = y - y0;
-  const float* r0 = m.ptr<float>(y0);
-  const float* r1 = m.ptr<float>(y0 + 1);
-  *value = (1.0 - ay) * ((1.0 - ax) * r0[x0] + ax * r0[x0 + 1]) +
-           ay * ((1.0 - ax) * r1[x0] + ax * r1[x0 + 1]);
+  *value = Bilinear(m, x, y);
   return true;
 }
 

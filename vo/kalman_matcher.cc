@@ -4,15 +4,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 namespace vo {
 namespace {
-
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Mean Sobel gradient (grey levels / pixel) over a window x window neighbourhood of the
 // nearest pixel; pixels outside the image are clamped to the border.
@@ -43,10 +37,8 @@ Eigen::Vector2f MeanGradient(const cv::Mat& image, const Eigen::Vector2d& uv, in
 KalmanMatcher::KalmanMatcher(const Options& options, const NccOptions& ncc)
     : options_(options), ncc_(ncc) {
   std::string error;
-  if (!options_.IsValid(&error) || !ncc_.IsValid(&error)) {
-    std::fprintf(stderr, "vo::KalmanMatcher: invalid options: %s\n", error.c_str());
-    std::abort();
-  }
+  const bool valid = options_.IsValid(&error) && ncc_.IsValid(&error);
+  AbortUnlessValid("KalmanMatcher", valid, error);
 }
 
 void KalmanMatcher::Reset() {
@@ -101,10 +93,8 @@ const std::vector<Eigen::Vector2f>& KalmanMatcher::Gradients(const MatchFrame& f
 std::vector<Match> KalmanMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
                                           const MatchPrediction& prediction,
                                           MatcherSummary* summary) {
-  MatcherSummary local;
-  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
-  if (prev.image.empty() || curr.image.empty() || prev.image.type() != CV_8UC1 ||
-      curr.image.type() != CV_8UC1) {
+  MatcherSummary& s = *summary;
+  if (!BothGreyImages(prev, curr)) {
     s.ok = false;
     s.message = "KalmanMatcher: needs CV_8UC1 images in both frames";
     Reset();

@@ -52,6 +52,8 @@ class KalmanMatcher : public FrameMatcher {
  protected:
   std::vector<Match> DoMatch(const MatchFrame& prev, const MatchFrame& curr,
                              const MatchPrediction& prediction, MatcherSummary* summary) override;
+  // Its tracks live across frames: it sees every frame, one without features included.
+  bool SeesEveryFrame() const override { return true; }
 
  private:
   struct Track {

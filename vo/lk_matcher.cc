@@ -2,25 +2,14 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <opencv2/video/tracking.hpp>
 
 namespace vo {
-namespace {
-
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
 
 LucasKanadeMatcher::LucasKanadeMatcher(const Options& options) : options_(options) {
   std::string error;
-  if (!options_.IsValid(&error)) {
-    std::fprintf(stderr, "vo::LucasKanadeMatcher: invalid options: %s\n", error.c_str());
-    std::abort();
-  }
+  const bool valid = options_.IsValid(&error);
+  AbortUnlessValid("LucasKanadeMatcher", valid, error);
 }
 
 const std::vector<cv::Mat>& LucasKanadeMatcher::Pyramid(const MatchFrame& frame) const {
@@ -40,11 +29,8 @@ const std::vector<cv::Mat>& LucasKanadeMatcher::Pyramid(const MatchFrame& frame)
 std::vector<Match> LucasKanadeMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
                                                const MatchPrediction& prediction,
                                                MatcherSummary* summary) {
-  MatcherSummary local;
-  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
-  if (s.num_prev == 0 || s.num_curr == 0) return {};
-  if (prev.image.empty() || curr.image.empty() || prev.image.type() != CV_8UC1 ||
-      curr.image.type() != CV_8UC1 || prev.image.size() != curr.image.size()) {
+  MatcherSummary& s = *summary;
+  if (!BothGreyImages(prev, curr) || prev.image.size() != curr.image.size()) {
     s.ok = false;
     s.message = "LucasKanadeMatcher: needs CV_8UC1 images of the same size in both frames";
     return {};

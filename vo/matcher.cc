@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <numeric>
 #include <sstream>
 
@@ -397,13 +399,19 @@ bool IsOneToOne(const std::vector<Match>& matches) {
          std::adjacent_find(curr.begin(), curr.end()) == curr.end();
 }
 
-MatcherSummary& StartSummary(const MatchFrame& prev, const MatchFrame& curr,
-                             MatcherSummary* summary, MatcherSummary* local) {
-  MatcherSummary& s = summary != nullptr ? *summary : *local;
-  s = MatcherSummary();
-  s.num_prev = static_cast<int>(prev.features.size());
-  s.num_curr = static_cast<int>(curr.features.size());
-  return s;
+bool BothGreyImages(const MatchFrame& prev, const MatchFrame& curr) {
+  return !prev.image.empty() && !curr.image.empty() && prev.image.type() == CV_8UC1 &&
+         curr.image.type() == CV_8UC1;
+}
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void AbortUnlessValid(const char* matcher, bool valid, const std::string& error) {
+  if (valid) return;
+  std::fprintf(stderr, "vo::%s: invalid options: %s\n", matcher, error.c_str());
+  std::abort();
 }
 
 std::vector<Match> FrameMatcher::MatchFrames(const MatchFrame& prev, const MatchFrame& curr,
@@ -411,10 +419,12 @@ std::vector<Match> FrameMatcher::MatchFrames(const MatchFrame& prev, const Match
                                              MatcherSummary* summary) {
   MatcherSummary local;
   MatcherSummary* s = summary != nullptr ? summary : &local;
+  *s = MatcherSummary();
+  s->num_prev = static_cast<int>(prev.features.size());
+  s->num_curr = static_cast<int>(curr.features.size());
   const bool size_ok = prediction.uv_px.empty() || prediction.uv_px.size() == prev.features.size();
   const bool scale_ok = prediction.radius_scale >= 0.05 && prediction.radius_scale <= 20.0;
   if (!size_ok || !scale_ok) {
-    StartSummary(prev, curr, s, &local);
     s->ok = false;
     std::ostringstream msg;
     if (!size_ok) {
@@ -426,6 +436,7 @@ std::vector<Match> FrameMatcher::MatchFrames(const MatchFrame& prev, const Match
     s->message = msg.str();
     return {};
   }
+  if ((s->num_prev == 0 || s->num_curr == 0) && !SeesEveryFrame()) return {};
   return DoMatch(prev, curr, prediction, s);
 }
 

@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -173,10 +174,14 @@ class FrameMatcher {
 
  protected:
   // The matcher itself; `prediction` is checked (empty or one finite-or-not entry per
-  // previous feature, radius_scale in range) and `summary` is never null.
+  // previous feature, radius_scale in range) and `summary` is never null, reset, with the
+  // frames' feature counts set. Called only when both frames have features, unless
+  // SeesEveryFrame().
   virtual std::vector<Match> DoMatch(const MatchFrame& prev, const MatchFrame& curr,
                                      const MatchPrediction& prediction,
                                      MatcherSummary* summary) = 0;
+  // True for a matcher with state across frames that must see a frame without features too.
+  virtual bool SeesEveryFrame() const { return false; }
 };
 
 // ---- Options of every matcher -------------------------------------------------------------
@@ -390,12 +395,17 @@ struct CandidatePair {
 std::vector<Match> GreedyOneToOne(std::vector<CandidatePair> candidates,
                                   const std::function<double(double)>& score_of);
 
-// The summary a MatchFrames() call fills: *summary, or *local when summary is null; reset,
-// with the frames' feature counts set.
-MatcherSummary& StartSummary(const MatchFrame& prev, const MatchFrame& curr,
-                             MatcherSummary* summary, MatcherSummary* local);
+// True when both frames hold a non-empty CV_8UC1 image (what the image-based matchers need).
+bool BothGreyImages(const MatchFrame& prev, const MatchFrame& curr);
 
 // True when no prev index and no curr index appears twice.
 bool IsOneToOne(const std::vector<Match>& matches);
+
+// Wall-clock milliseconds since t0 (a MatcherSummary's cue_time_ms and match_time_ms).
+double MsSince(std::chrono::steady_clock::time_point t0);
+
+// A matcher's constructor check: unless `valid`, prints "vo::<matcher>: invalid options:
+// <error>" and aborts (options reach a matcher checked; bad ones here are a programming error).
+void AbortUnlessValid(const char* matcher, bool valid, const std::string& error);
 
 }  // namespace vo

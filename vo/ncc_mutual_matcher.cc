@@ -1,35 +1,21 @@
 #include "vo/ncc_mutual_matcher.h"
 
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 
 namespace vo {
-namespace {
-
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
 
 NccMutualMatcher::NccMutualMatcher(const Options& options, const NccOptions& ncc)
     : options_(options), ncc_(ncc) {
   std::string error;
-  if (!options_.IsValid(&error) || !ncc_.IsValid(&error)) {
-    std::fprintf(stderr, "vo::NccMutualMatcher: invalid options: %s\n", error.c_str());
-    std::abort();
-  }
+  const bool valid = options_.IsValid(&error) && ncc_.IsValid(&error);
+  AbortUnlessValid("NccMutualMatcher", valid, error);
 }
 
 std::vector<Match> NccMutualMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
                                              const MatchPrediction& prediction,
                                              MatcherSummary* summary) {
-  MatcherSummary local;
-  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
-  if (s.num_prev == 0 || s.num_curr == 0) return {};
-  if (prev.image.empty() || curr.image.empty() || prev.image.type() != CV_8UC1 ||
-      curr.image.type() != CV_8UC1) {
+  MatcherSummary& s = *summary;
+  if (!BothGreyImages(prev, curr)) {
     s.ok = false;
     s.message = "NccMutualMatcher: needs CV_8UC1 images in both frames";
     return {};

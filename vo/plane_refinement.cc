@@ -6,6 +6,8 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "vo/bilinear.h"
+
 namespace vo {
 
 bool PlaneRefinementOptions::IsValid(std::string* error) const {
@@ -61,19 +63,6 @@ namespace {
 // (grey levels per pixel)²: a region whose matched right-image pixels have a smaller mean squared
 // horizontal gradient cannot fix the disparity (a flat or saturated area).
 constexpr double kMinMeanSquaredGradient = 0.01;
-
-// Bilinear sample of a CV_32F image at (x, y); the caller keeps (x, y) inside [0, cols−1) ×
-// [0, rows−1).
-inline double Bilinear(const cv::Mat& img, double x, double y) {
-  const int x0 = static_cast<int>(x);
-  const int y0 = static_cast<int>(y);
-  const double fx = x - x0;
-  const double fy = y - y0;
-  const float* r0 = img.ptr<float>(y0);
-  const float* r1 = img.ptr<float>(y0 + 1);
-  return (1.0 - fy) * ((1.0 - fx) * r0[x0] + fx * r0[x0 + 1]) +
-         fy * ((1.0 - fx) * r1[x0] + fx * r1[x0 + 1]);
-}
 
 double Median(std::vector<double>* v) {
   auto mid = v->begin() + static_cast<std::ptrdiff_t>(v->size() / 2);

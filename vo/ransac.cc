@@ -189,50 +189,52 @@ bool StereoResiduals(double fx, double fy, double cx, double cy, double b,
   return true;
 }
 
-// Current-frame residual of a fixed previous-frame point under T_curr_prev.
-// Parameters: q_curr_prev (Eigen order x, y, z, w), t_curr_prev.
-struct FixedPointCost {
-  FixedPointCost(const StereoCamera& cam, const StereoCorrespondence& c) : cam(cam), c(c) {}
+// What each cost below holds: the camera and the correspondence it measures.
+struct CorrespondenceCost {
+  CorrespondenceCost(const StereoCamera& cam, const StereoCorrespondence& c) : cam(cam), c(c) {}
+  // Current-frame residual of the previous-frame point p_prev moved by T_curr_prev = (q, t),
+  // q_curr_prev in Eigen order x, y, z, w.
   template <typename T>
-  bool operator()(const T* q_xyzw, const T* t, T* residual) const {
+  bool CurrResiduals(const T* q_xyzw, const T* t, const Eigen::Matrix<T, 3, 1>& p_prev,
+                     T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q(q_xyzw);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> tr(t);
-    const Eigen::Matrix<T, 3, 1> p = q * c.p_prev_cam0.cast<T>() + tr;  // p_curr
+    const Eigen::Matrix<T, 3, 1> p = q * p_prev + tr;  // p_curr
     return StereoResiduals(cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px, cam.baseline_m, p,
                            c.uv_curr_px, c.disparity_curr_px, residual);
   }
   StereoCamera cam;
   StereoCorrespondence c;
+};
+
+// Current-frame residual of a fixed previous-frame point under T_curr_prev.
+// Parameters: q_curr_prev (Eigen order x, y, z, w), t_curr_prev.
+struct FixedPointCost : CorrespondenceCost {
+  using CorrespondenceCost::CorrespondenceCost;
+  template <typename T>
+  bool operator()(const T* q_xyzw, const T* t, T* residual) const {
+    return CurrResiduals(q_xyzw, t, Eigen::Matrix<T, 3, 1>(c.p_prev_cam0.cast<T>()), residual);
+  }
 };
 
 // Current-frame residual of a free previous-frame point: parameters q, t, p_prev.
-struct FreePointCurrCost {
-  FreePointCurrCost(const StereoCamera& cam, const StereoCorrespondence& c) : cam(cam), c(c) {}
+struct FreePointCurrCost : CorrespondenceCost {
+  using CorrespondenceCost::CorrespondenceCost;
   template <typename T>
   bool operator()(const T* q_xyzw, const T* t, const T* p_prev, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q(q_xyzw);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> tr(t);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pp(p_prev);
-    const Eigen::Matrix<T, 3, 1> p = q * pp + tr;
-    return StereoResiduals(cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px, cam.baseline_m, p,
-                           c.uv_curr_px, c.disparity_curr_px, residual);
+    return CurrResiduals(q_xyzw, t, Eigen::Matrix<T, 3, 1>(p_prev), residual);
   }
-  StereoCamera cam;
-  StereoCorrespondence c;
 };
 
 // Previous-frame residual of a free point (its own observation): parameter p_prev.
-struct FreePointPrevCost {
-  FreePointPrevCost(const StereoCamera& cam, const StereoCorrespondence& c) : cam(cam), c(c) {}
+struct FreePointPrevCost : CorrespondenceCost {
+  using CorrespondenceCost::CorrespondenceCost;
   template <typename T>
   bool operator()(const T* p_prev, T* residual) const {
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pp(p_prev);
-    const Eigen::Matrix<T, 3, 1> p = pp;
+    const Eigen::Matrix<T, 3, 1> p = Eigen::Map<const Eigen::Matrix<T, 3, 1>>(p_prev);
     return StereoResiduals(cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px, cam.baseline_m, p,
                            c.uv_prev_px, c.disparity_prev_px, residual);
   }
-  StereoCamera cam;
-  StereoCorrespondence c;
 };
 
 // Reprojection residuals of fixed previous-frame points for ceres::TinySolver: 4 per

@@ -10,6 +10,7 @@
 #endif
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
+
 #define VO_SAD_HAVE_AVX2 1
 #else
 #define VO_SAD_HAVE_AVX2 0
@@ -62,6 +63,14 @@ void PrefilterXSobelPadded(const cv::Mat& src, int cap, int pad_left, int half, 
 
 inline uint8_t AbsDiff(uint8_t a, uint8_t b) { return a > b ? a - b : b - a; }
 
+#ifdef __SSE2__
+// |v - r[i]| for the 16 bytes at r, each byte on its own (one saturating difference is zero).
+inline __m128i AbsDiff16(__m128i v, const uint8_t* r) {
+  const __m128i rv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r));
+  return _mm_or_si128(_mm_subs_epu8(v, rv), _mm_subs_epu8(rv, v));
+}
+#endif
+
 // The inner loops run over the disparity index k (n = num_disparities, a multiple of 16).
 // SSE2 (every x86-64) versions with portable scalar fallbacks that compute the same values.
 
@@ -73,10 +82,8 @@ inline void UpdateColumn(int16_t* colsum, uint8_t a_add, const uint8_t* r_add, u
   const __m128i va = _mm_set1_epi8(static_cast<char>(a_add));
   const __m128i vs = _mm_set1_epi8(static_cast<char>(a_sub));
   for (int k = 0; k < n; k += 16) {
-    const __m128i ra = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r_add + k));
-    const __m128i rs = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r_sub + k));
-    const __m128i da = _mm_or_si128(_mm_subs_epu8(va, ra), _mm_subs_epu8(ra, va));
-    const __m128i ds = _mm_or_si128(_mm_subs_epu8(vs, rs), _mm_subs_epu8(rs, vs));
+    const __m128i da = AbsDiff16(va, r_add + k);
+    const __m128i ds = AbsDiff16(vs, r_sub + k);
     __m128i* c = reinterpret_cast<__m128i*>(colsum + k);
     __m128i lo = _mm_loadu_si128(c), hi = _mm_loadu_si128(c + 1);
     lo = _mm_sub_epi16(_mm_add_epi16(lo, _mm_unpacklo_epi8(da, zero)), _mm_unpacklo_epi8(ds, zero));
@@ -98,8 +105,7 @@ inline void AddColumn(int16_t* colsum, uint8_t a, const uint8_t* r, int n) {
   const __m128i zero = _mm_setzero_si128();
   const __m128i va = _mm_set1_epi8(static_cast<char>(a));
   for (int k = 0; k < n; k += 16) {
-    const __m128i rv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r + k));
-    const __m128i d = _mm_or_si128(_mm_subs_epu8(va, rv), _mm_subs_epu8(rv, va));
+    const __m128i d = AbsDiff16(va, r + k);
     __m128i* c = reinterpret_cast<__m128i*>(colsum + k);
     _mm_storeu_si128(c, _mm_add_epi16(_mm_loadu_si128(c), _mm_unpacklo_epi8(d, zero)));
     _mm_storeu_si128(c + 1, _mm_add_epi16(_mm_loadu_si128(c + 1), _mm_unpackhi_epi8(d, zero)));
@@ -504,8 +510,7 @@ struct KernelsAvx2 {
   VO_AVX2 static void AddColumn(int16_t* colsum, uint8_t a, const uint8_t* r, int n) {
     const __m128i va = _mm_set1_epi8(static_cast<char>(a));
     for (int k = 0; k < n; k += 16) {
-      const __m128i rv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r + k));
-      const __m128i d = _mm_or_si128(_mm_subs_epu8(va, rv), _mm_subs_epu8(rv, va));
+      const __m128i d = AbsDiff16(va, r + k);
       __m256i* p = reinterpret_cast<__m256i*>(colsum + k);
       _mm256_storeu_si256(p, _mm256_add_epi16(_mm256_loadu_si256(p), _mm256_cvtepu8_epi16(d)));
     }
@@ -515,10 +520,8 @@ struct KernelsAvx2 {
     const __m128i va = _mm_set1_epi8(static_cast<char>(a_add));
     const __m128i vs = _mm_set1_epi8(static_cast<char>(a_sub));
     for (int k = 0; k < n; k += 16) {
-      const __m128i ra = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r_add + k));
-      const __m128i rs = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r_sub + k));
-      const __m128i da = _mm_or_si128(_mm_subs_epu8(va, ra), _mm_subs_epu8(ra, va));
-      const __m128i ds = _mm_or_si128(_mm_subs_epu8(vs, rs), _mm_subs_epu8(rs, vs));
+      const __m128i da = AbsDiff16(va, r_add + k);
+      const __m128i ds = AbsDiff16(vs, r_sub + k);
       __m256i* p = reinterpret_cast<__m256i*>(colsum + k);
       const __m256i sum =
           _mm256_sub_epi16(_mm256_add_epi16(_mm256_loadu_si256(p), _mm256_cvtepu8_epi16(da)),
@@ -539,8 +542,7 @@ struct KernelsAvx2 {
         const __m128i va = _mm_set1_epi8(static_cast<char>(a[i]));
         const uint8_t* bp = row + i * b_step;
         for (int b = 0; b < kBlocks; ++b) {
-          const __m128i rv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bp + 16 * b));
-          const __m128i d = _mm_or_si128(_mm_subs_epu8(va, rv), _mm_subs_epu8(rv, va));
+          const __m128i d = AbsDiff16(va, bp + 16 * b);
           acc[b] = _mm256_add_epi16(acc[b], _mm256_cvtepu8_epi16(d));
         }
       }

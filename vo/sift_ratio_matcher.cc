@@ -2,18 +2,12 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 namespace vo {
 namespace {
 
 constexpr int kLanes = 8;  // lane-wise partial sums: vectorisable without reassociation
-
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Squared L2 distance between two float rows of length n.
 float SquaredDistance(const float* a, const float* b, int n) {
@@ -55,18 +49,14 @@ bool DescriptorsUsable(const MatchFrame& f) {
 
 SiftRatioMatcher::SiftRatioMatcher(const Options& options) : options_(options) {
   std::string error;
-  if (!options_.IsValid(&error)) {
-    std::fprintf(stderr, "vo::SiftRatioMatcher: invalid options: %s\n", error.c_str());
-    std::abort();
-  }
+  const bool valid = options_.IsValid(&error);
+  AbortUnlessValid("SiftRatioMatcher", valid, error);
 }
 
 std::vector<Match> SiftRatioMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
                                              const MatchPrediction& prediction,
                                              MatcherSummary* summary) {
-  MatcherSummary local;
-  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
-  if (s.num_prev == 0 || s.num_curr == 0) return {};
+  MatcherSummary& s = *summary;
   if (!DescriptorsUsable(prev) || !DescriptorsUsable(curr) ||
       prev.descriptors.cols != curr.descriptors.cols) {
     s.ok = false;

@@ -15,10 +15,6 @@ namespace {
 // The guard's first bound when min_entry is 0 (a multiplicative raise needs a start).
 constexpr double kGuardStartEntry = 1e-4;
 
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // Eigenvalues of the Gram matrix below this fraction of the largest (singular values below
 // 1e-6 of the largest) count as zero. Above it the eigenvectors are accurate to ~1e-4 (double
 // precision over the squared condition number), far below what moves a row/column maximum.
@@ -248,10 +244,9 @@ SvdMatcher::SvdMatcher(const Options& options, Cues cues, const NccOptions& ncc,
                        const GaborOptions& gabor)
     : options_(options), cues_(cues), ncc_(ncc) {
   std::string error;
-  if (!options_.IsValid(&error) || (cues_ != Cues::kProximity && !ncc_.IsValid(&error))) {
-    std::fprintf(stderr, "vo::SvdMatcher: invalid options: %s\n", error.c_str());
-    std::abort();
-  }
+  const bool valid =
+      options_.IsValid(&error) && (cues_ == Cues::kProximity || ncc_.IsValid(&error));
+  AbortUnlessValid("SvdMatcher", valid, error);
   if (cues_ == Cues::kProximityNccGabor) bank_ = std::make_unique<GaborBank>(gabor);
 }
 
@@ -269,9 +264,7 @@ MatcherType SvdMatcher::type() const {
 
 std::vector<Match> SvdMatcher::DoMatch(const MatchFrame& prev, const MatchFrame& curr,
                                        const MatchPrediction& prediction, MatcherSummary* summary) {
-  MatcherSummary local;
-  MatcherSummary& s = StartSummary(prev, curr, summary, &local);
-  if (s.num_prev == 0 || s.num_curr == 0) return {};
+  MatcherSummary& s = *summary;
   const bool use_ncc = cues_ != Cues::kProximity;
   const bool use_gabor = cues_ == Cues::kProximityNccGabor;
   if (use_ncc && (prev.image.empty() || curr.image.empty() || prev.image.type() != CV_8UC1 ||
