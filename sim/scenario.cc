@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sim/data_dir.h"
+#include "sim/floor_plan.h"
 #include "sim/scene_walls.h"
 #include "sim/yaml_input.h"
 
@@ -257,12 +258,23 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   constexpr int kIntMax = std::numeric_limits<int>::max();
   r.CheckKeys(root, "",
               {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
-               "robot", "scene", "seed", "settle_s", "textures", "imu"});
+               "robot", "scene", "floor_plan", "seed", "settle_s", "textures", "imu"});
   r.String(root, "", "name", &s.name);
-  std::string scene;
+  // The scene: an MJCF file, or a floor plan it is generated from (sim/floor_plan.h).
+  std::string scene, floor_plan;
   r.String(root, "", "scene", &scene);
-  r.Check(!scene.empty(), root, "", "scene",
-          "required: the MJCF scene file (relative to the scenario file)");
+  r.String(root, "", "floor_plan", &floor_plan);
+  r.Check(scene.empty() || floor_plan.empty(), root, "", "floor_plan",
+          "give scene (an MJCF file) or floor_plan (a floor-plan YAML), not both");
+  r.Check(!scene.empty() || !floor_plan.empty(), root, "", "scene",
+          "required: the MJCF scene file, or floor_plan: a floor-plan YAML (relative to the "
+          "scenario file)");
+  r.Check(scene.empty() || !IsFloorPlanPath(scene), root, "", "scene",
+          "'" + scene + "' is a YAML file: a floor plan is given as floor_plan:");
+  r.Check(floor_plan.empty() || IsFloorPlanPath(floor_plan), root, "", "floor_plan",
+          "expected a .yaml or .yml floor plan, got '" + floor_plan + "'");
+  const std::string scene_key = floor_plan.empty() ? "scene" : "floor_plan";
+  if (!floor_plan.empty()) scene = floor_plan;
   r.Uint64(root, "", "seed", &s.seed);
   r.Double(root, "", "rate_hz", &s.rate_hz);
   r.Double(root, "", "physics_dt_s", &s.physics_dt_s);
@@ -403,7 +415,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   if (scene_path.is_relative()) scene_path = fs::path(base_dir) / scene_path;
   s.scene_path = scene_path.lexically_normal().string();
   if (!fs::exists(s.scene_path)) {
-    if (error) *error = source_name + ": key 'scene': file not found: " + s.scene_path;
+    if (error) *error = source_name + ": key '" + scene_key + "': file not found: " + s.scene_path;
     return false;
   }
   if (s.name.empty()) s.name = fs::path(source_name).stem().string();
@@ -448,7 +460,8 @@ std::string ScenarioToYaml(const Scenario& s) {
   out.SetDoublePrecision(17);
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << s.name;
-  out << YAML::Key << "scene" << YAML::Value << s.scene_path;
+  out << YAML::Key << (IsFloorPlanPath(s.scene_path) ? "floor_plan" : "scene") << YAML::Value
+      << s.scene_path;
   out << YAML::Key << "seed" << YAML::Value << s.seed;
   out << YAML::Key << "rate_hz" << YAML::Value << s.rate_hz;
   out << YAML::Key << "physics_dt_s" << YAML::Value << s.physics_dt_s;

@@ -83,7 +83,8 @@ struct ImuOptions {
 struct Scenario {
   std::string name;             // scenario name (file stem unless given)
   std::string source_path;      // the YAML file it was read from (empty if built in code)
-  std::string scene_path;       // MJCF scene, resolved to an absolute path
+  std::string scene_path;       // MJCF scene, or a floor plan (.yaml, sim/floor_plan.h) the
+                                // scene is generated from; resolved to an absolute path
   uint64_t seed = 1;            // noise seed
   double rate_hz = 10.0;        // camera frame rate (Hz), > 0, at most 1 / physics_dt_s, and
                                 // the frame period a whole number of physics steps (frames are

@@ -8,6 +8,8 @@
 #include <limits>
 #include <sstream>
 
+#include "sim/floor_plan.h"
+
 namespace sim {
 namespace {
 
@@ -74,12 +76,8 @@ void WallsOfModel(const mjModel* m, std::vector<SceneWall>* walls,
 
 bool WallsOfScene(const std::string& scene_path, std::vector<SceneWall>* walls, std::string* error,
                   std::vector<SceneFloor>* floors) {
-  char load_error[1024] = "";
-  mjModel* m = mj_loadXML(scene_path.c_str(), nullptr, load_error, sizeof(load_error));
-  if (!m) {
-    *error = scene_path + ": cannot load MJCF scene: " + load_error;
-    return false;
-  }
+  mjModel* m = LoadSceneModel(scene_path, error);  // MJCF or a floor plan
+  if (!m) return false;
   WallsOfModel(m, walls, floors);
   mj_deleteModel(m);
   return true;
