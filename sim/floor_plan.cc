@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <queue>
 #include <set>
 #include <sstream>
 
@@ -815,6 +816,158 @@ std::string FloorPlanToMjcf(const FloorPlan& plan, const std::string& robot_incl
   }
   x << "  </worldbody>\n</mujoco>\n";
   return x.str();
+}
+
+namespace {
+
+// The plan's obstacles for a path (vertical surfaces reaching below 1.5 m) and its free area.
+struct FreeSpace {
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> obstacles;
+  std::vector<std::vector<Eigen::Vector2d>> areas;  // spaces and door passages
+  double clearance_m = 0.0;
+
+  explicit FreeSpace(const FloorPlan& plan, double clearance) : clearance_m(clearance) {
+    for (const PlanSurface& s : PlanSurfaces(plan)) {
+      if (std::abs(s.y_axis.z()) < 0.5 || s.centre.z() - s.half_height_m > 1.5) continue;
+      const Eigen::Vector2d c = s.centre.head<2>(), x = s.x_axis.head<2>();
+      obstacles.emplace_back(c - s.half_width_m * x, c + s.half_width_m * x);
+    }
+    for (const PlanSpace& sp : plan.spaces) areas.push_back(sp.polygon);
+    for (const PlanDoor& d : plan.doors) {  // the passage between the two walls
+      const auto& poly = plan.spaces[d.space[0]].polygon;
+      const Eigen::Vector2d a = poly[d.edge[0]];
+      const Eigen::Vector2d dir = (poly[(d.edge[0] + 1) % poly.size()] - a).normalized();
+      const Eigen::Vector2d out = -LeftNormal(dir) * d.depth_m;
+      const Eigen::Vector2d p0 = a + d.from_m[0] * dir, p1 = a + d.to_m[0] * dir;
+      if (d.depth_m > kEps) areas.push_back({p0, p0 + out, p1 + out, p1});
+    }
+  }
+  bool Inside(const Eigen::Vector2d& p) const {
+    for (const auto& a : areas)
+      if (InsidePolygon(a, p)) return true;
+    return false;
+  }
+  bool Free(const Eigen::Vector2d& p) const {
+    for (const auto& [a, b] : obstacles)
+      if (PointSegmentDistance(p, a, b) < clearance_m) return false;
+    return Inside(p);
+  }
+  // The straight segment keeps the clearance (exactly) and stays inside (every 2 cm).
+  bool Clear(const Eigen::Vector2d& p, const Eigen::Vector2d& q) const {
+    for (const auto& [a, b] : obstacles) {
+      const bool cross = SegmentsCrossProperly(p, q, a, b);
+      const double d = std::min({PointSegmentDistance(p, a, b), PointSegmentDistance(q, a, b),
+                                 PointSegmentDistance(a, p, q), PointSegmentDistance(b, p, q)});
+      if (cross || d < clearance_m) return false;
+    }
+    const int n = std::max(1, static_cast<int>(std::ceil((q - p).norm() / 0.02)));
+    for (int k = 0; k <= n; ++k)
+      if (!Inside(p + (q - p) * (static_cast<double>(k) / n))) return false;
+    return true;
+  }
+};
+
+}  // namespace
+
+bool PlanPath(const FloorPlan& plan, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+              double clearance_m, std::vector<Eigen::Vector2d>* path, std::string* error,
+              double cell_m) {
+  const FreeSpace free(plan, clearance_m);
+  const Eigen::Vector2d ends[2] = {from, to};
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::Vector2d& p = ends[k];
+    if (!free.Free(p)) {
+      *error = std::string("the ") + (k == 0 ? "start" : "goal") + " " + Pt(p) +
+               " is not in free space (inside the " + "building and " + Num(clearance_m) +
+               " m from every wall and box)";
+      return false;
+    }
+  }
+  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  for (const auto& a : free.areas)
+    for (const auto& q : a) {
+      lo = lo.cwiseMin(q);
+      hi = hi.cwiseMax(q);
+    }
+  const int nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / cell_m)) + 1;
+  const int ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / cell_m)) + 1;
+  auto centre = [&](int i) -> Eigen::Vector2d {
+    return lo + cell_m * Eigen::Vector2d(i % nx, i / nx);
+  };
+  auto cell_of = [&](const Eigen::Vector2d& p) {
+    const int cx = std::clamp(static_cast<int>(std::lround((p.x() - lo.x()) / cell_m)), 0, nx - 1);
+    const int cy = std::clamp(static_cast<int>(std::lround((p.y() - lo.y()) / cell_m)), 0, ny - 1);
+    return cy * nx + cx;
+  };
+  std::vector<signed char> is_free(static_cast<size_t>(nx) * ny, -1);  // -1: not yet known
+  auto cell_free = [&](int i) {
+    if (is_free[i] < 0) is_free[i] = free.Free(centre(i)) ? 1 : 0;
+    return is_free[i] == 1;
+  };
+  const int start = cell_of(from), goal = cell_of(to);
+  // The ends join the grid at their nearest cells; those must be reachable in a straight line.
+  if (!cell_free(start) || !cell_free(goal) || !free.Clear(from, centre(start)) ||
+      !free.Clear(centre(goal), to)) {
+    *error =
+        "the start or the goal is too close to a wall for the planner's " + Num(cell_m) + " m grid";
+    return false;
+  }
+  // A*, ties broken by the cell index (deterministic).
+  std::vector<double> g(is_free.size(), std::numeric_limits<double>::infinity());
+  std::vector<int> parent(is_free.size(), -1);
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  g[start] = 0;
+  open.push({(centre(start) - centre(goal)).norm(), start});
+  while (!open.empty()) {
+    const auto [f, i] = open.top();
+    open.pop();
+    if (i == goal) break;
+    if (f > g[i] + (centre(i) - centre(goal)).norm() + 1e-12) continue;  // stale
+    const int cx = i % nx, cy = i / nx;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int x = cx + dx, y = cy + dy;
+        if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= nx || y >= ny) continue;
+        const int j = y * nx + x;
+        if (!cell_free(j)) continue;
+        const double step = cell_m * ((dx != 0 && dy != 0) ? M_SQRT2 : 1.0);
+        if (g[i] + step < g[j] - 1e-12) {
+          g[j] = g[i] + step;
+          parent[j] = i;
+          open.push({g[j] + (centre(j) - centre(goal)).norm(), j});
+        }
+      }
+    }
+  }
+  if (!std::isfinite(g[goal])) {
+    *error = "no path from " + Pt(from) + " to " + Pt(to) + " keeps " + Num(clearance_m) +
+             " m from the walls (a door narrower than " + Num(2 * clearance_m) + " m?)";
+    return false;
+  }
+  std::vector<Eigen::Vector2d> cells;  // start .. goal
+  for (int i = goal; i >= 0; i = parent[i]) cells.push_back(centre(i));
+  std::reverse(cells.begin(), cells.end());
+  cells.front() = from;
+  if (cells.size() == 1)
+    cells.push_back(to);
+  else
+    cells.back() = to;
+  // Shortened: the farthest point in sight, each time.
+  path->assign(1, from);
+  size_t at = 0;
+  while (at + 1 < cells.size()) {
+    size_t next = at + 1;
+    for (size_t k = cells.size() - 1; k > at + 1; --k) {
+      if (free.Clear(cells[at], cells[k])) {
+        next = k;
+        break;
+      }
+    }
+    path->push_back(cells[next]);
+    at = next;
+  }
+  return true;
 }
 
 mjModel* LoadSceneModel(const std::string& scene_path, std::string* error) {

@@ -154,6 +154,18 @@ bool IsFloorPlanPath(const std::string& path);
 // system, with the plan's robot file). nullptr with *error naming the file on failure.
 mjModel* LoadSceneModel(const std::string& scene_path, std::string* error);
 
+// A path between two points of a checked plan, for a robot that must stay `clearance_m` from
+// every wall piece, jamb and box side below 1.5 m (lintels and soffits are above the robot):
+// A* on a grid of `cell_m` cells (8-connected, Euclidean costs and heuristic) over the free
+// space (inside a space or a door's passage, the clearance kept), then shortened: from each
+// waypoint the farthest later grid point in sight (the straight segment keeps the clearance and
+// stays inside) is the next. The result starts at `from` and ends at `to`, each segment checked
+// exactly (not on the grid). False with *error when either end is not in free space or no path
+// exists (a door narrower than twice the clearance, a room without a door).
+bool PlanPath(const FloorPlan& plan, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+              double clearance_m, std::vector<Eigen::Vector2d>* path, std::string* error,
+              double cell_m = 0.05);
+
 // Whether p is inside the polygon or on its boundary (within 1e-9 m).
 bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p);
 

@@ -258,7 +258,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   constexpr int kIntMax = std::numeric_limits<int>::max();
   r.CheckKeys(root, "",
               {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
-               "robot", "scene", "floor_plan", "seed", "settle_s", "textures", "imu"});
+               "robot", "scene", "floor_plan", "route", "seed", "settle_s", "textures", "imu"});
   r.String(root, "", "name", &s.name);
   // The scene: an MJCF file, or a floor plan it is generated from (sim/floor_plan.h).
   std::string scene, floor_plan;
@@ -283,9 +283,23 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
 
   // path: a sequence of [x, y] pairs.
   std::vector<std::pair<double, double>> path;
-  if (r.Require(root, "", "path", "a list of at least 2 waypoints [x, y] (m)") &&
-      r.ReadPairs(root["path"], "path", &path, "a list of waypoints [x, y] (m)",
-                  "a pair [x, y] (m)")) {
+  // route: {from: PLACE, to: PLACE}, the path planned through the floor plan (below).
+  std::string route_from, route_to;
+  const bool route = YamlReader::Has(root, "route");
+  if (route) {
+    const YAML::Node n = root["route"];
+    r.Check(!YamlReader::Has(root, "path"), root, "", "path",
+            "give path (waypoints) or route (planned between two places), not both");
+    r.Check(!floor_plan.empty(), root, "", "route",
+            "a route is planned through a floor plan: give floor_plan:");
+    r.CheckKeys(n, "route", {"from", "to"});
+    r.Require(n, "route", "from", "a place of the floor plan");
+    r.Require(n, "route", "to", "a place of the floor plan");
+    r.String(n, "route", "from", &route_from, false);
+    r.String(n, "route", "to", &route_to, false);
+  } else if (r.Require(root, "", "path", "a list of at least 2 waypoints [x, y] (m)") &&
+             r.ReadPairs(root["path"], "path", &path, "a list of waypoints [x, y] (m)",
+                         "a pair [x, y] (m)")) {
     for (const auto& [x, y] : path) s.path.emplace_back(x, y);
     r.Check(s.path.size() >= 2, root, "", "path",
             "expected at least 2 waypoints, got " + std::to_string(s.path.size()));
@@ -417,6 +431,36 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   if (!fs::exists(s.scene_path)) {
     if (error) *error = source_name + ": key '" + scene_key + "': file not found: " + s.scene_path;
     return false;
+  }
+  if (route) {  // the planned path: waypoints from the plan's grid planner (sim/floor_plan.h)
+    FloorPlan plan;
+    if (!LoadFloorPlan(s.scene_path, &plan, error)) return false;
+    Eigen::Vector2d ends[2];
+    const std::string names[2] = {route_from, route_to};
+    for (int k = 0; k < 2; ++k) {
+      bool found = false;
+      std::string known;
+      for (const auto& [name, at] : plan.places) {
+        known += (known.empty() ? "" : ", ") + name;
+        if (name == names[k]) {
+          ends[k] = at;
+          found = true;
+        }
+      }
+      if (!found) {
+        r.Fail(root["route"][k == 0 ? "from" : "to"], k == 0 ? "route.from" : "route.to",
+               "no place '" + names[k] + "' in " + s.scene_path +
+                   " (places: " + (known.empty() ? "none" : known) + ")");
+        return r.Report(error);
+      }
+    }
+    std::string why;
+    // The planner keeps 5 cm more than the path check needs: its grid steps may pass a little
+    // closer than their ends.
+    if (!PlanPath(plan, ends[0], ends[1], kRobotClearanceM + 0.05, &s.path, &why)) {
+      r.Fail(root["route"], "route", why);
+      return r.Report(error);
+    }
   }
   if (s.name.empty()) s.name = fs::path(source_name).stem().string();
   s.source_path = source_name;

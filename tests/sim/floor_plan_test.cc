@@ -281,11 +281,94 @@ TEST(FloorPlanTest, AScenarioSaysFloorPlanAndItsSceneLoads) {
   WriteText(dir / "s4.yaml", "seed: 1\n" + base);
   EXPECT_FALSE(sim::LoadScenario(dir / "s4.yaml", &s, &error));
   EXPECT_NE(error.find("key 'scene': required"), std::string::npos) << error;
+  // A route between two places of the plan: planned, and checked as any path.
+  WriteText(dir / "plan.yaml",
+            "corridors:\n  - {name: c, centre: [[0, 0], [6, 0]], width_m: 2}\nrooms:\n"
+            "  - {name: r, rect: [2, 1.1, 5, 4]}\ndoors:\n"
+            "  - {between: [c, r], at: [3.5, 1.05], width_m: 1.2, height_m: 2.1}\n"
+            "places:\n  west: [0.6, 0]\n  room: [3.5, 3]\n");
+  WriteText(dir / "s6.yaml", "floor_plan: plan.yaml\nroute: {from: west, to: room}\n");
+  ASSERT_TRUE(sim::LoadScenario(dir / "s6.yaml", &s, &error)) << error;
+  EXPECT_EQ(s.path.front(), Eigen::Vector2d(0.6, 0));
+  EXPECT_EQ(s.path.back(), Eigen::Vector2d(3.5, 3));
+  WriteText(dir / "s7.yaml", "floor_plan: plan.yaml\nroute:\n  from: west\n  to: attic\n");
+  EXPECT_FALSE(sim::LoadScenario(dir / "s7.yaml", &s, &error));
+  EXPECT_NE(error.find("s7.yaml:4: key 'route.to': no place 'attic'"), std::string::npos) << error;
+  WriteText(dir / "s8.yaml", "scene: x.xml\nroute: {from: west, to: room}\n");
+  EXPECT_FALSE(sim::LoadScenario(dir / "s8.yaml", &s, &error));
+  EXPECT_NE(error.find("give floor_plan:"), std::string::npos) << error;
   // A bad plan is reported at the plan's file and line.
   WriteText(dir / "plan.yaml", "corridors:\n  - {name: c, centre: [[0, 0], [6, 0]], width_m: 0}\n");
   WriteText(dir / "s5.yaml", "floor_plan: plan.yaml\n" + base);
   EXPECT_FALSE(sim::LoadScenario(dir / "s5.yaml", &s, &error));
   EXPECT_NE(error.find("plan.yaml:2: key 'corridors[0].width_m'"), std::string::npos) << error;
+}
+
+double SegmentPointDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                            const Eigen::Vector2d& b) {
+  const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+  return (a + t * (b - a) - p).norm();
+}
+
+TEST(FloorPlanTest, APlannedPathKeepsTheFootprintInFreeSpace) {
+  // From the corridor's west end into the room through its 1.2 m door, round the desk.
+  const char* kPlan = R"(
+corridors:
+  - {name: c, centre: [[0, 0], [10, 0]], width_m: 2}
+rooms:
+  - {name: r, rect: [4, 1.1, 9, 6]}
+doors:
+  - {between: [c, r], at: [5, 1.05], width_m: DOOR, height_m: 2.1}
+boxes:
+  - {name: desk, at: [5.5, 3.2], size_m: [2.4, 0.8], height_m: 0.75}
+)";
+  auto plan_with_door = [&](const std::string& width) {
+    std::string yaml = kPlan;
+    yaml.replace(yaml.find("DOOR"), 4, width);
+    return Parse(yaml);
+  };
+  const sim::FloorPlan plan = plan_with_door("1.2");
+  const double clearance = 0.38;
+  std::vector<Eigen::Vector2d> path;
+  std::string error;
+  ASSERT_TRUE(sim::PlanPath(plan, {0.6, 0}, {5.5, 4.8}, clearance, &path, &error)) << error;
+  ASSERT_GE(path.size(), 3u);
+  EXPECT_EQ(path.front(), Eigen::Vector2d(0.6, 0));
+  EXPECT_EQ(path.back(), Eigen::Vector2d(5.5, 4.8));
+  // Every point of every segment (every 1 cm) keeps the clearance from every wall piece, jamb
+  // and box side, and lies in the corridor, the room or the door's passage.
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> walls;
+  for (const sim::PlanSurface& s : sim::PlanSurfaces(plan)) {
+    if (std::abs(s.y_axis.z()) < 0.5 || s.centre.z() - s.half_height_m > 1.5) continue;
+    Eigen::Vector2d a, b;
+    Ends(s, &a, &b);
+    walls.emplace_back(a, b);
+  }
+  ASSERT_GT(walls.size(), 10u);
+  const std::vector<Eigen::Vector2d> passage = {{4.4, 1}, {5.6, 1}, {5.6, 1.1}, {4.4, 1.1}};
+  double closest = 1e9;
+  for (size_t i = 1; i < path.size(); ++i) {
+    const int n = static_cast<int>(std::ceil((path[i] - path[i - 1]).norm() / 0.01));
+    for (int k = 0; k <= n; ++k) {
+      const Eigen::Vector2d p = path[i - 1] + (path[i] - path[i - 1]) * (double(k) / n);
+      for (const auto& [a, b] : walls) closest = std::min(closest, SegmentPointDistance(p, a, b));
+      EXPECT_TRUE(sim::InsidePolygon(plan.spaces[0].polygon, p) ||
+                  sim::InsidePolygon(plan.spaces[1].polygon, p) || sim::InsidePolygon(passage, p))
+          << p.transpose();
+    }
+  }
+  EXPECT_GE(closest, clearance - 1e-9);
+  EXPECT_LT(closest, clearance + 0.2);  // it does go through the door, round the desk
+  // Deterministic.
+  std::vector<Eigen::Vector2d> again;
+  ASSERT_TRUE(sim::PlanPath(plan, {0.6, 0}, {5.5, 4.8}, clearance, &again, &error));
+  EXPECT_EQ(path, again);
+  // A door narrower than the footprint: no path; an end in a wall's clearance: refused.
+  EXPECT_FALSE(
+      sim::PlanPath(plan_with_door("0.7"), {0.6, 0}, {5.5, 4.8}, clearance, &path, &error));
+  EXPECT_NE(error.find("no path from (0.6, 0) to (5.5, 4.8)"), std::string::npos) << error;
+  EXPECT_FALSE(sim::PlanPath(plan, {0.6, 0.8}, {5.5, 4.8}, clearance, &path, &error));
+  EXPECT_NE(error.find("the start (0.6, 0.8) is not in free space"), std::string::npos) << error;
 }
 
 TEST(FloorPlanTest, TheMjcfIsDeterministic) {
