@@ -154,8 +154,14 @@ int EstimatedFrames(const Scenario& s) {
     if (i + 1 < s.path.size() && s.robot.corner_mode == "in_place") {
       const Eigen::Vector2d next = s.path[i + 1] - s.path[i];
       const double turn = std::abs(std::atan2(d.x() * next.y() - d.y() * next.x(), d.dot(next)));
-      seconds += turn * 180.0 / M_PI / s.robot.turn_rate_dps;
+      seconds += turn * 180.0 / M_PI / s.robot.turn_rate_dps + s.robot.stop_s;
     }
+  }
+  if (std::isfinite(s.robot.final_heading_deg) && s.path.size() >= 2) {  // the final turn
+    const Eigen::Vector2d d = s.path.back() - s.path[s.path.size() - 2];
+    const double h = s.robot.final_heading_deg * M_PI / 180.0 - std::atan2(d.y(), d.x());
+    seconds +=
+        std::abs(std::atan2(std::sin(h), std::cos(h))) * 180.0 / M_PI / s.robot.turn_rate_dps;
   }
   seconds = std::min(seconds, s.max_duration_s);
   return static_cast<int>(std::floor(seconds * s.rate_hz)) + 1;
@@ -185,6 +191,10 @@ bool Scenario::IsValid(std::string* error) const {
     e << "robot.corner_mode: expected 'in_place' or 'arc', got '" << robot.corner_mode << "'";
   else if (!(robot.goal_tolerance_m > 0))
     e << "robot.goal_tolerance_m: expected > 0";
+  else if (!(robot.stop_s >= 0 && robot.stop_s <= 600))
+    e << "robot.stop_s: expected in [0, 600] s";
+  else if (std::isinf(robot.final_heading_deg))
+    e << "robot.final_heading_deg: expected a finite angle (or none)";
   else if (camera.width < 16 || camera.width > 4096 || camera.height < 16 || camera.height > 4096)
     e << "camera.width/height: expected 16..4096, got " << camera.width << "x" << camera.height;
   else if (!(camera.fovy_deg > kMinFovDeg && camera.fovy_deg < kMaxFovDeg))
@@ -308,7 +318,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   if (const YAML::Node n = root["robot"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(n, "robot",
                 {"corner_mode", "goal_tolerance_m", "lookahead_m", "max_accel_mps2", "speed_mps",
-                 "turn_rate_dps"});
+                 "turn_rate_dps", "stop_s", "final_heading_deg"});
     RobotOptions& o = s.robot;
     r.Double(n, "robot", "speed_mps", &o.speed_mps);
     r.Check(o.speed_mps > 0 && o.speed_mps <= 3, n, "robot", "speed_mps",
@@ -325,6 +335,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
             "expected 'in_place' or 'arc', got '" + o.corner_mode + "'");
     r.Double(n, "robot", "goal_tolerance_m", &o.goal_tolerance_m);
     r.Check(o.goal_tolerance_m > 0, n, "robot", "goal_tolerance_m", "expected > 0");
+    r.Double(n, "robot", "stop_s", &o.stop_s);
+    r.Check(o.stop_s >= 0 && o.stop_s <= 600, n, "robot", "stop_s", "expected in [0, 600] s");
+    r.Double(n, "robot", "final_heading_deg", &o.final_heading_deg);
   }
   if (const YAML::Node n = root["camera"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(
@@ -520,7 +533,12 @@ std::string ScenarioToYaml(const Scenario& s) {
       << s.robot.max_accel_mps2 << YAML::Key << "turn_rate_dps" << YAML::Value
       << s.robot.turn_rate_dps << YAML::Key << "lookahead_m" << YAML::Value << s.robot.lookahead_m
       << YAML::Key << "corner_mode" << YAML::Value << s.robot.corner_mode << YAML::Key
-      << "goal_tolerance_m" << YAML::Value << s.robot.goal_tolerance_m << YAML::EndMap;
+      << "goal_tolerance_m" << YAML::Value << s.robot.goal_tolerance_m;
+  // The path's goals only where set: effective scenarios without them read as before.
+  if (s.robot.stop_s != 0.0) out << YAML::Key << "stop_s" << YAML::Value << s.robot.stop_s;
+  if (std::isfinite(s.robot.final_heading_deg))
+    out << YAML::Key << "final_heading_deg" << YAML::Value << s.robot.final_heading_deg;
+  out << YAML::EndMap;
   out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap << YAML::Key << "width"
       << YAML::Value << s.camera.width << YAML::Key << "height" << YAML::Value << s.camera.height
       << YAML::Key << "fovy_deg" << YAML::Value << s.camera.fovy_deg << YAML::Key << "baseline_m"
