@@ -37,14 +37,6 @@ std::string Num(double v) {
 }
 std::string Pt(const Eigen::Vector2d& p) { return "(" + Num(p.x()) + ", " + Num(p.y()) + ")"; }
 
-double PointSegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                            const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
 // Whether segments a0-a1 and b0-b1 share a point (touching included).
 bool SegmentsTouch(const Eigen::Vector2d& a0, const Eigen::Vector2d& a1, const Eigen::Vector2d& b0,
                    const Eigen::Vector2d& b1) {
@@ -179,6 +171,24 @@ bool CorridorPolygon(const std::vector<Eigen::Vector2d>& c, double width_m,
   return true;
 }
 
+// Calls item(node, key) on each mapping of the list root[list] (none when absent), its keys
+// checked against `keys`; stops at the first error.
+template <typename F>
+void ForEachItem(YamlReader& r, const YAML::Node& root, const char* list,
+                 const std::vector<std::string>& keys, F item) {
+  if (!r.ok() || !YamlReader::Has(root, list)) return;
+  const YAML::Node l = root[list];
+  if (!l.IsSequence()) {
+    r.Fail(l, list, "expected a list");
+    return;
+  }
+  for (size_t i = 0; r.ok() && i < l.size(); ++i) {
+    const std::string key = YamlReader::Item(list, i);
+    if (!r.ExpectMap(l[i], key) || !r.CheckKeys(l[i], key, keys)) return;
+    item(l[i], key);
+  }
+}
+
 // Reads a style key.
 void ReadStyle(YamlReader& r, const YAML::Node& map, const std::string& prefix,
                const std::string& key, bool walls, SurfaceStyle* out) {
@@ -188,6 +198,14 @@ void ReadStyle(YamlReader& r, const YAML::Node& map, const std::string& prefix,
 }
 
 }  // namespace
+
+double PointSegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                            const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
 
 bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p) {
   return BoundaryDistance(polygon, p) < kEps || StrictlyInside(polygon, p);
@@ -359,182 +377,172 @@ bool ParseFloorPlan(const std::string& yaml_text, const std::string& source_name
   }
 
   // Doors.
-  if (r.ok() && YamlReader::Has(root, "doors")) {
-    const YAML::Node l = root["doors"];
-    if (!l.IsSequence()) r.Fail(l, "doors", "expected a list");
-    for (size_t i = 0; r.ok() && i < l.size(); ++i) {
-      const YAML::Node n = l[i];
-      const std::string key = YamlReader::Item("doors", i);
-      if (!r.ExpectMap(n, key)) break;
-      r.CheckKeys(n, key, {"between", "at", "width_m", "height_m"});
-      r.Require(n, key, "between", "the two spaces it joins [a, b]");
-      r.Require(n, key, "at", "the door's centre [x, y] on the wall (m)");
-      r.Require(n, key, "width_m", "the door's width (m)");
-      if (!r.ok()) break;
-      const YAML::Node bn = n["between"];
-      const std::string bkey = YamlReader::Join(key, "between");
-      if (!bn.IsSequence() || bn.size() != 2) {
-        r.Fail(bn, bkey, "expected two space names [a, b]");
-        break;
-      }
-      PlanDoor d;
-      std::string names[2];
-      for (int k = 0; k < 2 && r.ok(); ++k) {
-        r.ReadString(bn[k], YamlReader::Item(bkey, k), &names[k], false);
-        if (r.ok() && space_index.count(names[k]) == 0)
-          r.Fail(bn[k], YamlReader::Item(bkey, k), "no corridor or room named '" + names[k] + "'");
-        if (r.ok()) d.space[k] = space_index[names[k]];
-      }
-      r.Check(!r.ok() || d.space[0] != d.space[1], n, key, "between",
-              "a door joins two different spaces");
-      std::vector<double> at;
-      r.ReadNumbers(n["at"], YamlReader::Join(key, "at"), 2, &at, "a point [x, y] (m)");
-      double width = 0, height = p.ceiling_height_m;
-      r.Double(n, key, "width_m", &width);
-      r.Check(width > 0, n, key, "width_m", "expected > 0 m, got " + Num(width));
-      r.Double(n, key, "height_m", &height);
-      r.Check(height > 0 && height <= p.ceiling_height_m, n, key, "height_m",
-              "expected in (0, ceiling_height_m = " + Num(p.ceiling_height_m) + "] m");
-      r.Check(height == p.ceiling_height_m || p.ceiling_height_m - height >= kMinWallPieceM, n, key,
-              "height_m", "leaves a lintel thinner than 1 cm: make it an opening");
-      if (!r.ok()) break;
-      const Eigen::Vector2d c(at[0], at[1]);
-      d.centre_xy = c;
-      d.height_m = height;
-      // The nearest wall of each space within max_door_depth_m whose span holds the point.
-      for (int k = 0; k < 2 && r.ok(); ++k) {
-        const auto& poly = p.spaces[d.space[k]].polygon;
-        double best = std::numeric_limits<double>::infinity();
-        for (size_t e = 0; e < poly.size(); ++e) {
-          const Eigen::Vector2d a = poly[e], b = poly[(e + 1) % poly.size()];
-          const Eigen::Vector2d dir = (b - a).normalized();
-          const double s = (c - a).dot(dir), len = (b - a).norm();
-          const double off = -(c - a).dot(LeftNormal(dir));  // outward distance from the wall
-          if (s < -kEps || s > len + kEps || off < -p.max_door_depth_m - kEps ||
-              off > p.max_door_depth_m + kEps || std::abs(off) >= best)
-            continue;
-          best = std::abs(off);
-          d.edge[k] = static_cast<int>(e);
-          d.from_m[k] = s - 0.5 * width;
-          d.to_m[k] = s + 0.5 * width;
+  ForEachItem(
+      r, root, "doors", {"between", "at", "width_m", "height_m"},
+      [&](const YAML::Node& n, const std::string& key) {
+        r.Require(n, key, "between", "the two spaces it joins [a, b]");
+        r.Require(n, key, "at", "the door's centre [x, y] on the wall (m)");
+        r.Require(n, key, "width_m", "the door's width (m)");
+        if (!r.ok()) return;
+        const YAML::Node bn = n["between"];
+        const std::string bkey = YamlReader::Join(key, "between");
+        if (!bn.IsSequence() || bn.size() != 2) {
+          r.Fail(bn, bkey, "expected two space names [a, b]");
+          return;
         }
-        if (d.edge[k] < 0)
+        PlanDoor d;
+        std::string names[2];
+        for (int k = 0; k < 2 && r.ok(); ++k) {
+          r.ReadString(bn[k], YamlReader::Item(bkey, k), &names[k], false);
+          if (r.ok() && space_index.count(names[k]) == 0)
+            r.Fail(bn[k], YamlReader::Item(bkey, k),
+                   "no corridor or room named '" + names[k] + "'");
+          if (r.ok()) d.space[k] = space_index[names[k]];
+        }
+        r.Check(!r.ok() || d.space[0] != d.space[1], n, key, "between",
+                "a door joins two different spaces");
+        std::vector<double> at;
+        r.ReadNumbers(n["at"], YamlReader::Join(key, "at"), 2, &at, "a point [x, y] (m)");
+        double width = 0, height = p.ceiling_height_m;
+        r.Double(n, key, "width_m", &width);
+        r.Check(width > 0, n, key, "width_m", "expected > 0 m, got " + Num(width));
+        r.Double(n, key, "height_m", &height);
+        r.Check(height > 0 && height <= p.ceiling_height_m, n, key, "height_m",
+                "expected in (0, ceiling_height_m = " + Num(p.ceiling_height_m) + "] m");
+        r.Check(height == p.ceiling_height_m || p.ceiling_height_m - height >= kMinWallPieceM, n,
+                key, "height_m", "leaves a lintel thinner than 1 cm: make it an opening");
+        if (!r.ok()) return;
+        const Eigen::Vector2d c(at[0], at[1]);
+        d.centre_xy = c;
+        d.height_m = height;
+        // The nearest wall of each space within max_door_depth_m whose span holds the point.
+        for (int k = 0; k < 2 && r.ok(); ++k) {
+          const auto& poly = p.spaces[d.space[k]].polygon;
+          double best = std::numeric_limits<double>::infinity();
+          for (size_t e = 0; e < poly.size(); ++e) {
+            const Eigen::Vector2d a = poly[e], b = poly[(e + 1) % poly.size()];
+            const Eigen::Vector2d dir = (b - a).normalized();
+            const double s = (c - a).dot(dir), len = (b - a).norm();
+            const double off = -(c - a).dot(LeftNormal(dir));  // outward distance from the wall
+            if (s < -kEps || s > len + kEps || off < -p.max_door_depth_m - kEps ||
+                off > p.max_door_depth_m + kEps || std::abs(off) >= best)
+              continue;
+            best = std::abs(off);
+            d.edge[k] = static_cast<int>(e);
+            d.from_m[k] = s - 0.5 * width;
+            d.to_m[k] = s + 0.5 * width;
+          }
+          if (d.edge[k] < 0)
+            r.Fail(n["at"], YamlReader::Join(key, "at"),
+                   "the door at " + Pt(c) + " is on no wall of '" + names[k] + "' (within " +
+                       Num(p.max_door_depth_m) + " m, max_door_depth_m)");
+        }
+        if (!r.ok()) return;
+        const auto& pa = p.spaces[d.space[0]].polygon;
+        const auto& pb = p.spaces[d.space[1]].polygon;
+        const Eigen::Vector2d a0 = pa[d.edge[0]], a1 = pa[(d.edge[0] + 1) % pa.size()];
+        const Eigen::Vector2d b0 = pb[d.edge[1]], b1 = pb[(d.edge[1] + 1) % pb.size()];
+        const Eigen::Vector2d da = (a1 - a0).normalized(), db = (b1 - b0).normalized();
+        d.depth_m = -(b0 - a0).dot(LeftNormal(da));
+        if (std::abs(Cross(da, db)) > 1e-9 || da.dot(db) > 0) {
           r.Fail(n["at"], YamlReader::Join(key, "at"),
-                 "the door at " + Pt(c) + " is on no wall of '" + names[k] + "' (within " +
-                     Num(p.max_door_depth_m) + " m, max_door_depth_m)");
-      }
-      if (!r.ok()) break;
-      const auto& pa = p.spaces[d.space[0]].polygon;
-      const auto& pb = p.spaces[d.space[1]].polygon;
-      const Eigen::Vector2d a0 = pa[d.edge[0]], a1 = pa[(d.edge[0] + 1) % pa.size()];
-      const Eigen::Vector2d b0 = pb[d.edge[1]], b1 = pb[(d.edge[1] + 1) % pb.size()];
-      const Eigen::Vector2d da = (a1 - a0).normalized(), db = (b1 - b0).normalized();
-      d.depth_m = -(b0 - a0).dot(LeftNormal(da));
-      if (std::abs(Cross(da, db)) > 1e-9 || da.dot(db) > 0) {
-        r.Fail(n["at"], YamlReader::Join(key, "at"),
-               "the walls of '" + names[0] + "' and '" + names[1] + "' at " + Pt(c) +
-                   " are not parallel and facing: a door joins two facing walls");
-        break;
-      }
-      if (d.depth_m < -kEps || d.depth_m > p.max_door_depth_m + kEps) {
-        r.Fail(n["at"], YamlReader::Join(key, "at"),
-               "the walls of '" + names[0] + "' and '" + names[1] + "' are " + Num(d.depth_m) +
-                   " m apart; a door joins walls at most max_door_depth_m = " +
-                   Num(p.max_door_depth_m) + " m apart");
-        break;
-      }
-      d.depth_m = std::max(0.0, d.depth_m);
-      // The span on b's edge: the same points, measured from b's start (b runs the other way).
-      const double sb = (c - b0).dot(db);
-      d.from_m[1] = sb - 0.5 * width;
-      d.to_m[1] = sb + 0.5 * width;
-      for (int k = 0; k < 2 && r.ok(); ++k) {
-        const auto& poly = p.spaces[d.space[k]].polygon;
-        const double len = (poly[(d.edge[k] + 1) % poly.size()] - poly[d.edge[k]]).norm();
-        const double left = d.from_m[k], right = len - d.to_m[k];
-        if (left < -1e-6 || right < -1e-6) {
-          r.Fail(n, key,
-                 "the door (" + Num(width) + " m wide at " + Pt(c) +
-                     ") runs past the end of wall " + std::to_string(d.edge[k]) + " of '" +
-                     names[k] + "' (" + Num(len) + " m long)");
-        } else if ((left > 1e-6 && left < kMinWallPieceM) ||
-                   (right > 1e-6 && right < kMinWallPieceM)) {
-          r.Fail(n, key,
-                 "the door leaves a sliver of wall under 1 cm beside it on '" + names[k] +
-                     "': put it flush with the wall's end or 1 cm away");
+                 "the walls of '" + names[0] + "' and '" + names[1] + "' at " + Pt(c) +
+                     " are not parallel and facing: a door joins two facing walls");
+          return;
         }
-        d.from_m[k] = std::max(0.0, d.from_m[k]);
-        d.to_m[k] = std::min(len, d.to_m[k]);
-      }
-      for (const PlanDoor& o : p.doors) {
-        for (int k = 0; k < 2 && r.ok(); ++k)
-          for (int q = 0; q < 2; ++q)
-            if (o.space[q] == d.space[k] && o.edge[q] == d.edge[k] &&
-                o.from_m[q] < d.to_m[k] - kEps && d.from_m[k] < o.to_m[q] - kEps)
-              r.Fail(n, key, "the door overlaps another door on the same wall");
-      }
-      p.doors.push_back(d);
-    }
-  }
+        if (d.depth_m < -kEps || d.depth_m > p.max_door_depth_m + kEps) {
+          r.Fail(n["at"], YamlReader::Join(key, "at"),
+                 "the walls of '" + names[0] + "' and '" + names[1] + "' are " + Num(d.depth_m) +
+                     " m apart; a door joins walls at most max_door_depth_m = " +
+                     Num(p.max_door_depth_m) + " m apart");
+          return;
+        }
+        d.depth_m = std::max(0.0, d.depth_m);
+        // The span on b's edge: the same points, measured from b's start (b runs the other way).
+        const double sb = (c - b0).dot(db);
+        d.from_m[1] = sb - 0.5 * width;
+        d.to_m[1] = sb + 0.5 * width;
+        for (int k = 0; k < 2 && r.ok(); ++k) {
+          const auto& poly = p.spaces[d.space[k]].polygon;
+          const double len = (poly[(d.edge[k] + 1) % poly.size()] - poly[d.edge[k]]).norm();
+          const double left = d.from_m[k], right = len - d.to_m[k];
+          if (left < -1e-6 || right < -1e-6) {
+            r.Fail(n, key,
+                   "the door (" + Num(width) + " m wide at " + Pt(c) +
+                       ") runs past the end of wall " + std::to_string(d.edge[k]) + " of '" +
+                       names[k] + "' (" + Num(len) + " m long)");
+          } else if ((left > 1e-6 && left < kMinWallPieceM) ||
+                     (right > 1e-6 && right < kMinWallPieceM)) {
+            r.Fail(n, key,
+                   "the door leaves a sliver of wall under 1 cm beside it on '" + names[k] +
+                       "': put it flush with the wall's end or 1 cm away");
+          }
+          d.from_m[k] = std::max(0.0, d.from_m[k]);
+          d.to_m[k] = std::min(len, d.to_m[k]);
+        }
+        for (const PlanDoor& o : p.doors) {
+          for (int k = 0; k < 2 && r.ok(); ++k)
+            for (int q = 0; q < 2; ++q)
+              if (o.space[q] == d.space[k] && o.edge[q] == d.edge[k] &&
+                  o.from_m[q] < d.to_m[k] - kEps && d.from_m[k] < o.to_m[q] - kEps)
+                r.Fail(n, key, "the door overlaps another door on the same wall");
+        }
+        p.doors.push_back(d);
+      });
 
   // Boxes.
   std::set<std::string> box_names;
-  if (r.ok() && YamlReader::Has(root, "boxes")) {
-    const YAML::Node l = root["boxes"];
-    if (!l.IsSequence()) r.Fail(l, "boxes", "expected a list");
-    for (size_t i = 0; r.ok() && i < l.size(); ++i) {
-      const YAML::Node n = l[i];
-      const std::string key = YamlReader::Item("boxes", i);
-      if (!r.ExpectMap(n, key)) break;
-      r.CheckKeys(n, key, {"name", "at", "yaw_deg", "size_m", "height_m", "sides", "top", "wall"});
-      PlanBox b;
-      r.Require(n, key, "name", "a name (letters, digits, _)");
-      r.Require(n, key, "at", "the box's centre [x, y] (m)");
-      r.Require(n, key, "size_m", "its sizes [x, y] (m)");
-      r.Require(n, key, "height_m", "its height (m)");
-      r.String(n, key, "name", &b.name, false);
-      r.Check(ValidName(b.name) && box_names.insert(b.name).second, n, key, "name",
-              "expected a unique name of letters, digits and '_'");
-      std::vector<double> v;
-      if (r.ReadNumbers(n["at"], YamlReader::Join(key, "at"), 2, &v, "a point [x, y] (m)"))
-        b.centre_xy = Eigen::Vector2d(v[0], v[1]);
-      if (r.ReadNumbers(n["size_m"], YamlReader::Join(key, "size_m"), 2, &v, "sizes [x, y] (m)"))
-        b.size_m = Eigen::Vector2d(v[0], v[1]);
-      r.Check(b.size_m.minCoeff() >= 0.02, n, key, "size_m", "expected sizes >= 0.02 m");
-      double yaw_deg = 0;
-      r.Double(n, key, "yaw_deg", &yaw_deg);
-      b.yaw_rad = yaw_deg * M_PI / 180.0;
-      r.Double(n, key, "height_m", &b.height_m);
-      r.Check(b.height_m >= 0.02 && b.height_m <= p.ceiling_height_m, n, key, "height_m",
-              "expected in [0.02, ceiling_height_m] m");
-      ReadStyle(r, n, key, "sides", true, &b.sides);
-      ReadStyle(r, n, key, "top", false, &b.top);
-      r.Bool(n, key, "wall", &b.wall_like);
-      if (!r.ok()) break;
-      // Inside the building: every corner in a space, no side through a wall.
-      const Eigen::Vector2d ux(std::cos(b.yaw_rad), std::sin(b.yaw_rad));
-      const Eigen::Vector2d uy = LeftNormal(ux);
-      std::vector<Eigen::Vector2d> corners;
-      for (const auto& [sx, sy] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}})
-        corners.push_back(b.centre_xy + 0.5 * sx * b.size_m.x() * ux +
-                          0.5 * sy * b.size_m.y() * uy);
-      for (const auto& q : corners) {
-        bool in = false;
-        for (const auto& s : p.spaces) in = in || InsidePolygon(s.polygon, q);
-        if (!in) {
-          r.Fail(n, key, "the box's corner " + Pt(q) + " is outside every corridor and room");
-          break;
+  ForEachItem(
+      r, root, "boxes", {"name", "at", "yaw_deg", "size_m", "height_m", "sides", "top", "wall"},
+      [&](const YAML::Node& n, const std::string& key) {
+        PlanBox b;
+        r.Require(n, key, "name", "a name (letters, digits, _)");
+        r.Require(n, key, "at", "the box's centre [x, y] (m)");
+        r.Require(n, key, "size_m", "its sizes [x, y] (m)");
+        r.Require(n, key, "height_m", "its height (m)");
+        r.String(n, key, "name", &b.name, false);
+        r.Check(ValidName(b.name) && box_names.insert(b.name).second, n, key, "name",
+                "expected a unique name of letters, digits and '_'");
+        std::vector<double> v;
+        if (r.ReadNumbers(n["at"], YamlReader::Join(key, "at"), 2, &v, "a point [x, y] (m)"))
+          b.centre_xy = Eigen::Vector2d(v[0], v[1]);
+        if (r.ReadNumbers(n["size_m"], YamlReader::Join(key, "size_m"), 2, &v, "sizes [x, y] (m)"))
+          b.size_m = Eigen::Vector2d(v[0], v[1]);
+        r.Check(b.size_m.minCoeff() >= 0.02, n, key, "size_m", "expected sizes >= 0.02 m");
+        double yaw_deg = 0;
+        r.Double(n, key, "yaw_deg", &yaw_deg);
+        b.yaw_rad = yaw_deg * M_PI / 180.0;
+        r.Double(n, key, "height_m", &b.height_m);
+        r.Check(b.height_m >= 0.02 && b.height_m <= p.ceiling_height_m, n, key, "height_m",
+                "expected in [0.02, ceiling_height_m] m");
+        ReadStyle(r, n, key, "sides", true, &b.sides);
+        ReadStyle(r, n, key, "top", false, &b.top);
+        r.Bool(n, key, "wall", &b.wall_like);
+        if (!r.ok()) return;
+        // Inside the building: every corner in a space, no side through a wall.
+        const Eigen::Vector2d ux(std::cos(b.yaw_rad), std::sin(b.yaw_rad));
+        const Eigen::Vector2d uy = LeftNormal(ux);
+        std::vector<Eigen::Vector2d> corners;
+        for (const auto& [sx, sy] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}})
+          corners.push_back(b.centre_xy + 0.5 * sx * b.size_m.x() * ux +
+                            0.5 * sy * b.size_m.y() * uy);
+        for (const auto& q : corners) {
+          bool in = false;
+          for (const auto& s : p.spaces) in = in || InsidePolygon(s.polygon, q);
+          if (!in) {
+            r.Fail(n, key, "the box's corner " + Pt(q) + " is outside every corridor and room");
+            return;
+          }
         }
-      }
-      for (size_t k = 0; k < 4 && r.ok(); ++k)
-        for (const auto& s : p.spaces)
-          for (size_t e = 0; e < s.polygon.size() && r.ok(); ++e)
-            if (SegmentsCrossProperly(corners[k], corners[(k + 1) % 4], s.polygon[e],
-                                      s.polygon[(e + 1) % s.polygon.size()]))
-              r.Fail(n, key, "the box crosses wall " + std::to_string(e) + " of '" + s.name + "'");
-      p.boxes.push_back(b);
-    }
-  }
+        for (size_t k = 0; k < 4 && r.ok(); ++k)
+          for (const auto& s : p.spaces)
+            for (size_t e = 0; e < s.polygon.size() && r.ok(); ++e)
+              if (SegmentsCrossProperly(corners[k], corners[(k + 1) % 4], s.polygon[e],
+                                        s.polygon[(e + 1) % s.polygon.size()]))
+                r.Fail(n, key,
+                       "the box crosses wall " + std::to_string(e) + " of '" + s.name + "'");
+        p.boxes.push_back(b);
+      });
 
   // Lights: the hand-written hallways' two directional lights unless given.
   if (r.ok() && YamlReader::Has(root, "lights")) {

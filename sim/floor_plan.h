@@ -166,6 +166,10 @@ bool PlanPath(const FloorPlan& plan, const Eigen::Vector2d& from, const Eigen::V
               double clearance_m, std::vector<Eigen::Vector2d>* path, std::string* error,
               double cell_m = 0.05);
 
+// Distance from point p to the segment a-b (m).
+double PointSegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                            const Eigen::Vector2d& b);
+
 // Whether p is inside the polygon or on its boundary (within 1e-9 m).
 bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p);
 

@@ -85,15 +85,6 @@ bool WallsOfScene(const std::string& scene_path, std::vector<SceneWall>* walls, 
 
 namespace {
 
-// Distance from point p to the segment a-b.
-double PointSegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                            const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
 // Where segments a0-a1 and b0-b1 cross (the parameter along a in *t), if they do.
 bool SegmentsCross(const Eigen::Vector2d& a0, const Eigen::Vector2d& a1, const Eigen::Vector2d& b0,
                    const Eigen::Vector2d& b1, double* t) {
