@@ -39,7 +39,8 @@ double PathFollower::RampSpeed(double v_target, double dt_s) {
 }
 
 DriveCommand PathFollower::Turn(double yaw_rad, double dt_s) {
-  const double goal = Heading(path_[target_ - 1], path_[target_]);
+  const double goal = final_turn_ ? options_.final_heading_deg * M_PI / 180.0
+                                  : Heading(path_[target_ - 1], path_[target_]);
   const double err = WrapAngle(goal - yaw_rad);
   const double max_rate = options_.turn_rate_dps * M_PI / 180.0;
   // Rate that still lets us stop in time: w² = 2 α |err|.
@@ -51,7 +52,7 @@ DriveCommand PathFollower::Turn(double yaw_rad, double dt_s) {
   w_ = std::clamp(w_target, w_ - dw, w_ + dw);
   if (std::abs(err) < kTurnDoneRad) {
     w_ = 0.0;
-    mode_ = Mode::kDrive;
+    mode_ = final_turn_ ? Mode::kDone : Mode::kDrive;
   }
   return {RampSpeed(0.0, dt_s), w_};
 }
@@ -75,12 +76,22 @@ DriveCommand PathFollower::Drive(const Eigen::Vector2d& position, double yaw_rad
   // Segment switch: in-place mode stops and turns at each waypoint; arc mode moves its
   // target on as soon as the look-ahead point passes the waypoint.
   if (to_stop <= options_.goal_tolerance_m) {
+    if (last && std::isfinite(options_.final_heading_deg)) {  // the goal's heading
+      final_turn_ = true;
+      mode_ = Mode::kTurn;
+      return Turn(yaw_rad, dt_s);
+    }
     if (last) {
       mode_ = Mode::kDone;
       v_ = 0.0;
       return {};
     }
     ++target_;
+    if (options_.stop_s > 0.0) {  // stand still, then turn
+      stop_left_s_ = options_.stop_s;
+      mode_ = Mode::kStop;
+      return {RampSpeed(0.0, dt_s), 0.0};
+    }
     mode_ = Mode::kTurn;
     return Turn(yaw_rad, dt_s);
   }
@@ -111,6 +122,10 @@ DriveCommand PathFollower::Update(const Eigen::Vector2d& position, double yaw_ra
       return Turn(yaw_rad, dt_s);
     case Mode::kDrive:
       return Drive(position, yaw_rad, dt_s);
+    case Mode::kStop:
+      stop_left_s_ -= dt_s;
+      if (stop_left_s_ <= 0.0) mode_ = Mode::kTurn;
+      return {RampSpeed(0.0, dt_s), 0.0};
     case Mode::kDone:
       break;
   }

@@ -1,5 +1,7 @@
 // Path-tracking controller for a differential-drive robot: pure pursuit along a polyline of
-// waypoints, with either in-place turns at the corners or arcs that cut them.
+// waypoints, with either in-place turns at the corners or arcs that cut them; with in-place
+// corners a stop of RobotOptions::stop_s before each turn, and at the end an in-place turn to
+// RobotOptions::final_heading_deg when it is set.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,7 +23,7 @@ void WheelSpeeds(const DriveCommand& cmd, double wheel_radius_m, double track_m,
 
 class PathFollower {
  public:
-  enum class Mode { kTurn, kDrive, kDone };
+  enum class Mode { kTurn, kDrive, kStop, kDone };
 
   // `path`: waypoints (x, y) in the world (m), at least two; options as in the scenario.
   PathFollower(std::vector<Eigen::Vector2d> path, const RobotOptions& options);
@@ -42,9 +44,11 @@ class PathFollower {
   std::vector<Eigen::Vector2d> path_;
   RobotOptions options_;
   Mode mode_ = Mode::kTurn;
-  size_t target_ = 1;  // heading to path_[target_]
-  double v_ = 0.0;     // current commanded forward speed (m/s), ramped
-  double w_ = 0.0;     // current commanded yaw rate when turning (rad/s), ramped
+  size_t target_ = 1;         // heading to path_[target_]
+  double v_ = 0.0;            // current commanded forward speed (m/s), ramped
+  double w_ = 0.0;            // current commanded yaw rate when turning (rad/s), ramped
+  double stop_left_s_ = 0.0;  // kStop: time still to stand (s)
+  bool final_turn_ = false;   // kTurn toward final_heading_deg at the last waypoint
 };
 
 }  // namespace sim

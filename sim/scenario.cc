@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sim/data_dir.h"
+#include "sim/floor_plan.h"
 #include "sim/scene_walls.h"
 #include "sim/yaml_input.h"
 
@@ -153,8 +154,14 @@ int EstimatedFrames(const Scenario& s) {
     if (i + 1 < s.path.size() && s.robot.corner_mode == "in_place") {
       const Eigen::Vector2d next = s.path[i + 1] - s.path[i];
       const double turn = std::abs(std::atan2(d.x() * next.y() - d.y() * next.x(), d.dot(next)));
-      seconds += turn * 180.0 / M_PI / s.robot.turn_rate_dps;
+      seconds += turn * 180.0 / M_PI / s.robot.turn_rate_dps + s.robot.stop_s;
     }
+  }
+  if (std::isfinite(s.robot.final_heading_deg) && s.path.size() >= 2) {  // the final turn
+    const Eigen::Vector2d d = s.path.back() - s.path[s.path.size() - 2];
+    const double h = s.robot.final_heading_deg * M_PI / 180.0 - std::atan2(d.y(), d.x());
+    seconds +=
+        std::abs(std::atan2(std::sin(h), std::cos(h))) * 180.0 / M_PI / s.robot.turn_rate_dps;
   }
   seconds = std::min(seconds, s.max_duration_s);
   return static_cast<int>(std::floor(seconds * s.rate_hz)) + 1;
@@ -186,6 +193,10 @@ bool Scenario::IsValid(std::string* error) const {
     e << "robot.corner_mode: expected 'in_place' or 'arc', got '" << robot.corner_mode << "'";
   else if (!(robot.goal_tolerance_m > 0))
     e << "robot.goal_tolerance_m: expected > 0";
+  else if (!(robot.stop_s >= 0 && robot.stop_s <= 600))
+    e << "robot.stop_s: expected in [0, 600] s";
+  else if (std::isinf(robot.final_heading_deg))
+    e << "robot.final_heading_deg: expected a finite angle (or none)";
   else if (camera.width < 16 || camera.width > 4096 || camera.height < 16 || camera.height > 4096)
     e << "camera.width/height: expected 16..4096, got " << camera.width << "x" << camera.height;
   else if (!(camera.fovy_deg > kMinFovDeg && camera.fovy_deg < kMaxFovDeg))
@@ -259,12 +270,24 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   constexpr int kIntMax = std::numeric_limits<int>::max();
   r.CheckKeys(root, "",
               {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
-               "robot", "scene", "seed", "settle_s", "textures", "imu", "navigation"});
+               "robot", "scene", "floor_plan", "route", "seed", "settle_s", "textures", "imu",
+               "navigation"});
   r.String(root, "", "name", &s.name);
-  std::string scene;
+  // The scene: an MJCF file, or a floor plan it is generated from (sim/floor_plan.h).
+  std::string scene, floor_plan;
   r.String(root, "", "scene", &scene);
-  r.Check(!scene.empty(), root, "", "scene",
-          "required: the MJCF scene file (relative to the scenario file)");
+  r.String(root, "", "floor_plan", &floor_plan);
+  r.Check(scene.empty() || floor_plan.empty(), root, "", "floor_plan",
+          "give scene (an MJCF file) or floor_plan (a floor-plan YAML), not both");
+  r.Check(!scene.empty() || !floor_plan.empty(), root, "", "scene",
+          "required: the MJCF scene file, or floor_plan: a floor-plan YAML (relative to the "
+          "scenario file)");
+  r.Check(scene.empty() || !IsFloorPlanPath(scene), root, "", "scene",
+          "'" + scene + "' is a YAML file: a floor plan is given as floor_plan:");
+  r.Check(floor_plan.empty() || IsFloorPlanPath(floor_plan), root, "", "floor_plan",
+          "expected a .yaml or .yml floor plan, got '" + floor_plan + "'");
+  const std::string scene_key = floor_plan.empty() ? "scene" : "floor_plan";
+  if (!floor_plan.empty()) scene = floor_plan;
   r.Uint64(root, "", "seed", &s.seed);
   r.Double(root, "", "rate_hz", &s.rate_hz);
   r.Double(root, "", "physics_dt_s", &s.physics_dt_s);
@@ -276,9 +299,23 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
 
   // path: a sequence of [x, y] pairs.
   std::vector<std::pair<double, double>> path;
-  if (r.Require(root, "", "path", "a list of at least 2 waypoints [x, y] (m)") &&
-      r.ReadPairs(root["path"], "path", &path, "a list of waypoints [x, y] (m)",
-                  "a pair [x, y] (m)")) {
+  // route: {from: PLACE, to: PLACE}, the path planned through the floor plan (below).
+  std::string route_from, route_to;
+  const bool route = YamlReader::Has(root, "route");
+  if (route) {
+    const YAML::Node n = root["route"];
+    r.Check(!YamlReader::Has(root, "path"), root, "", "path",
+            "give path (waypoints) or route (planned between two places), not both");
+    r.Check(!floor_plan.empty(), root, "", "route",
+            "a route is planned through a floor plan: give floor_plan:");
+    r.CheckKeys(n, "route", {"from", "to"});
+    r.Require(n, "route", "from", "a place of the floor plan");
+    r.Require(n, "route", "to", "a place of the floor plan");
+    r.String(n, "route", "from", &route_from, false);
+    r.String(n, "route", "to", &route_to, false);
+  } else if (r.Require(root, "", "path", "a list of at least 2 waypoints [x, y] (m)") &&
+             r.ReadPairs(root["path"], "path", &path, "a list of waypoints [x, y] (m)",
+                         "a pair [x, y] (m)")) {
     for (const auto& [x, y] : path) s.path.emplace_back(x, y);
     r.Check(s.path.size() >= 2, root, "", "path",
             "expected at least 2 waypoints, got " + std::to_string(s.path.size()));
@@ -287,7 +324,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   if (const YAML::Node n = root["robot"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(n, "robot",
                 {"corner_mode", "goal_tolerance_m", "lookahead_m", "max_accel_mps2", "speed_mps",
-                 "turn_rate_dps"});
+                 "turn_rate_dps", "stop_s", "final_heading_deg"});
     RobotOptions& o = s.robot;
     r.Double(n, "robot", "speed_mps", &o.speed_mps);
     r.Check(o.speed_mps > 0 && o.speed_mps <= 3, n, "robot", "speed_mps",
@@ -304,6 +341,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
             "expected 'in_place' or 'arc', got '" + o.corner_mode + "'");
     r.Double(n, "robot", "goal_tolerance_m", &o.goal_tolerance_m);
     r.Check(o.goal_tolerance_m > 0, n, "robot", "goal_tolerance_m", "expected > 0");
+    r.Double(n, "robot", "stop_s", &o.stop_s);
+    r.Check(o.stop_s >= 0 && o.stop_s <= 600, n, "robot", "stop_s", "expected in [0, 600] s");
+    r.Double(n, "robot", "final_heading_deg", &o.final_heading_deg);
   }
   if (const YAML::Node n = root["camera"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(
@@ -408,8 +448,38 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   if (scene_path.is_relative()) scene_path = fs::path(base_dir) / scene_path;
   s.scene_path = scene_path.lexically_normal().string();
   if (!fs::exists(s.scene_path)) {
-    if (error) *error = source_name + ": key 'scene': file not found: " + s.scene_path;
+    if (error) *error = source_name + ": key '" + scene_key + "': file not found: " + s.scene_path;
     return false;
+  }
+  if (route) {  // the planned path: waypoints from the plan's grid planner (sim/floor_plan.h)
+    FloorPlan plan;
+    if (!LoadFloorPlan(s.scene_path, &plan, error)) return false;
+    Eigen::Vector2d ends[2];
+    const std::string names[2] = {route_from, route_to};
+    for (int k = 0; k < 2; ++k) {
+      bool found = false;
+      std::string known;
+      for (const auto& [name, at] : plan.places) {
+        known += (known.empty() ? "" : ", ") + name;
+        if (name == names[k]) {
+          ends[k] = at;
+          found = true;
+        }
+      }
+      if (!found) {
+        r.Fail(root["route"][k == 0 ? "from" : "to"], k == 0 ? "route.from" : "route.to",
+               "no place '" + names[k] + "' in " + s.scene_path +
+                   " (places: " + (known.empty() ? "none" : known) + ")");
+        return r.Report(error);
+      }
+    }
+    std::string why;
+    // The planner keeps 5 cm more than the path check needs: its grid steps may pass a little
+    // closer than their ends.
+    if (!PlanPath(plan, ends[0], ends[1], kRobotClearanceM + 0.05, &s.path, &why)) {
+      r.Fail(root["route"], "route", why);
+      return r.Report(error);
+    }
   }
   if (s.name.empty()) s.name = fs::path(source_name).stem().string();
   s.source_path = source_name;
@@ -453,7 +523,8 @@ std::string ScenarioToYaml(const Scenario& s) {
   out.SetDoublePrecision(17);
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << s.name;
-  out << YAML::Key << "scene" << YAML::Value << s.scene_path;
+  out << YAML::Key << (IsFloorPlanPath(s.scene_path) ? "floor_plan" : "scene") << YAML::Value
+      << s.scene_path;
   out << YAML::Key << "seed" << YAML::Value << s.seed;
   out << YAML::Key << "rate_hz" << YAML::Value << s.rate_hz;
   out << YAML::Key << "physics_dt_s" << YAML::Value << s.physics_dt_s;
@@ -469,7 +540,12 @@ std::string ScenarioToYaml(const Scenario& s) {
       << s.robot.max_accel_mps2 << YAML::Key << "turn_rate_dps" << YAML::Value
       << s.robot.turn_rate_dps << YAML::Key << "lookahead_m" << YAML::Value << s.robot.lookahead_m
       << YAML::Key << "corner_mode" << YAML::Value << s.robot.corner_mode << YAML::Key
-      << "goal_tolerance_m" << YAML::Value << s.robot.goal_tolerance_m << YAML::EndMap;
+      << "goal_tolerance_m" << YAML::Value << s.robot.goal_tolerance_m;
+  // The path's goals only where set: effective scenarios without them read as before.
+  if (s.robot.stop_s != 0.0) out << YAML::Key << "stop_s" << YAML::Value << s.robot.stop_s;
+  if (std::isfinite(s.robot.final_heading_deg))
+    out << YAML::Key << "final_heading_deg" << YAML::Value << s.robot.final_heading_deg;
+  out << YAML::EndMap;
   out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap << YAML::Key << "width"
       << YAML::Value << s.camera.width << YAML::Key << "height" << YAML::Value << s.camera.height
       << YAML::Key << "fovy_deg" << YAML::Value << s.camera.fovy_deg << YAML::Key << "baseline_m"

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -19,8 +20,13 @@ struct RobotOptions {
   std::string corner_mode = "in_place";  // "in_place": stop and rotate at corners; "arc": cut
                                          // corners on an arc (pure pursuit over the polyline)
   double goal_tolerance_m = 0.02;  // a waypoint counts as reached within this distance (m), > 0
-  double wheel_radius_m = 0.095;   // driven-wheel radius (m), as in the MJCF robot
-  double track_m = 0.33;           // distance between the driven wheels (m), as in the MJCF robot
+  // in_place corners: stand still this long at each corner before turning (s), in [0, 600].
+  double stop_s = 0.0;
+  // At the last waypoint: turn in place to this yaw (deg, counter-clockwise from +x); NaN (the
+  // default): stop facing along the last segment.
+  double final_heading_deg = std::numeric_limits<double>::quiet_NaN();
+  double wheel_radius_m = 0.095;  // driven-wheel radius (m), as in the MJCF robot
+  double track_m = 0.33;          // distance between the driven wheels (m), as in the MJCF robot
 };
 
 // Plausible ranges, shared by the scenario reader and the dataset readers (harness/dataset/):
@@ -83,7 +89,8 @@ struct ImuOptions {
 struct Scenario {
   std::string name;             // scenario name (file stem unless given)
   std::string source_path;      // the YAML file it was read from (empty if built in code)
-  std::string scene_path;       // MJCF scene, resolved to an absolute path
+  std::string scene_path;       // MJCF scene, or a floor plan (.yaml, sim/floor_plan.h) the
+                                // scene is generated from; resolved to an absolute path
   uint64_t seed = 1;            // noise seed
   double rate_hz = 10.0;        // camera frame rate (Hz), > 0, at most 1 / physics_dt_s, and
                                 // the frame period a whole number of physics steps (frames are

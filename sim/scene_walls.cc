@@ -8,6 +8,8 @@
 #include <limits>
 #include <sstream>
 
+#include "sim/floor_plan.h"
+
 namespace sim {
 namespace {
 
@@ -74,27 +76,14 @@ void WallsOfModel(const mjModel* m, std::vector<SceneWall>* walls,
 
 bool WallsOfScene(const std::string& scene_path, std::vector<SceneWall>* walls, std::string* error,
                   std::vector<SceneFloor>* floors) {
-  char load_error[1024] = "";
-  mjModel* m = mj_loadXML(scene_path.c_str(), nullptr, load_error, sizeof(load_error));
-  if (!m) {
-    *error = scene_path + ": cannot load MJCF scene: " + load_error;
-    return false;
-  }
+  mjModel* m = LoadSceneModel(scene_path, error);  // MJCF or a floor plan
+  if (!m) return false;
   WallsOfModel(m, walls, floors);
   mj_deleteModel(m);
   return true;
 }
 
 namespace {
-
-// Distance from point p to the segment a-b.
-double PointSegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                            const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
 
 // Where segments a0-a1 and b0-b1 cross (the parameter along a in *t), if they do.
 bool SegmentsCross(const Eigen::Vector2d& a0, const Eigen::Vector2d& a1, const Eigen::Vector2d& b0,

@@ -58,8 +58,8 @@ std::string PathProblem(const Scenario& scenario, const std::vector<SceneWall>& 
 void WallsOfModel(const mjModel* m, std::vector<SceneWall>* walls,
                   std::vector<SceneFloor>* floors = nullptr);
 
-// The walls of the MJCF scene at `scene_path` (loads it): false with *error naming the file when
-// it cannot be loaded.
+// The walls of the scene at `scene_path`, an MJCF file or a floor plan (loads it): false with
+// *error naming the file when it cannot be loaded.
 bool WallsOfScene(const std::string& scene_path, std::vector<SceneWall>* walls, std::string* error,
                   std::vector<SceneFloor>* floors = nullptr);
 

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 
+#include "sim/floor_plan.h"
 #include "sim/noise.h"
 #include "sim/path_follower.h"
 #include "sim/random.h"
@@ -73,14 +74,15 @@ Eigen::Isometry3d BodyPose(const mjData* d, int body_id) {
   return T;
 }
 
-// Fills every texture whose name starts with a known kind ("wall_", "floor_", ...) with the
-// procedural generator, sized from the plane geom that uses it.
+// Fills every texture whose name starts with a known kind ("wall_", "floor_", ...), styles
+// included ("wall-busy_", textures.h: ParseTextureName), with the procedural generator, sized
+// from the plane geom that uses it.
 bool FillTextures(mjModel* m, uint64_t seed, const std::string& scene, std::string* error) {
   for (int t = 0; t < m->ntex; ++t) {
     const std::string name = mj_id2name(m, mjOBJ_TEXTURE, t) ? mj_id2name(m, mjOBJ_TEXTURE, t) : "";
-    const std::string prefix = name.substr(0, name.find('_'));
     TextureKind kind;
-    if (name.find('_') == std::string::npos || !ParseTextureKind(prefix, &kind)) continue;
+    TextureOptions options;  // the name's styles (a floor plan's surfaces) over the defaults
+    if (!ParseTextureName(name, &kind, &options)) continue;
     if (m->tex_type[t] != mjTEXTURE_2D) {
       *error = scene + ": texture '" + name + "' must be type=\"2d\" to be generated";
       return false;
@@ -99,7 +101,6 @@ bool FillTextures(mjModel* m, uint64_t seed, const std::string& scene, std::stri
     const double width_m = 2.0 * m->geom_size[3 * geom];
     const double height_m = 2.0 * m->geom_size[3 * geom + 1];
     const int w = m->tex_width[t], h = m->tex_height[t];
-    TextureOptions options;
     options.px_per_m = w / width_m;
     cv::Mat img =
         GenerateTexture(kind, width_m, height_m, DeriveSeed(seed, HashName(name)), options);
@@ -178,12 +179,8 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   Impl& im = *sim->impl_;
   const std::string& scene = scenario.scene_path;
 
-  char load_error[1024] = "";
-  im.m = mj_loadXML(scene.c_str(), nullptr, load_error, sizeof(load_error));
-  if (!im.m) {
-    *error = scene + ": cannot load MJCF scene: " + load_error;
-    return nullptr;
-  }
+  im.m = LoadSceneModel(scene, error);  // an MJCF file or a floor plan (sim/floor_plan.h)
+  if (!im.m) return nullptr;
   mjModel* m = im.m;
   im.body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
   im.root_joint = mj_name2id(m, mjOBJ_JOINT, kRobotJoint);
@@ -281,6 +278,11 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
 
   m->vis.global.offwidth = std::max(m->vis.global.offwidth, co.width);
   m->vis.global.offheight = std::max(m->vis.global.offheight, co.height);
+  if (m->ntex > kMaxPlanTextures) {  // mjrContext holds 100: the rest would be drawn untextured
+    *error = scene + ": " + std::to_string(m->ntex) +
+             " textures; MuJoCo's renderer holds at most " + std::to_string(kMaxPlanTextures);
+    return nullptr;
+  }
   if (!FillTextures(m, scenario.textures.seed, scene, error)) return nullptr;
 
   im.renderer = OffscreenRenderer::Create(m, co.width, co.height, error);

@@ -1353,7 +1353,7 @@ double DrawHighFixture(Canvas& cv, double x_m, double y0_m, double max_w_m, Rng&
 // fixtures at eye height; radiators, extinguishers and sockets low down. Gaps between objects
 // are random and shrink with `density`; every object draws its own size and content.
 void FillWallSegment(Canvas& cv, double a_m, double b_m, bool door_left, bool door_right,
-                     double density, Rng& rng) {
+                     double density, double poster_share, Rng& rng) {
   if (b_m - a_m < 0.2) return;
   const double inv = 1.0 / std::max(density, 0.05);
   // Beside the doors.
@@ -1376,7 +1376,13 @@ void FillWallSegment(Canvas& cv, double a_m, double b_m, bool door_left, bool do
   double x = a_m + (door_left ? rng.Uniform(0.35, 0.6) : rng.Uniform(0.05, 0.5));
   const double end = b_m - (door_right ? 0.35 : 0.05);
   while (x < end - 0.1) {
-    const double u = rng.Uniform();
+    double u = rng.Uniform();
+    // Another poster share: the other kinds keep their proportions over the rest (0.3 is the
+    // default and leaves u as drawn, so default walls are unchanged bit for bit).
+    if (poster_share != 0.3 && u >= poster_share)
+      u = 0.3 + (u - poster_share) * (0.7 / (1.0 - poster_share));
+    else if (poster_share != 0.3)
+      u = 0.0;
     double w = 0.0, h = 0.0, y = 0.0;
     int kind = 0;
     if (u < 0.3) {  // poster: A1..A3 or a custom size, portrait or landscape
@@ -1598,7 +1604,7 @@ void PaintWall(Canvas& cv, double width_m, uint64_t seed, const TextureOptions& 
   const double fw = scheme.frame_w_m;
   const double door_h = std::min(door_rng.Uniform(2.0, 2.1), cv.height_m - fw - 0.12);
   std::vector<std::pair<double, double>> frames;  // [left, right] of each frame (metres)
-  if (door_h > 1.2) {
+  if (door_h > 1.2 && o.doors) {
     if (plain) {
       double centre = door_rng.Uniform(0.2, 1.0) * o.plain_door_spacing_m;
       while (true) {
@@ -1651,7 +1657,7 @@ void PaintWall(Canvas& cv, double width_m, uint64_t seed, const TextureOptions& 
   for (size_t i = 0; i <= frames.size(); ++i) {
     const double b = i < frames.size() ? frames[i].first : width_m;
     Rng seg(rng.Fork());
-    FillWallSegment(cv, a, b, i > 0, i < frames.size(), density, seg);
+    FillWallSegment(cv, a, b, i > 0, i < frames.size(), density, o.poster_share, seg);
     if (i < frames.size()) a = frames[i].second;
   }
 }
@@ -2057,6 +2063,38 @@ bool ParseTextureKind(const std::string& name, TextureKind* kind) {
   return false;
 }
 
+bool ParseTextureName(const std::string& texture_name, TextureKind* kind, TextureOptions* options) {
+  const size_t underscore = texture_name.find('_');
+  if (underscore == std::string::npos) return false;
+  const std::string prefix = texture_name.substr(0, underscore);
+  size_t dash = prefix.find('-');
+  TextureKind k;
+  if (!ParseTextureKind(prefix.substr(0, dash), &k)) return false;
+  TextureOptions o = *options;
+  while (dash != std::string::npos) {
+    const size_t next = prefix.find('-', dash + 1);
+    const std::string style =
+        prefix.substr(dash + 1, next == std::string::npos ? std::string::npos : next - dash - 1);
+    if (style == "busy") {
+      o.detail_density = 3.0;
+    } else if (style == "bare") {
+      o.detail_density = 0.0;
+    } else if (style == "posters") {
+      o.detail_density = 1.5;
+      o.poster_share = 0.9;
+    } else if (style == "furniture") {
+      o.doors = false;
+      o.skirting_height_m = 0.0;
+    } else {
+      return false;
+    }
+    dash = next;
+  }
+  *kind = k;
+  *options = o;
+  return true;
+}
+
 const char* TextureKindName(TextureKind kind) {
   switch (kind) {
     case TextureKind::kWall:
@@ -2103,7 +2141,9 @@ bool TextureOptions::IsValid(std::string* error) const {
                  {"ceiling_grid_width_m", ceiling_grid_width_m, 0.0, false},
                  {"ceiling_panel_m", ceiling_panel_m, ceiling_grid_width_m, true},
                  {"plain_shading_amplitude", plain_shading_amplitude, 0.0, false},
-                 {"plain_grain_amplitude", plain_grain_amplitude, 0.0, false}};
+                 {"plain_grain_amplitude", plain_grain_amplitude, 0.0, false},
+                 {"poster_share", poster_share, 0.0, false}};
+  if (!(poster_share < 1.0)) return fail("poster_share must be < 1");
   for (const auto& f : kFields) {
     if (!std::isfinite(f.value)) return fail(std::string(f.name) + " must be finite");
     if (f.strict ? !(f.value > f.min) : !(f.value >= f.min)) {

@@ -39,6 +39,19 @@ const char* TextureKindName(TextureKind kind);
 // True for kPlainWall, kPlainFloor, kPlainCeiling.
 bool IsPlainTexture(TextureKind kind);
 
+struct TextureOptions;
+
+// Surface styles a texture name may add to its kind (scenes/README.md, "Textures"): the name of
+// a generated texture is "KIND[-STYLE...]_REST", KIND one of ParseTextureKind()'s names:
+//   busy       rich kinds: three times the objects and marks (detail_density 3)
+//   bare       rich kinds: no objects or marks (detail_density 0): plaster, tiles, panels only
+//   posters    rich walls: posters are 90 % of the eye-height objects, 1.5 times as many
+//   furniture  walls: no doors, no skirting (the sides of a cabinet, a desk, a pillar)
+// A name without styles ("wall_south") gives the kind with default options, as before styles.
+// Returns false (kind and options untouched) when the part before the first '_' is not
+// KIND[-STYLE...] with known names; *options gets the styles applied over its current values.
+bool ParseTextureName(const std::string& texture_name, TextureKind* kind, TextureOptions* options);
+
 struct TextureOptions {
   double px_per_m = 256.0;       // texture resolution (texels per metre), > 0
   double grain_amplitude = 5.0;  // rich kinds: peak of the per-texel grain (grey levels), >= 0
@@ -64,6 +77,9 @@ struct TextureOptions {
       2.0;  // plain kinds: peak low-frequency shading (grey levels), >= 0
   double plain_grain_amplitude = 0.8;  // plain kinds: peak per-texel grain (grey levels), >= 0
   bool tinted = true;  // true: slightly coloured surfaces and objects; false: B = G = R everywhere
+  bool doors = true;   // walls: door frames painted (false: none, as on furniture)
+  double poster_share = 0.3;  // rich walls: share of the eye-height objects that are posters
+                              // (the rest: boards, pictures, whiteboards, signs, ...), [0, 1)
 
   // True when every field is finite and in range; otherwise fills *error (may be null).
   bool IsValid(std::string* error) const;
