@@ -11,12 +11,15 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
 #include <thread>
 
 #include "harness/interrupt.h"
 #include "harness/progress.h"
 #include "harness/sim_adapter.h"
 #include "harness/suite/spec.h"
+#include "sim/floor_plan.h"
 
 namespace harness {
 
@@ -30,11 +33,43 @@ constexpr const char* kIndexFile = "sequence.json";
 constexpr const char* kFramesFile = "frames.bin";
 constexpr auto kLockPoll = std::chrono::milliseconds(100);  // waiting for a sequence's writer
 
-// The scenario as the entry records it: its YAML without the name (the run's id in a suite).
+// Appends the bytes of `path` (or a line saying it is missing: the simulator then fails with
+// its own message) and of every MJCF file it includes, to `text`.
+void AppendSceneFile(const fs::path& path, int depth, std::string* text) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    *text += "missing: " + path.string() + "\n";
+    return;
+  }
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  const std::string content = bytes.str();
+  *text += path.string() + " " + std::to_string(content.size()) + "\n" + content;
+  if (depth >= 8) return;  // MuJoCo refuses deeper include chains anyway
+  static const std::regex kInclude(R"re(<include\s+file\s*=\s*["']([^"']+)["'])re");
+  for (std::sregex_iterator it(content.begin(), content.end(), kInclude), end; it != end; ++it)
+    AppendSceneFile(path.parent_path() / (*it)[1].str(), depth + 1, text);
+}
+
+// FNV-1a of the scene's files as they are now: the MJCF and the files it includes, or the floor
+// plan and the robot it includes. The scenario's YAML names the scene by path only; without this
+// an entry kept across calls would give the frames of a scene file since edited.
+std::string SceneFilesHash(const std::string& scene_path) {
+  std::string text;
+  AppendSceneFile(scene_path, 0, &text);
+  sim::FloorPlan plan;
+  std::string ignored;
+  if (sim::IsFloorPlanPath(scene_path) && sim::LoadFloorPlan(scene_path, &plan, &ignored))
+    AppendSceneFile(plan.robot_path, 0, &text);
+  return Fnv1aHex(text);
+}
+
+// The scenario as the entry records it: its YAML without the name (the run's id in a suite),
+// and the hash of its scene's files.
 std::string KeyYaml(const sim::Scenario& scenario) {
   sim::Scenario s = scenario;
   s.name.clear();
-  return sim::ScenarioToYaml(s);
+  return sim::ScenarioToYaml(s) + "# scene files: " + SceneFilesHash(s.scene_path) + "\n";
 }
 
 // --- A frame's record: plain bytes in, plain bytes out. ---

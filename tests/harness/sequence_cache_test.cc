@@ -149,6 +149,25 @@ TEST(SequenceCacheTest, TheCachedFramesEqualTheSimulatedOnesBitForBit) {
   EXPECT_TRUE(harness::IsUsableSequenceCache(other, kFrames, entry, &why)) << why;
 }
 
+// The scenario names its scene by path: the key follows the scene's files by content, the MJCF
+// and what it includes, so an entry kept across calls never gives an edited scene's old frames.
+TEST(SequenceCacheTest, TheKeyFollowsTheSceneFilesContent) {
+  TempDir dir("seqcache_scene");
+  const std::string scene = vobench_test::WriteScene(dir, "");
+  const sim::Scenario scenario = vobench_test::MakeScenario(scene);
+  const std::string before = harness::SequenceCacheKey(scenario, kFrames);
+  EXPECT_EQ(harness::SequenceCacheKey(scenario, kFrames), before);  // the same files, one key
+  const std::string text = ReadAll(scene);
+  WriteText(scene, text + "<!-- edited -->\n");
+  const std::string edited_scene = harness::SequenceCacheKey(scenario, kFrames);
+  EXPECT_NE(edited_scene, before);
+  WriteText(scene, text);
+  EXPECT_EQ(harness::SequenceCacheKey(scenario, kFrames), before);
+  const std::string robot = dir / "robot_p2dx.xml";
+  WriteText(robot, ReadAll(robot) + "<!-- edited -->\n");  // the included robot
+  EXPECT_NE(harness::SequenceCacheKey(scenario, kFrames), before);
+}
+
 TEST(SequenceCacheTest, ADamagedOrPartialEntryIsNotUsed) {
   TempDir dir("seqcache_damaged");
   const sim::Scenario scenario = LHallway();
