@@ -13,10 +13,15 @@ namespace harness {
 
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
                           std::string* error) {
+  if (std::string problem = CalibrationErrorProblem(scenario, false, "the VO's camera in memory");
+      !problem.empty()) {
+    *error = problem;
+    return false;
+  }
   std::shared_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
   sequence->name = scenario.name;
-  sequence->camera = ToStereoCamera(simulator->calibration());
+  sequence->camera = ExportedStereoCamera(scenario, simulator->calibration());
   sequence->expected_frames = simulator->EstimatedFrames();
   sequence->scenario_yaml = sim::ScenarioToYaml(scenario);
   sequence->outline_scene = scenario.scene_path;

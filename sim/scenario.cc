@@ -141,6 +141,61 @@ std::string ImuProblem(const Scenario& s, std::string* key) {
   return e.str();
 }
 
+// calibration_error and frames (issue #34): "" when fine, else the problem, and *key names the
+// key to blame. Kept apart from the other checks (one block per scenario section).
+std::string CalibrationAndFramesProblem(const Scenario& s, std::string* key) {
+  const CalibrationErrorOptions& c = s.calibration_error;
+  const std::pair<const char*, double> pct[] = {{"calibration_error.baseline_pct", c.baseline_pct},
+                                                {"calibration_error.focal_pct", c.focal_pct}};
+  for (const auto& [name, v] : pct)
+    if (!(v > -100.0 && v < 1000.0)) {
+      *key = name;
+      return "expected a percentage in (-100, 1000), got " + Num(v);
+    }
+  *key = "calibration_error.rotation_deg";
+  if (!(std::abs(c.rotation_deg) < 45.0))
+    return "expected degrees in (-45, 45), got " + Num(c.rotation_deg);
+  *key = "frames.drop_rate";
+  if (!(s.frames.drop_rate >= 0.0 && s.frames.drop_rate < 1.0))
+    return "expected a fraction in [0, 1), got " + Num(s.frames.drop_rate);
+  *key = "frames.time_jitter_s";
+  const double half_period = 0.5 / s.rate_hz;
+  if (!(s.frames.time_jitter_s >= 0.0 && s.frames.time_jitter_s < half_period))
+    return "expected seconds in [0, " + Num(half_period) +
+           ") (below half the frame period at rate_hz " + Num(s.rate_hz) +
+           ", so the stamps stay in order), got " + Num(s.frames.time_jitter_s);
+  return "";
+}
+
+// Reads the calibration_error and frames sections (their ranges: CalibrationAndFramesProblem).
+void ReadCalibrationAndFrames(const YAML::Node& root, YamlReader* r, Scenario* s) {
+  if (const YAML::Node n = root["calibration_error"]; n.IsDefined() && r->ok()) {
+    r->CheckKeys(n, "calibration_error", {"baseline_pct", "focal_pct", "rotation_deg"});
+    r->Double(n, "calibration_error", "baseline_pct", &s->calibration_error.baseline_pct);
+    r->Double(n, "calibration_error", "focal_pct", &s->calibration_error.focal_pct);
+    r->Double(n, "calibration_error", "rotation_deg", &s->calibration_error.rotation_deg);
+  }
+  if (const YAML::Node n = root["frames"]; n.IsDefined() && r->ok()) {
+    r->CheckKeys(n, "frames", {"drop_rate", "time_jitter_s"});
+    r->Double(n, "frames", "drop_rate", &s->frames.drop_rate);
+    r->Double(n, "frames", "time_jitter_s", &s->frames.time_jitter_s);
+  }
+}
+
+// The two sections in ScenarioToYaml, only where they differ from the defaults (a scenario
+// without them writes the same YAML as before they existed).
+void EmitCalibrationAndFrames(const Scenario& s, YAML::Emitter* out) {
+  if (s.calibration_error.any())
+    *out << YAML::Key << "calibration_error" << YAML::Value << YAML::BeginMap << YAML::Key
+         << "baseline_pct" << YAML::Value << s.calibration_error.baseline_pct << YAML::Key
+         << "focal_pct" << YAML::Value << s.calibration_error.focal_pct << YAML::Key
+         << "rotation_deg" << YAML::Value << s.calibration_error.rotation_deg << YAML::EndMap;
+  if (s.frames.any())
+    *out << YAML::Key << "frames" << YAML::Value << YAML::BeginMap << YAML::Key << "drop_rate"
+         << YAML::Value << s.frames.drop_rate << YAML::Key << "time_jitter_s" << YAML::Value
+         << s.frames.time_jitter_s << YAML::EndMap;
+}
+
 }  // namespace
 
 int EstimatedFrames(const Scenario& s) {
@@ -220,6 +275,8 @@ bool Scenario::IsValid(std::string* error) const {
     e << key << ": " << physics;
   else if (std::string imu_key, imu = ImuProblem(*this, &imu_key); !imu.empty())
     e << imu_key << ": " << imu;
+  else if (std::string cf_key, cf = CalibrationAndFramesProblem(*this, &cf_key); !cf.empty())
+    e << cf_key << ": " << cf;
   else {
     for (size_t i = 0; i < path.size(); ++i) {
       if (!path[i].allFinite()) {
@@ -255,9 +312,10 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   }
   constexpr int kIntMin = std::numeric_limits<int>::min();
   constexpr int kIntMax = std::numeric_limits<int>::max();
-  r.CheckKeys(root, "",
-              {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
-               "robot", "scene", "seed", "settle_s", "textures", "imu"});
+  r.CheckKeys(
+      root, "",
+      {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz", "robot",
+       "scene", "seed", "settle_s", "textures", "imu", "calibration_error", "frames"});
   r.String(root, "", "name", &s.name);
   std::string scene;
   r.String(root, "", "scene", &scene);
@@ -377,6 +435,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     r.CheckKeys(n, "imu", std::vector<std::string>(std::begin(keys), std::end(keys)));
     for (size_t i = 0; i < std::size(keys) && r.ok(); ++i) r.Double(n, "imu", keys[i], values[i]);
   }
+  ReadCalibrationAndFrames(root, &r, &s);
   if (std::string key, imu = ImuProblem(s, &key);
       r.ok() && !imu.empty() && s.physics_dt_s > 0 && s.physics_dt_s <= 0.01) {
     // At the imu key's line, else at physics_dt_s (a step that the default rate does not fit).
@@ -494,6 +553,7 @@ std::string ScenarioToYaml(const Scenario& s) {
            {"yaw_deg", imu.yaw_deg}})
     out << YAML::Key << k << YAML::Value << v;
   out << YAML::EndMap;
+  EmitCalibrationAndFrames(s, &out);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

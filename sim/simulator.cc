@@ -313,7 +313,33 @@ int Simulator::EstimatedFrames() const {
   return static_cast<int>(t * scenario_.rate_hz) + 1;
 }
 
+FrameFate FrameFateOf(const FrameOptions& options, uint64_t seed, int index) {
+  FrameFate fate;
+  if (!options.any()) return fate;
+  SplitMix64 rng(DeriveSeed(seed, static_cast<uint64_t>(index), 3));
+  fate.dropped = rng.Uniform() < options.drop_rate;
+  const double u = rng.Uniform();
+  // Frame 0 is the clock's origin: its stamp stays 0 (no stamp before the sequence starts).
+  fate.jitter_s = index == 0 ? 0.0 : options.time_jitter_s * (2.0 * u - 1.0);
+  return fate;
+}
+
 bool Simulator::Next(StereoFrame* frame, std::string* error) {
+  const FrameOptions& options = scenario_.frames;
+  if (!options.any()) return Capture(frame, error);
+  std::vector<ImuSample> imu;  // the samples of dropped frames, for the next frame kept
+  while (Capture(frame, error)) {
+    imu.insert(imu.end(), frame->imu.begin(), frame->imu.end());
+    const FrameFate fate = FrameFateOf(options, scenario_.seed, frame->index);
+    if (fate.dropped) continue;
+    frame->time_s += fate.jitter_s;
+    frame->imu = std::move(imu);
+    return true;
+  }
+  return false;
+}
+
+bool Simulator::Capture(StereoFrame* frame, std::string* error) {
   error->clear();
   Impl& im = *impl_;
   if (im.finished) return false;

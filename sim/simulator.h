@@ -50,7 +50,11 @@ class Simulator {
   ~Simulator();
 
   // Advances the physics to the next frame and renders it. Returns false at the end of the
-  // path (then *error is empty) or on a failure (then *error says what happened).
+  // path (then *error is empty) or on a failure (then *error says what happened). With the
+  // scenario's frames.drop_rate, dropped frames are captured and discarded (their IMU samples go
+  // with the next frame kept; a kept frame keeps its index and time, so the stamps have gaps);
+  // with frames.time_jitter_s the frame's time_s is its capture time plus the jitter
+  // (sim/scenario.h FrameOptions; FrameFate gives both).
   bool Next(StereoFrame* frame, std::string* error);
 
   const StereoCalibration& calibration() const { return calibration_; }
@@ -64,11 +68,22 @@ class Simulator {
  private:
   struct Impl;
   explicit Simulator(const Scenario& scenario);
+  bool Capture(StereoFrame* frame, std::string* error);  // the next frame, none dropped
   Scenario scenario_;
   StereoCalibration calibration_;
   std::vector<Eigen::Vector3d> body_track_;
   std::unique_ptr<Impl> impl_;
 };
+
+// What frames.drop_rate and frames.time_jitter_s do to frame `index` of a scenario with `seed`:
+// whether it is dropped, and the jitter added to its stamp (s; 0 when time_jitter_s is 0). One
+// stream per frame, DeriveSeed(seed, index, 3): first draw the drop, second the jitter; frame 0
+// (the clock's origin) has none.
+struct FrameFate {
+  bool dropped = false;
+  double jitter_s = 0.0;
+};
+FrameFate FrameFateOf(const FrameOptions& options, uint64_t seed, int index);
 
 // Intrinsics of a MuJoCo camera with vertical field of view `fovy_deg` rendered at
 // width x height: square pixels, principal point at the image centre.

@@ -333,6 +333,7 @@ Eigen::Isometry3d DatasetWriter::EurocBodyCam0() const {
 bool DatasetWriter::WriteEurocCamera(int cam, double rate_hz, std::string* error) const {
   Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
   T_cam0_cam1.translation() = Eigen::Vector3d(camera_.baseline_m, 0.0, 0.0);
+  T_cam0_cam1.linear() = options_.R_cam0_cam1;
   const Eigen::Isometry3d T_body_cam0 = EurocBodyCam0();
   const Eigen::Isometry3d T_body_cam = cam == 0 ? T_body_cam0 : T_body_cam0 * T_cam0_cam1;
   const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));

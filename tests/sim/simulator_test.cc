@@ -202,6 +202,75 @@ TEST(SimulatorTest, SameScenarioAndSeedGiveIdenticalFrames) {
   EXPECT_TRUE(f.T_world_cam0.matrix() == runs[0][0].T_world_cam0.matrix());
 }
 
+TEST(SimulatorTest, FrameDropsAndStampJitterFollowTheSeed) {
+  // The fate of each frame: a pinned pattern for seed 1 (a change to the stream shows here), and
+  // the statistics over many frames: drops binomial(n, rate) within 5 sigma, jitter uniform on
+  // [-j, j] (mean 0, variance j^2 / 3, bounded), frame 0 never jittered.
+  sim::FrameOptions options;
+  options.drop_rate = 0.3;
+  options.time_jitter_s = 0.01;
+  std::string pattern;
+  for (int k = 0; k < 20; ++k) pattern += sim::FrameFateOf(options, 1, k).dropped ? 'x' : '.';
+  EXPECT_EQ(pattern, ".x...x.x.x.xx..x..xx");  // 8 of 20 at 0.3
+  EXPECT_EQ(sim::FrameFateOf(options, 7, 0).jitter_s, 0.0);
+  constexpr int kN = 100000;
+  int dropped = 0;
+  double sum = 0.0, sum2 = 0.0, largest = 0.0;
+  for (int k = 1; k <= kN; ++k) {
+    const sim::FrameFate fate = sim::FrameFateOf(options, 7, k);
+    dropped += fate.dropped;
+    sum += fate.jitter_s;
+    sum2 += fate.jitter_s * fate.jitter_s;
+    largest = std::max(largest, std::abs(fate.jitter_s));
+  }
+  EXPECT_NEAR(dropped, 0.3 * kN, 5.0 * std::sqrt(kN * 0.3 * 0.7));
+  const double j = options.time_jitter_s;
+  EXPECT_NEAR(sum / kN, 0.0, 5.0 * j / std::sqrt(3.0 * kN));
+  EXPECT_NEAR(sum2 / kN, j * j / 3.0, 5.0 * j * j * std::sqrt(4.0 / 45.0 / kN));
+  EXPECT_LE(largest, j);
+  EXPECT_GT(largest, 0.999 * j);
+  options = sim::FrameOptions();  // off: nothing dropped, no jitter
+  EXPECT_FALSE(sim::FrameFateOf(options, 7, 3).dropped);
+  EXPECT_EQ(sim::FrameFateOf(options, 7, 3).jitter_s, 0.0);
+
+  // In the simulator: the kept frames are the undropped sequence's frames at their index, their
+  // stamps the capture time plus the frame's jitter, and no IMU sample is lost with a drop.
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  s.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.6, 0)};
+  std::vector<sim::StereoFrame> all, kept;
+  size_t all_imu = 0, kept_imu = 0;
+  for (auto* run : {&all, &kept}) {
+    if (run == &kept) s.frames = {0.3, 0.02};
+    auto simulator = sim::Simulator::Create(s, &error);
+    ASSERT_TRUE(simulator) << error;
+    sim::StereoFrame f;
+    while (simulator->Next(&f, &error)) {
+      (run == &all ? all_imu : kept_imu) += f.imu.size();
+      run->push_back(f);
+    }
+    ASSERT_TRUE(error.empty()) << error;
+  }
+  ASSERT_GT(all.size(), 10u);
+  size_t expected_kept = 0, drops_before_last = 0;
+  for (size_t k = 0; k < all.size(); ++k)
+    if (!sim::FrameFateOf(s.frames, s.seed, static_cast<int>(k)).dropped) ++expected_kept;
+  EXPECT_EQ(kept.size(), expected_kept);
+  EXPECT_LT(kept.size(), all.size());
+  for (const sim::StereoFrame& f : kept) {
+    ASSERT_LT(static_cast<size_t>(f.index), all.size());
+    const sim::StereoFrame& same = all[f.index];
+    EXPECT_EQ(cv::norm(f.left, same.left, cv::NORM_INF), 0) << f.index;
+    EXPECT_EQ(cv::norm(f.right, same.right, cv::NORM_INF), 0) << f.index;
+    EXPECT_TRUE(f.T_world_cam0.matrix() == same.T_world_cam0.matrix()) << f.index;
+    EXPECT_EQ(f.time_s, same.time_s + sim::FrameFateOf(s.frames, s.seed, f.index).jitter_s);
+  }
+  for (size_t k = static_cast<size_t>(kept.back().index) + 1; k < all.size(); ++k)
+    drops_before_last += all[k].imu.size();  // dropped after the last frame kept: not carried
+  EXPECT_EQ(kept_imu + drops_before_last, all_imu);
+}
+
 TEST(SimulatorTest, NoiseModelsChangeTheImageAsConfigured) {
   sim::Scenario s;
   std::string error;
