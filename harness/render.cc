@@ -29,6 +29,7 @@ DatasetWriter::Options ScenarioWriterOptions(const sim::Scenario& scenario,
   options.rig.imu_pitch_deg = scenario.imu.pitch_deg;
   options.rig.imu_yaw_deg = scenario.imu.yaw_deg;
   options.R_cam0_cam1 = ExportedRotationCam0Cam1(scenario);
+  options.lens = scenario.camera.distortion;
   return options;
 }
 

@@ -55,6 +55,10 @@ Eigen::Matrix3d ExportedRotationCam0Cam1(const sim::Scenario& scenario) {
 
 std::string CalibrationErrorProblem(const sim::Scenario& scenario, bool euroc,
                                     const std::string& where) {
+  if (!euroc && scenario.camera.distortion.any())
+    return scenario.source_path + ": camera.distortion: raw images of a lens cannot be " +
+           "exported to " + where + " (rectified images only); render it with --format euroc, " +
+           "whose sensor.yaml holds the lens for `eval --format euroc` to rectify";
   if (euroc || scenario.calibration_error.rotation_deg == 0.0) return "";
   return scenario.source_path + ": calibration_error.rotation_deg: a rotation between the " +
          "cameras cannot be exported to " + where +

@@ -42,7 +42,8 @@ vo::StereoCamera ExportedStereoCamera(const sim::Scenario& scenario,
 Eigen::Matrix3d ExportedRotationCam0Cam1(const sim::Scenario& scenario);
 
 // "" when the scenario's calibration error can be exported where it goes, else why not:
-// calibration_error.rotation_deg needs EuRoC's T_BS (`where` names the destination, e.g.
+// calibration_error.rotation_deg needs EuRoC's T_BS, camera.distortion's raw images EuRoC's
+// sensor.yaml (`where` names the destination, e.g.
 // "--format kitti", "vobench run"; euroc = true: it goes to a EuRoC sequence).
 std::string CalibrationErrorProblem(const sim::Scenario& scenario, bool euroc,
                                     const std::string& where);

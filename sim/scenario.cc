@@ -175,11 +175,48 @@ void ReadCalibrationAndFrames(const YAML::Node& root, YamlReader* r, Scenario* s
     r->Double(n, "calibration_error", "focal_pct", &s->calibration_error.focal_pct);
     r->Double(n, "calibration_error", "rotation_deg", &s->calibration_error.rotation_deg);
   }
+  if (const YAML::Node n = root["camera"].IsMap() ? root["camera"]["distortion"]
+                                                  : YAML::Node(YAML::NodeType::Undefined);
+      n.IsDefined() && r->ok()) {
+    // The lens: model radtan | equidistant (EuRoC's radial-tangential / equidistant) and its 4
+    // coefficients; MakeDistortedView (sim/lens.h) checks the lens can be rendered.
+    r->CheckKeys(n, "camera.distortion", {"model", "coeffs"});
+    std::string model;
+    r->Require(n, "camera.distortion", "model", "radtan or equidistant");
+    r->Require(n, "camera.distortion", "coeffs", "4 numbers (k1 k2 p1 p2, or k1 .. k4)");
+    r->String(n, "camera.distortion", "model", &model);
+    r->Check(!r->ok() || model == "radtan" || model == "equidistant", n, "camera.distortion",
+             "model", "expected radtan or equidistant, got '" + model + "'");
+    LensDistortion& lens = s->camera.distortion;
+    lens.model = model == "radtan" ? kRadTan : kEquidistant;
+    if (r->ok() && n["coeffs"].IsSequence() && n["coeffs"].size() == 4) {
+      lens.coeffs.assign(4, 0.0);
+      for (size_t i = 0; i < 4 && r->ok(); ++i)
+        r->ReadDouble(n["coeffs"][i], YamlReader::Item("camera.distortion.coeffs", i),
+                      &lens.coeffs[i]);
+    } else {
+      r->Check(!r->ok(), n, "camera.distortion", "coeffs",
+               "expected a list of 4 numbers (k1 k2 p1 p2 for radtan, k1 k2 k3 k4 for "
+               "equidistant)");
+    }
+    if (DistortedView view;
+        r->ok() && !MakeDistortedView(lens, 100, 100, 0, 0, 1, 1, &view, &model)) {
+      r->Fail(n, "camera.distortion", model);
+    }
+  }
   if (const YAML::Node n = root["frames"]; n.IsDefined() && r->ok()) {
     r->CheckKeys(n, "frames", {"drop_rate", "time_jitter_s"});
     r->Double(n, "frames", "drop_rate", &s->frames.drop_rate);
     r->Double(n, "frames", "time_jitter_s", &s->frames.time_jitter_s);
   }
+}
+
+// camera.distortion in ScenarioToYaml's camera map, only with a lens.
+void EmitLens(const Scenario& s, YAML::Emitter* out) {
+  if (const LensDistortion& lens = s.camera.distortion; lens.any())
+    *out << YAML::Key << "distortion" << YAML::Value << YAML::BeginMap << YAML::Key << "model"
+         << YAML::Value << (lens.model == kRadTan ? "radtan" : "equidistant") << YAML::Key
+         << "coeffs" << YAML::Value << YAML::Flow << lens.coeffs << YAML::EndMap;
 }
 
 // The two sections in ScenarioToYaml, only where they differ from the defaults (a scenario
@@ -359,9 +396,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     r.Check(o.goal_tolerance_m > 0, n, "robot", "goal_tolerance_m", "expected > 0");
   }
   if (const YAML::Node n = root["camera"]; n.IsDefined() && r.ok()) {
-    r.CheckKeys(
-        n, "camera",
-        {"baseline_m", "forward_m", "fovy_deg", "height", "height_m", "pitch_deg", "width"});
+    r.CheckKeys(n, "camera",
+                {"baseline_m", "distortion", "forward_m", "fovy_deg", "height", "height_m",
+                 "pitch_deg", "width"});
     CameraOptions& o = s.camera;
     r.Int(n, "camera", "width", kIntMin, kIntMax, &o.width);
     r.Check(o.width >= 16 && o.width <= 4096, n, "camera", "width",
@@ -528,7 +565,9 @@ std::string ScenarioToYaml(const Scenario& s) {
       << YAML::Key << "fovy_deg" << YAML::Value << s.camera.fovy_deg << YAML::Key << "baseline_m"
       << YAML::Value << s.camera.baseline_m << YAML::Key << "height_m" << YAML::Value
       << s.camera.height_m << YAML::Key << "forward_m" << YAML::Value << s.camera.forward_m
-      << YAML::Key << "pitch_deg" << YAML::Value << s.camera.pitch_deg << YAML::EndMap;
+      << YAML::Key << "pitch_deg" << YAML::Value << s.camera.pitch_deg;
+  EmitLens(s, &out);
+  out << YAML::EndMap;
   out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap << YAML::Key << "pixel_sigma"
       << YAML::Value << s.noise.pixel_sigma << YAML::Key << "gain_sigma" << YAML::Value
       << s.noise.gain_sigma << YAML::Key << "bias_sigma" << YAML::Value << s.noise.bias_sigma

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "sim/lens.h"
+
 namespace sim {
 
 // Differential-drive robot and its path-tracking controller (pure pursuit).
@@ -42,6 +44,10 @@ struct CameraOptions {
   double height_m = 1.0;     // optical centre height above the floor (m), > 0
   double forward_m = 0.15;   // optical centre ahead of the wheel axle (m)
   double pitch_deg = 0.0;    // downward tilt of the optical axis (degrees), (-80, 80)
+  // The lens (sim/lens.h): none by default (an ideal pinhole). Scenario keys
+  // camera.distortion.model (radtan | equidistant) and camera.distortion.coeffs (4 numbers);
+  // the images are then the raw, distorted ones, rendered wider and remapped.
+  LensDistortion distortion;
 };
 
 // Camera noise models; each is off at 0.

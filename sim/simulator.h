@@ -23,7 +23,8 @@ struct StereoCalibration {
   double fy_px = 0.0;
   double cx_px = 0.0;  // principal point (pixels)
   double cy_px = 0.0;
-  double baseline_m = 0.0;                                        // stereo baseline (m)
+  double baseline_m = 0.0;  // stereo baseline (m)
+  LensDistortion lens;      // both cameras' lens (none: the images are the rectified pinhole's)
   Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();  // cam0 on the robot base
   Eigen::Isometry3d T_body_imu = Eigen::Isometry3d::Identity();   // the IMU on the robot base
 };

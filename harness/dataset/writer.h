@@ -73,6 +73,9 @@ class DatasetWriter {
     // for a rectified pair; a scenario's calibration_error.rotation_deg otherwise
     // (ExportedRotationCam0Cam1, harness/sim_adapter.h). The KITTI-side files cannot hold it.
     Eigen::Matrix3d R_cam0_cam1 = Eigen::Matrix3d::Identity();
+    // EuRoC: both cameras' lens in sensor.yaml (distortion_model, distortion_coefficients); the
+    // images are then the raw ones of that lens. None: radial-tangential [0, 0, 0, 0].
+    sim::LensDistortion lens;
 
     bool IsValid(std::string* error) const;
   };

@@ -313,6 +313,34 @@ TEST_F(ScenarioFileTest, CalibrationErrorAndFrameKeysAreCheckedAndRoundTrip) {
   }
 }
 
+TEST_F(ScenarioFileTest, LensKeysAreCheckedAndRoundTrip) {
+  sim::Scenario s, again;
+  ASSERT_EQ(Load(Replace("  baseline_m: 0.12\n",
+                         "  baseline_m: 0.12\n  distortion:\n    model: equidistant\n"
+                         "    coeffs: [0.05, -0.01, 0.002, -0.0005]\n"),
+                 &s),
+            "");
+  EXPECT_EQ(s.camera.distortion.model, sim::kEquidistant);
+  EXPECT_EQ(s.camera.distortion.coeffs, (std::vector<double>{0.05, -0.01, 0.002, -0.0005}));
+  const std::string path = dir_ / "effective.yaml";
+  WriteText(path, sim::ScenarioToYaml(s));
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(path, &again, &error)) << error;
+  EXPECT_EQ(sim::ScenarioToYaml(again), sim::ScenarioToYaml(s));
+  const std::string model = Load(
+      Replace("  baseline_m: 0.12\n",
+              "  baseline_m: 0.12\n  distortion:\n    model: fisheye\n    coeffs: [0, 0, 0, 0]\n"));
+  EXPECT_NE(model.find("s.yaml:11: key 'camera.distortion.model': expected radtan or equidistant"),
+            std::string::npos)
+      << model;
+  const std::string three = Load(
+      Replace("  baseline_m: 0.12\n",
+              "  baseline_m: 0.12\n  distortion:\n    model: radtan\n    coeffs: [0, 0, 0]\n"));
+  EXPECT_NE(three.find("key 'camera.distortion.coeffs': expected a list of 4 numbers"),
+            std::string::npos)
+      << three;
+}
+
 TEST_F(ScenarioFileTest, ImuKeysAreCheckedAndRoundTrip) {
   const std::string good = std::string(kGood) +
                            "imu:\n  gyro_noise_density: 1e-4\n  accel_random_walk: 0\n"
