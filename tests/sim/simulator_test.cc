@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sim_test_util.h"
@@ -269,6 +270,41 @@ TEST(SimulatorTest, FrameDropsAndStampJitterFollowTheSeed) {
   for (size_t k = static_cast<size_t>(kept.back().index) + 1; k < all.size(); ++k)
     drops_before_last += all[k].imu.size();  // dropped after the last frame kept: not carried
   EXPECT_EQ(kept_imu + drops_before_last, all_imu);
+}
+
+TEST(SimulatorTest, DistortedRenderRectifiesBackToThePinholeRender) {
+  // The round trip: render through a radtan lens, rectify with the calibration's lens
+  // (OpenCV's initUndistortRectifyMap onto the same K), compare with the pinhole render of the
+  // same frame: closer than the pinhole render is to itself shifted by half a pixel.
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  s.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.6, 0)};
+  s.noise = sim::NoiseOptions();
+  sim::StereoFrame pinhole, raw;
+  for (auto* f : {&pinhole, &raw}) {
+    if (f == &raw) s.camera.distortion = {sim::kRadTan, {-0.28, 0.07, 0.0002, 0.00002}};
+    auto simulator = sim::Simulator::Create(s, &error);
+    ASSERT_TRUE(simulator) << error;
+    ASSERT_TRUE(simulator->Next(f, &error)) << error;
+    EXPECT_EQ(simulator->calibration().lens.model, s.camera.distortion.model);
+  }
+  ASSERT_EQ(raw.left.size(), pinhole.left.size());
+  const double f = 0.5 * s.camera.height / std::tan(0.5 * s.camera.fovy_deg * M_PI / 180.0);
+  const cv::Matx33d K(f, 0, 0.5 * (s.camera.width - 1), 0, f, 0.5 * (s.camera.height - 1), 0, 0, 1);
+  cv::Mat map_x, map_y, rectified, shifted;
+  cv::initUndistortRectifyMap(K, cv::Mat(s.camera.distortion.coeffs, true), cv::Matx33d::eye(), K,
+                              raw.left.size(), CV_32FC1, map_x, map_y);
+  cv::remap(raw.left, rectified, map_x, map_y, cv::INTER_LINEAR);
+  const cv::Matx23d half_px(1, 0, 0.5, 0, 1, 0);
+  cv::warpAffine(pinhole.left, shifted, half_px, pinhole.left.size());
+  const cv::Rect inner(20, 20, s.camera.width - 40, s.camera.height - 40);
+  cv::Mat a, b;
+  cv::absdiff(rectified(inner), pinhole.left(inner), a);
+  cv::absdiff(shifted(inner), pinhole.left(inner), b);
+  const double round_trip = cv::mean(a)[0], half_pixel = cv::mean(b)[0];
+  EXPECT_LT(round_trip, half_pixel) << "grey levels";
+  EXPECT_GT(cv::norm(raw.left, pinhole.left, cv::NORM_L1), 0);  // the lens did change the image
 }
 
 TEST(SimulatorTest, NoiseModelsChangeTheImageAsConfigured) {
