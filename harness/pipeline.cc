@@ -13,6 +13,11 @@ namespace harness {
 
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
                           std::string* error) {
+  if (std::string problem = CalibrationErrorProblem(scenario, false, "the VO's camera in memory");
+      !problem.empty()) {
+    *error = problem;
+    return false;
+  }
   std::shared_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
   DescribeScenarioSequence(scenario, simulator->calibration(), simulator->EstimatedFrames(),
@@ -49,7 +54,7 @@ void DescribeScenarioSequence(const sim::Scenario& scenario,
                               const sim::StereoCalibration& calibration, int expected_frames,
                               StereoSequence* sequence) {
   sequence->name = scenario.name;
-  sequence->camera = ToStereoCamera(calibration);
+  sequence->camera = ExportedStereoCamera(scenario, calibration);
   sequence->expected_frames = expected_frames;
   sequence->scenario_yaml = sim::ScenarioToYaml(scenario);
   sequence->outline_scene = scenario.scene_path;

@@ -28,12 +28,21 @@ DatasetWriter::Options ScenarioWriterOptions(const sim::Scenario& scenario,
   options.rig.imu_roll_deg = scenario.imu.roll_deg;
   options.rig.imu_pitch_deg = scenario.imu.pitch_deg;
   options.rig.imu_yaw_deg = scenario.imu.yaw_deg;
+  options.R_cam0_cam1 = ExportedRotationCam0Cam1(scenario);
+  options.lens = scenario.camera.distortion;
   return options;
 }
 
 bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
                     const RenderOptions& options, RenderSummary* summary, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
+  if (const std::string problem =
+          CalibrationErrorProblem(scenario, options.format == DatasetFormat::kEuroc,
+                                  std::string("--format ") + DatasetFormatName(options.format));
+      !problem.empty()) {
+    *error = problem;
+    return false;
+  }
   std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
   DatasetWriter::Options wopt =
@@ -43,7 +52,8 @@ bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
   // EuRoC's body with the IMU: the cameras' T_BS relative to it, imu0/ from the frames' samples.
   wopt.T_body_imu = simulator->calibration().T_body_imu;
   DatasetWriter writer(wopt);
-  if (!writer.Open(out_dir, ToStereoCamera(simulator->calibration()), error)) return false;
+  if (!writer.Open(out_dir, ExportedStereoCamera(scenario, simulator->calibration()), error))
+    return false;
 
   Progress progress("render " + scenario.name, simulator->EstimatedFrames(), options.progress);
   sim::StereoFrame frame;

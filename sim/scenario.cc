@@ -142,6 +142,98 @@ std::string ImuProblem(const Scenario& s, std::string* key) {
   return e.str();
 }
 
+// calibration_error and frames (issue #34): "" when fine, else the problem, and *key names the
+// key to blame. Kept apart from the other checks (one block per scenario section).
+std::string CalibrationAndFramesProblem(const Scenario& s, std::string* key) {
+  const CalibrationErrorOptions& c = s.calibration_error;
+  const std::pair<const char*, double> pct[] = {{"calibration_error.baseline_pct", c.baseline_pct},
+                                                {"calibration_error.focal_pct", c.focal_pct}};
+  for (const auto& [name, v] : pct)
+    if (!(v > -100.0 && v < 1000.0)) {
+      *key = name;
+      return "expected a percentage in (-100, 1000), got " + Num(v);
+    }
+  *key = "calibration_error.rotation_deg";
+  if (!(std::abs(c.rotation_deg) < 45.0))
+    return "expected degrees in (-45, 45), got " + Num(c.rotation_deg);
+  *key = "frames.drop_rate";
+  if (!(s.frames.drop_rate >= 0.0 && s.frames.drop_rate < 1.0))
+    return "expected a fraction in [0, 1), got " + Num(s.frames.drop_rate);
+  *key = "frames.time_jitter_s";
+  const double half_period = 0.5 / s.rate_hz;
+  if (!(s.frames.time_jitter_s >= 0.0 && s.frames.time_jitter_s < half_period))
+    return "expected seconds in [0, " + Num(half_period) +
+           ") (below half the frame period at rate_hz " + Num(s.rate_hz) +
+           ", so the stamps stay in order), got " + Num(s.frames.time_jitter_s);
+  return "";
+}
+
+// Reads the calibration_error and frames sections (their ranges: CalibrationAndFramesProblem).
+void ReadCalibrationAndFrames(const YAML::Node& root, YamlReader* r, Scenario* s) {
+  if (const YAML::Node n = root["calibration_error"]; n.IsDefined() && r->ok()) {
+    r->CheckKeys(n, "calibration_error", {"baseline_pct", "focal_pct", "rotation_deg"});
+    r->Double(n, "calibration_error", "baseline_pct", &s->calibration_error.baseline_pct);
+    r->Double(n, "calibration_error", "focal_pct", &s->calibration_error.focal_pct);
+    r->Double(n, "calibration_error", "rotation_deg", &s->calibration_error.rotation_deg);
+  }
+  if (const YAML::Node n = root["camera"].IsMap() ? root["camera"]["distortion"]
+                                                  : YAML::Node(YAML::NodeType::Undefined);
+      n.IsDefined() && r->ok()) {
+    // The lens: model radtan | equidistant (EuRoC's radial-tangential / equidistant) and its 4
+    // coefficients; MakeDistortedView (sim/lens.h) checks the lens can be rendered.
+    r->CheckKeys(n, "camera.distortion", {"model", "coeffs"});
+    std::string model;
+    r->Require(n, "camera.distortion", "model", "radtan or equidistant");
+    r->Require(n, "camera.distortion", "coeffs", "4 numbers (k1 k2 p1 p2, or k1 .. k4)");
+    r->String(n, "camera.distortion", "model", &model);
+    r->Check(!r->ok() || model == "radtan" || model == "equidistant", n, "camera.distortion",
+             "model", "expected radtan or equidistant, got '" + model + "'");
+    LensDistortion& lens = s->camera.distortion;
+    lens.model = model == "radtan" ? kRadTan : kEquidistant;
+    if (r->ok() && n["coeffs"].IsSequence() && n["coeffs"].size() == 4) {
+      lens.coeffs.assign(4, 0.0);
+      for (size_t i = 0; i < 4 && r->ok(); ++i)
+        r->ReadDouble(n["coeffs"][i], YamlReader::Item("camera.distortion.coeffs", i),
+                      &lens.coeffs[i]);
+    } else {
+      r->Check(!r->ok(), n, "camera.distortion", "coeffs",
+               "expected a list of 4 numbers (k1 k2 p1 p2 for radtan, k1 k2 k3 k4 for "
+               "equidistant)");
+    }
+    if (DistortedView view;
+        r->ok() && !MakeDistortedView(lens, 100, 100, 0, 0, 1, 1, &view, &model)) {
+      r->Fail(n, "camera.distortion", model);
+    }
+  }
+  if (const YAML::Node n = root["frames"]; n.IsDefined() && r->ok()) {
+    r->CheckKeys(n, "frames", {"drop_rate", "time_jitter_s"});
+    r->Double(n, "frames", "drop_rate", &s->frames.drop_rate);
+    r->Double(n, "frames", "time_jitter_s", &s->frames.time_jitter_s);
+  }
+}
+
+// camera.distortion in ScenarioToYaml's camera map, only with a lens.
+void EmitLens(const Scenario& s, YAML::Emitter* out) {
+  if (const LensDistortion& lens = s.camera.distortion; lens.any())
+    *out << YAML::Key << "distortion" << YAML::Value << YAML::BeginMap << YAML::Key << "model"
+         << YAML::Value << (lens.model == kRadTan ? "radtan" : "equidistant") << YAML::Key
+         << "coeffs" << YAML::Value << YAML::Flow << lens.coeffs << YAML::EndMap;
+}
+
+// The two sections in ScenarioToYaml, only where they differ from the defaults (a scenario
+// without them writes the same YAML as before they existed).
+void EmitCalibrationAndFrames(const Scenario& s, YAML::Emitter* out) {
+  if (s.calibration_error.any())
+    *out << YAML::Key << "calibration_error" << YAML::Value << YAML::BeginMap << YAML::Key
+         << "baseline_pct" << YAML::Value << s.calibration_error.baseline_pct << YAML::Key
+         << "focal_pct" << YAML::Value << s.calibration_error.focal_pct << YAML::Key
+         << "rotation_deg" << YAML::Value << s.calibration_error.rotation_deg << YAML::EndMap;
+  if (s.frames.any())
+    *out << YAML::Key << "frames" << YAML::Value << YAML::BeginMap << YAML::Key << "drop_rate"
+         << YAML::Value << s.frames.drop_rate << YAML::Key << "time_jitter_s" << YAML::Value
+         << s.frames.time_jitter_s << YAML::EndMap;
+}
+
 }  // namespace
 
 int EstimatedFrames(const Scenario& s) {
@@ -233,6 +325,8 @@ bool Scenario::IsValid(std::string* error) const {
     e << key << ": " << physics;
   else if (std::string imu_key, imu = ImuProblem(*this, &imu_key); !imu.empty())
     e << imu_key << ": " << imu;
+  else if (std::string cf_key, cf = CalibrationAndFramesProblem(*this, &cf_key); !cf.empty())
+    e << cf_key << ": " << cf;
   else {
     for (size_t i = 0; i < path.size(); ++i) {
       if (!path[i].allFinite()) {
@@ -271,7 +365,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   r.CheckKeys(root, "",
               {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
                "robot", "scene", "floor_plan", "route", "seed", "settle_s", "textures", "imu",
-               "navigation"});
+               "navigation", "calibration_error", "frames"});
   r.String(root, "", "name", &s.name);
   // The scene: an MJCF file, or a floor plan it is generated from (sim/floor_plan.h).
   std::string scene, floor_plan;
@@ -346,9 +440,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     r.Double(n, "robot", "final_heading_deg", &o.final_heading_deg);
   }
   if (const YAML::Node n = root["camera"]; n.IsDefined() && r.ok()) {
-    r.CheckKeys(
-        n, "camera",
-        {"baseline_m", "forward_m", "fovy_deg", "height", "height_m", "pitch_deg", "width"});
+    r.CheckKeys(n, "camera",
+                {"baseline_m", "distortion", "forward_m", "fovy_deg", "height", "height_m",
+                 "pitch_deg", "width"});
     CameraOptions& o = s.camera;
     r.Int(n, "camera", "width", kIntMin, kIntMax, &o.width);
     r.Check(o.width >= 16 && o.width <= 4096, n, "camera", "width",
@@ -422,6 +516,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     r.CheckKeys(n, "imu", std::vector<std::string>(std::begin(keys), std::end(keys)));
     for (size_t i = 0; i < std::size(keys) && r.ok(); ++i) r.Double(n, "imu", keys[i], values[i]);
   }
+  ReadCalibrationAndFrames(root, &r, &s);
   if (std::string key, imu = ImuProblem(s, &key);
       r.ok() && !imu.empty() && s.physics_dt_s > 0 && s.physics_dt_s <= 0.01) {
     // At the imu key's line, else at physics_dt_s (a step that the default rate does not fit).
@@ -551,7 +646,9 @@ std::string ScenarioToYaml(const Scenario& s) {
       << YAML::Key << "fovy_deg" << YAML::Value << s.camera.fovy_deg << YAML::Key << "baseline_m"
       << YAML::Value << s.camera.baseline_m << YAML::Key << "height_m" << YAML::Value
       << s.camera.height_m << YAML::Key << "forward_m" << YAML::Value << s.camera.forward_m
-      << YAML::Key << "pitch_deg" << YAML::Value << s.camera.pitch_deg << YAML::EndMap;
+      << YAML::Key << "pitch_deg" << YAML::Value << s.camera.pitch_deg;
+  EmitLens(s, &out);
+  out << YAML::EndMap;
   out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap << YAML::Key << "pixel_sigma"
       << YAML::Value << s.noise.pixel_sigma << YAML::Key << "gain_sigma" << YAML::Value
       << s.noise.gain_sigma << YAML::Key << "bias_sigma" << YAML::Value << s.noise.bias_sigma
@@ -576,6 +673,7 @@ std::string ScenarioToYaml(const Scenario& s) {
            {"yaw_deg", imu.yaw_deg}})
     out << YAML::Key << k << YAML::Value << v;
   out << YAML::EndMap;
+  EmitCalibrationAndFrames(s, &out);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "sim/lens.h"
+
 namespace sim {
 
 // Differential-drive robot and its path-tracking controller (pure pursuit).
@@ -48,6 +50,10 @@ struct CameraOptions {
   double height_m = 1.0;     // optical centre height above the floor (m), > 0
   double forward_m = 0.15;   // optical centre ahead of the wheel axle (m)
   double pitch_deg = 0.0;    // downward tilt of the optical axis (degrees), (-80, 80)
+  // The lens (sim/lens.h): none by default (an ideal pinhole). Scenario keys
+  // camera.distortion.model (radtan | equidistant) and camera.distortion.coeffs (4 numbers);
+  // the images are then the raw, distorted ones, rendered wider and remapped.
+  LensDistortion distortion;
 };
 
 // Camera noise models; each is off at 0.
@@ -86,6 +92,36 @@ struct ImuOptions {
   double roll_deg = 0.0, pitch_deg = 0.0, yaw_deg = 0.0;  // R = Rz(yaw) Ry(pitch) Rx(roll)
 };
 
+// Calibration error (issue #34): the calibration vobench EXPORTS (render's calib.txt and EuRoC
+// sensor.yaml, the camera the VO receives in `vobench run`) differs from the true one that
+// rendered the images, to measure a VO's sensitivity to a bad calibration. The images do not
+// change. baseline_pct scales the stereo baseline by (1 + baseline_pct / 100), focal_pct both
+// focal lengths by (1 + focal_pct / 100) (the principal point stays); rotation_deg turns the
+// right camera about its own y axis (image down: a toe-in/out "yaw" between the cameras, the
+// error that biases disparity most) in EuRoC's cam1 T_BS. A rotation between the cameras has no
+// place in a rectified calibration (KITTI's calib.txt, the VO's vo::StereoCamera): it is written
+// to EuRoC only and refused elsewhere (CalibrationErrorProblem in harness/sim_adapter.h).
+// All 0 = the true calibration, byte for byte.
+struct CalibrationErrorOptions {
+  double baseline_pct = 0.0;  // baseline error (% of the true baseline), > -100
+  double focal_pct = 0.0;     // focal length error (% of the true fx, fy), > -100
+  double rotation_deg = 0.0;  // right camera turned about its y axis (degrees), |.| < 45
+  bool any() const { return baseline_pct != 0.0 || focal_pct != 0.0 || rotation_deg != 0.0; }
+};
+
+// Frame timing faults (issue #34), seeded by the scenario's seed, deterministic, each off at 0:
+// frame k is dropped when u_k < drop_rate, u_k uniform in [0, 1) from DeriveSeed(seed, k, 3)
+// (the kept frames are the very frames of the undropped sequence; their stamps keep the gaps),
+// and a kept frame's stamp is the capture time plus a jitter UNIFORM in [-time_jitter_s,
+// +time_jitter_s] from the same stream (bounded, so stamps stay in order: time_jitter_s below
+// half the frame period). The images and ground truth stay those of the capture time; only the
+// stamp is wrong, as with a camera driver's clock.
+struct FrameOptions {
+  double drop_rate = 0.0;      // fraction of frames dropped, [0, 1)
+  double time_jitter_s = 0.0;  // stamp jitter half-width (s), [0, 0.5 / rate_hz)
+  bool any() const { return drop_rate != 0.0 || time_jitter_s != 0.0; }
+};
+
 struct Scenario {
   std::string name;             // scenario name (file stem unless given)
   std::string source_path;      // the YAML file it was read from (empty if built in code)
@@ -107,6 +143,8 @@ struct Scenario {
   // What the path follower steers on (sim/navigation.h): "ground_truth" (the true pose) or "vo"
   // (the VO's estimate, frame by frame: the closed loop).
   std::string navigation = "ground_truth";
+  CalibrationErrorOptions calibration_error;
+  FrameOptions frames;
 
   bool IsValid(std::string* error) const;
 };

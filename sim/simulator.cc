@@ -134,6 +134,7 @@ struct Simulator::Impl {
   mjModel* m = nullptr;
   mjData* d = nullptr;
   std::unique_ptr<OffscreenRenderer> renderer;
+  DistortedView lens;  // with camera.distortion: the wide render and its maps to the lens
   std::unique_ptr<PathFollower> follower;
   int body = -1, root_joint = -1, act_left = -1, act_right = -1, cam0 = -1, cam1 = -1;
   long start_step = 0;    // physics step of frame time 0 (after settling)
@@ -256,6 +257,22 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   const Eigen::Vector3d centre(co.forward_m, 0.0, z_cam);
   const Eigen::Vector3d p_cam0 = centre - 0.5 * co.baseline_m * right_dir;
   const Eigen::Vector3d p_cam1 = centre + 0.5 * co.baseline_m * right_dir;
+  StereoCalibration& cal = sim->calibration_;
+  cal.width = co.width;
+  cal.height = co.height;
+  IntrinsicsFromFovy(co.fovy_deg, co.width, co.height, &cal.fx_px, &cal.fy_px, &cal.cx_px,
+                     &cal.cy_px);
+  cal.lens = co.distortion;
+  int render_width = co.width, render_height = co.height;
+  if (co.distortion.any()) {  // render wider, remap to the lens (sim/lens.h)
+    if (!MakeDistortedView(co.distortion, cal.fx_px, cal.fy_px, cal.cx_px, cal.cy_px, co.width,
+                           co.height, &im.lens, error)) {
+      *error = scenario.source_path + ": camera." + *error;
+      return nullptr;
+    }
+    render_width = im.lens.wide_width;
+    render_height = im.lens.wide_height;
+  }
   for (int k = 0; k < 2; ++k) {
     const int id = k == 0 ? im.cam0 : im.cam1;
     const Eigen::Vector3d& p = k == 0 ? p_cam0 : p_cam1;
@@ -264,20 +281,15 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
     m->cam_quat[4 * id + 1] = q_body_mjcam.x();
     m->cam_quat[4 * id + 2] = q_body_mjcam.y();
     m->cam_quat[4 * id + 3] = q_body_mjcam.z();
-    m->cam_fovy[id] = co.fovy_deg;
+    m->cam_fovy[id] = co.distortion.any() ? im.lens.wide_fovy_deg : co.fovy_deg;
     m->cam_mode[id] = mjCAMLIGHT_FIXED;
   }
-  StereoCalibration& cal = sim->calibration_;
-  cal.width = co.width;
-  cal.height = co.height;
-  IntrinsicsFromFovy(co.fovy_deg, co.width, co.height, &cal.fx_px, &cal.fy_px, &cal.cx_px,
-                     &cal.cy_px);
   cal.baseline_m = co.baseline_m;
   cal.T_body_cam0.linear() = R_body_mjcam * Eigen::Vector3d(1, -1, -1).asDiagonal();
   cal.T_body_cam0.translation() = p_cam0;
 
-  m->vis.global.offwidth = std::max(m->vis.global.offwidth, co.width);
-  m->vis.global.offheight = std::max(m->vis.global.offheight, co.height);
+  m->vis.global.offwidth = std::max(m->vis.global.offwidth, render_width);
+  m->vis.global.offheight = std::max(m->vis.global.offheight, render_height);
   if (m->ntex > kMaxPlanTextures) {  // mjrContext holds 100: the rest would be drawn untextured
     *error = scene + ": " + std::to_string(m->ntex) +
              " textures; MuJoCo's renderer holds at most " + std::to_string(kMaxPlanTextures);
@@ -285,7 +297,7 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   }
   if (!FillTextures(m, scenario.textures.seed, scene, error)) return nullptr;
 
-  im.renderer = OffscreenRenderer::Create(m, co.width, co.height, error);
+  im.renderer = OffscreenRenderer::Create(m, render_width, render_height, error);
   if (!im.renderer) {
     *error = "cannot render offscreen: " + *error;
     return nullptr;
@@ -342,7 +354,33 @@ int Simulator::EstimatedFrames() const {
   return static_cast<int>(t * scenario_.rate_hz) + 1;
 }
 
+FrameFate FrameFateOf(const FrameOptions& options, uint64_t seed, int index) {
+  FrameFate fate;
+  if (!options.any()) return fate;
+  SplitMix64 rng(DeriveSeed(seed, static_cast<uint64_t>(index), 3));
+  fate.dropped = rng.Uniform() < options.drop_rate;
+  const double u = rng.Uniform();
+  // Frame 0 is the clock's origin: its stamp stays 0 (no stamp before the sequence starts).
+  fate.jitter_s = index == 0 ? 0.0 : options.time_jitter_s * (2.0 * u - 1.0);
+  return fate;
+}
+
 bool Simulator::Next(StereoFrame* frame, std::string* error) {
+  const FrameOptions& options = scenario_.frames;
+  if (!options.any()) return Capture(frame, error);
+  std::vector<ImuSample> imu;  // the samples of dropped frames, for the next frame kept
+  while (Capture(frame, error)) {
+    imu.insert(imu.end(), frame->imu.begin(), frame->imu.end());
+    const FrameFate fate = FrameFateOf(options, scenario_.seed, frame->index);
+    if (fate.dropped) continue;
+    frame->time_s += fate.jitter_s;
+    frame->imu = std::move(imu);
+    return true;
+  }
+  return false;
+}
+
+bool Simulator::Capture(StereoFrame* frame, std::string* error) {
   error->clear();
   Impl& im = *impl_;
   if (im.finished) return false;
@@ -509,9 +547,20 @@ bool Simulator::Next(StereoFrame* frame, std::string* error) {
   // Average the exposure samples, then the per-image noise (seeded by frame and camera).
   for (int c = 0; c < 2; ++c) {
     acc[c] *= 1.0 / samples;
+    if (sc.camera.distortion.any()) {  // the lens: the wide pinhole render remapped (bilinear)
+      cv::Mat raw;
+      cv::remap(acc[c], raw, im.lens.map_x, im.lens.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+      acc[c] = raw;
+    }
     cv::Mat out =
         ApplyCameraNoise(acc[c], sc.noise, DeriveSeed(sc.seed, static_cast<uint64_t>(k), c));
     (c == 0 ? frame->left : frame->right) = out;
+  }
+  if (sc.camera.distortion.any()) {  // depth along the same rays: nearest, never blended
+    cv::Mat raw;
+    cv::remap(frame->depth_m, raw, im.lens.map_x, im.lens.map_y, cv::INTER_NEAREST,
+              cv::BORDER_REPLICATE);
+    frame->depth_m = raw;
   }
   // The IMU samples up to the frame time (a blurred frame's exposure runs past it).
   frame->imu.clear();

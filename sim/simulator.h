@@ -25,7 +25,8 @@ struct StereoCalibration {
   double fy_px = 0.0;
   double cx_px = 0.0;  // principal point (pixels)
   double cy_px = 0.0;
-  double baseline_m = 0.0;                                        // stereo baseline (m)
+  double baseline_m = 0.0;  // stereo baseline (m)
+  LensDistortion lens;      // both cameras' lens (none: the images are the rectified pinhole's)
   Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();  // cam0 on the robot base
   Eigen::Isometry3d T_body_imu = Eigen::Isometry3d::Identity();   // the IMU on the robot base
 };
@@ -52,7 +53,11 @@ class Simulator {
   ~Simulator();
 
   // Advances the physics to the next frame and renders it. Returns false at the end of the
-  // path (then *error is empty) or on a failure (then *error says what happened).
+  // path (then *error is empty) or on a failure (then *error says what happened). With the
+  // scenario's frames.drop_rate, dropped frames are captured and discarded (their IMU samples go
+  // with the next frame kept; a kept frame keeps its index and time, so the stamps have gaps);
+  // with frames.time_jitter_s the frame's time_s is its capture time plus the jitter
+  // (sim/scenario.h FrameOptions; FrameFate gives both).
   bool Next(StereoFrame* frame, std::string* error);
 
   const StereoCalibration& calibration() const { return calibration_; }
@@ -80,11 +85,22 @@ class Simulator {
  private:
   struct Impl;
   explicit Simulator(const Scenario& scenario);
+  bool Capture(StereoFrame* frame, std::string* error);  // the next frame, none dropped
   Scenario scenario_;
   StereoCalibration calibration_;
   std::vector<Eigen::Vector3d> body_track_;
   std::unique_ptr<Impl> impl_;
 };
+
+// What frames.drop_rate and frames.time_jitter_s do to frame `index` of a scenario with `seed`:
+// whether it is dropped, and the jitter added to its stamp (s; 0 when time_jitter_s is 0). One
+// stream per frame, DeriveSeed(seed, index, 3): first draw the drop, second the jitter; frame 0
+// (the clock's origin) has none.
+struct FrameFate {
+  bool dropped = false;
+  double jitter_s = 0.0;
+};
+FrameFate FrameFateOf(const FrameOptions& options, uint64_t seed, int index);
 
 // Intrinsics of a MuJoCo camera with vertical field of view `fovy_deg` rendered at
 // width x height: square pixels, principal point at the image centre.

@@ -88,7 +88,8 @@ std::string EurocTransformYaml(const Eigen::Isometry3d& T_body_sensor) {
 }
 
 std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d& T_body_cam,
-                            const vo::StereoCamera& camera, double rate_hz) {
+                            const vo::StereoCamera& camera, const sim::LensDistortion& lens,
+                            double rate_hz) {
   std::string s = kOpenCvYamlHeader;
   s += "# General sensor definitions.\n";
   s += "sensor_type: camera\n";
@@ -102,8 +103,16 @@ std::string EurocSensorYaml(const std::string& comment, const Eigen::Isometry3d&
   s += "camera_model: pinhole\n";
   s += "intrinsics: [" + FormatDouble(camera.fx_px) + ", " + FormatDouble(camera.fy_px) + ", " +
        FormatDouble(camera.cx_px) + ", " + FormatDouble(camera.cy_px) + "] #fu, fv, cu, cv\n";
-  s += "distortion_model: radial-tangential\n";
-  s += "distortion_coefficients: [0, 0, 0, 0]\n";
+  if (!lens.any()) {
+    s += "distortion_model: radial-tangential\n";
+    s += "distortion_coefficients: [0, 0, 0, 0]\n";
+  } else {
+    s += "distortion_model: " + lens.model + "\n";
+    s += "distortion_coefficients: [";
+    for (size_t i = 0; i < lens.coeffs.size(); ++i)
+      s += (i ? ", " : "") + FormatDouble(lens.coeffs[i]);
+    s += "]\n";
+  }
   return s;
 }
 
@@ -348,6 +357,7 @@ Eigen::Isometry3d DatasetWriter::EurocBodyCam0() const {
 bool DatasetWriter::WriteEurocCamera(int cam, double rate_hz, std::string* error) const {
   Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
   T_cam0_cam1.translation() = Eigen::Vector3d(camera_.baseline_m, 0.0, 0.0);
+  T_cam0_cam1.linear() = options_.R_cam0_cam1;
   const Eigen::Isometry3d T_body_cam0 = EurocBodyCam0();
   const Eigen::Isometry3d T_body_cam = cam == 0 ? T_body_cam0 : T_body_cam0 * T_cam0_cam1;
   const std::string base = Join(partial_dir_, "mav0/cam" + std::to_string(cam));
@@ -357,7 +367,7 @@ bool DatasetWriter::WriteEurocCamera(int cam, double rate_hz, std::string* error
   return WriteTextFile(Join(base, "data.csv"), csv, error) &&
          WriteTextFile(Join(base, "sensor.yaml"),
                        EurocSensorYaml(cam == 0 ? "vobench cam0 (left)" : "vobench cam1 (right)",
-                                       T_body_cam, camera_, rate_hz),
+                                       T_body_cam, camera_, options_.lens, rate_hz),
                        error);
 }
 

@@ -73,6 +73,13 @@ class DatasetWriter {
     // T_body_cam0, T_body_imu) (dataset/euroc_imu.h), T_body_imu the IMU on the same body.
     sim::ImuOptions imu;
     Eigen::Isometry3d T_body_imu = Eigen::Isometry3d::Identity();
+    // EuRoC: cam1's orientation in cam0 written in its T_BS (a rotation matrix). The identity
+    // for a rectified pair; a scenario's calibration_error.rotation_deg otherwise
+    // (ExportedRotationCam0Cam1, harness/sim_adapter.h). The KITTI-side files cannot hold it.
+    Eigen::Matrix3d R_cam0_cam1 = Eigen::Matrix3d::Identity();
+    // EuRoC: both cameras' lens in sensor.yaml (distortion_model, distortion_coefficients); the
+    // images are then the raw ones of that lens. None: radial-tangential [0, 0, 0, 0].
+    sim::LensDistortion lens;
 
     bool IsValid(std::string* error) const;
   };

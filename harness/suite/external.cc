@@ -112,7 +112,8 @@ bool WriteSequence(const ExternalRunSpec& spec, const std::string& dir, std::str
   if (!simulator) return false;
   DatasetWriter writer(
       SequenceWriterOptions(scenario, spec.stride, simulator->calibration().T_body_cam0));
-  if (!writer.Open(dir, ToStereoCamera(simulator->calibration()), error)) return false;
+  if (!writer.Open(dir, ExportedStereoCamera(scenario, simulator->calibration()), error))
+    return false;
   sim::StereoFrame frame;
   for (int index = 0; spec.max_frames == 0 || index < spec.max_frames; ++index) {
     if (!simulator->Next(&frame, error)) break;

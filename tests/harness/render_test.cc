@@ -8,9 +8,12 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "harness/dataset.h"
 #include "harness/dataset/rig.h"
+#include "harness/pipeline.h"
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
 
@@ -108,6 +111,74 @@ TEST(RenderTest, DatasetOnDiskEqualsTheSimulationAndIsDeterministic) {
     ++n;
   }
   EXPECT_EQ(n, reader.size());
+}
+
+// calibration_error (issue #34): the exported calibration differs from the true one exactly as
+// configured (baseline and focal scaled, cam1's T_BS turned about its y axis); the images are
+// the same bytes; the in-memory sequence's camera has the same error; the rotation, which a
+// rectified calibration cannot hold, is refused for KITTI and `run`, nothing written.
+TEST(RenderTest, CalibrationErrorChangesOnlyTheExportedCalibration) {
+  TempDir dir("render");
+  const std::string truth = ShortScenario(dir);
+  const std::string wrong = dir / "wrong.yaml";
+  WriteText(wrong, ReadAll(truth) +
+                       "calibration_error:\n  baseline_pct: 2\n  focal_pct: -1.5\n"
+                       "  rotation_deg: 0.7\n");
+  for (const auto& [yaml, out] : {std::pair{truth, dir / "a"}, std::pair{wrong, dir / "b"}}) {
+    const auto r = RunVobench("render " + yaml + " --out " + out + " -q --format euroc");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  size_t images = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "a"))
+    if (e.is_regular_file() && e.path().extension() == ".png") {
+      const std::string f = fs::relative(e.path(), dir / "a").string();
+      EXPECT_EQ(ReadAll(fs::path(dir / "b") / f), ReadAll(e.path().string())) << f;
+      ++images;
+    }
+  EXPECT_GT(images, 20u);
+  std::string error;
+  harness::KittiReader a, b;
+  ASSERT_TRUE(a.Open(dir / "a", &error)) << error;
+  ASSERT_TRUE(b.Open(dir / "b", &error)) << error;
+  EXPECT_NEAR(b.camera().baseline_m, a.camera().baseline_m * 1.02, 1e-12);
+  EXPECT_NEAR(b.camera().fx_px, a.camera().fx_px * 0.985, 1e-9);
+  EXPECT_NEAR(b.camera().fy_px, a.camera().fy_px * 0.985, 1e-9);
+  EXPECT_EQ(b.camera().cx_px, a.camera().cx_px);
+  EXPECT_EQ(b.camera().cy_px, a.camera().cy_px);
+  harness::EurocCameraCalibration a0, a1, b0, b1;
+  for (const auto& [folder, cam, calib] :
+       {std::tuple{dir / "a", "cam0", &a0}, std::tuple{dir / "a", "cam1", &a1},
+        std::tuple{dir / "b", "cam0", &b0}, std::tuple{dir / "b", "cam1", &b1}})
+    ASSERT_TRUE(harness::ReadEurocSensorYaml(
+        (fs::path(folder) / "mav0" / cam / "sensor.yaml").string(), calib, &error))
+        << error;
+  EXPECT_NEAR(b1.fu_px, a1.fu_px * 0.985, 1e-9);
+  EXPECT_LT((b0.T_body_cam.matrix() - a0.T_body_cam.matrix()).cwiseAbs().maxCoeff(), 1e-15);
+  const Eigen::Isometry3d a01 = a0.T_body_cam.inverse() * a1.T_body_cam;
+  const Eigen::Isometry3d b01 = b0.T_body_cam.inverse() * b1.T_body_cam;
+  EXPECT_LT((a01.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(b01.translation().x(), a01.translation().x() * 1.02, 1e-12);
+  const Eigen::AngleAxisd turn(b01.linear());
+  EXPECT_NEAR(turn.angle(), 0.7 * M_PI / 180.0, 1e-12);
+  EXPECT_NEAR(std::abs(turn.axis().y()), 1.0, 1e-12);  // about the camera's y axis
+
+  // `run`'s sequence in memory: the same scaled camera; the rotation refused.
+  sim::Scenario scenario;
+  ASSERT_TRUE(sim::LoadScenario(wrong, &scenario, &error)) << error;
+  harness::StereoSequence sequence;
+  EXPECT_FALSE(harness::OpenScenarioSequence(scenario, &sequence, &error));
+  EXPECT_NE(error.find("calibration_error.rotation_deg"), std::string::npos) << error;
+  scenario.calibration_error.rotation_deg = 0.0;
+  error.clear();
+  ASSERT_TRUE(harness::OpenScenarioSequence(scenario, &sequence, &error)) << error;
+  EXPECT_EQ(sequence.camera.baseline_m, b.camera().baseline_m);
+  EXPECT_EQ(sequence.camera.fx_px, b.camera().fx_px);
+  const auto k = RunVobench("render " + wrong + " --out " + (dir / "k") + " -q --format kitti");
+  EXPECT_NE(k.exit_code, 0);
+  EXPECT_NE(k.output.find("rotation_deg: a rotation between the cameras cannot be exported"),
+            std::string::npos)
+      << k.output;
+  EXPECT_FALSE(fs::exists(dir / "k"));
 }
 
 class RenderBadInputTest : public ::testing::Test {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "sim/simulator.h"
 #include "sim_test_util.h"
@@ -290,6 +291,75 @@ TEST_F(ScenarioFileTest, ImuRateMustBeAWholeNumberOfPhysicsSteps) {
   const std::string above = Load(std::string(kGood) + "imu:\n  rate_hz: 1000\n");
   EXPECT_NE(above.find("key 'imu.rate_hz': 1000 Hz is above the physics rate"), std::string::npos)
       << above;
+}
+
+TEST_F(ScenarioFileTest, CalibrationErrorAndFrameKeysAreCheckedAndRoundTrip) {
+  const std::string good = std::string(kGood) +
+                           "calibration_error:\n  baseline_pct: 1.5\n  rotation_deg: -0.25\n"
+                           "frames:\n  drop_rate: 0.05\n  time_jitter_s: 0.004\n";
+  sim::Scenario s, again, plain;
+  ASSERT_EQ(Load(good, &s), "");
+  EXPECT_EQ(s.calibration_error.baseline_pct, 1.5);
+  EXPECT_EQ(s.calibration_error.focal_pct, 0.0);
+  EXPECT_EQ(s.calibration_error.rotation_deg, -0.25);
+  EXPECT_EQ(s.frames.drop_rate, 0.05);
+  EXPECT_EQ(s.frames.time_jitter_s, 0.004);
+  const std::string path = dir_ / "effective.yaml";
+  WriteText(path, sim::ScenarioToYaml(s));
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(path, &again, &error)) << error;
+  EXPECT_EQ(sim::ScenarioToYaml(again), sim::ScenarioToYaml(s));
+  // Without them the effective YAML does not mention them (as before they existed).
+  ASSERT_EQ(Load(kGood, &plain), "");
+  EXPECT_EQ(sim::ScenarioToYaml(plain).find("calibration_error"), std::string::npos);
+  EXPECT_EQ(sim::ScenarioToYaml(plain).find("frames"), std::string::npos);
+
+  const std::pair<std::string, std::string> bad[] = {
+      {"calibration_error:\n  baseline_pct: -100\n",
+       "s.yaml:13: key 'calibration_error.baseline_pct': expected a percentage in (-100, 1000)"},
+      {"calibration_error:\n  focal_pct: .nan\n", "s.yaml:13: key 'calibration_error.focal_pct'"},
+      {"calibration_error:\n  rotation_deg: 45\n",
+       "s.yaml:13: key 'calibration_error.rotation_deg': expected degrees in (-45, 45)"},
+      {"calibration_error:\n  roll_deg: 1\n", "s.yaml:13: key 'calibration_error.roll_deg'"},
+      {"frames:\n  drop_rate: 1\n",
+       "s.yaml:13: key 'frames.drop_rate': expected a fraction in [0, 1)"},
+      {"frames:\n  time_jitter_s: 0.05\n",
+       "s.yaml:13: key 'frames.time_jitter_s': expected seconds in [0, 0.05) (below half the "
+       "frame period at rate_hz 10"},
+      {"frames:\n  time_jitter_s: -0.001\n", "s.yaml:13: key 'frames.time_jitter_s'"},
+      {"frames: 3\n", "s.yaml:12: key 'frames'"}};
+  for (const auto& [yaml, expected] : bad) {
+    const std::string e = Load(std::string(kGood) + yaml);
+    EXPECT_NE(e.find(expected), std::string::npos) << yaml << " -> " << e;
+  }
+}
+
+TEST_F(ScenarioFileTest, LensKeysAreCheckedAndRoundTrip) {
+  sim::Scenario s, again;
+  ASSERT_EQ(Load(Replace("  baseline_m: 0.12\n",
+                         "  baseline_m: 0.12\n  distortion:\n    model: equidistant\n"
+                         "    coeffs: [0.05, -0.01, 0.002, -0.0005]\n"),
+                 &s),
+            "");
+  EXPECT_EQ(s.camera.distortion.model, sim::kEquidistant);
+  EXPECT_EQ(s.camera.distortion.coeffs, (std::vector<double>{0.05, -0.01, 0.002, -0.0005}));
+  const std::string path = dir_ / "effective.yaml";
+  WriteText(path, sim::ScenarioToYaml(s));
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(path, &again, &error)) << error;
+  EXPECT_EQ(sim::ScenarioToYaml(again), sim::ScenarioToYaml(s));
+  const std::string model = Load(
+      Replace("  baseline_m: 0.12\n",
+              "  baseline_m: 0.12\n  distortion:\n    model: fisheye\n    coeffs: [0, 0, 0, 0]\n"));
+  EXPECT_NE(model.find("s.yaml:11: key 'camera.distortion.model': expected radtan or equidistant"),
+            std::string::npos)
+      << model;
+  const std::string three = Load(
+      Replace("  baseline_m: 0.12\n",
+              "  baseline_m: 0.12\n  distortion:\n    model: radtan\n    coeffs: [0, 0, 0]\n"));
+  EXPECT_NE(three.find("key 'camera.distortion.coeffs': expected a list of 4 numbers"),
+            std::string::npos)
+      << three;
 }
 
 TEST_F(ScenarioFileTest, ImuKeysAreCheckedAndRoundTrip) {

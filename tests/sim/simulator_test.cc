@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sim_test_util.h"
@@ -200,6 +201,110 @@ TEST(SimulatorTest, SameScenarioAndSeedGiveIdenticalFrames) {
   ASSERT_TRUE(simulator->Next(&f, &error));
   EXPECT_GT(cv::norm(f.left, runs[0][0].left, cv::NORM_L1), 0);
   EXPECT_TRUE(f.T_world_cam0.matrix() == runs[0][0].T_world_cam0.matrix());
+}
+
+TEST(SimulatorTest, FrameDropsAndStampJitterFollowTheSeed) {
+  // The fate of each frame: a pinned pattern for seed 1 (a change to the stream shows here), and
+  // the statistics over many frames: drops binomial(n, rate) within 5 sigma, jitter uniform on
+  // [-j, j] (mean 0, variance j^2 / 3, bounded), frame 0 never jittered.
+  sim::FrameOptions options;
+  options.drop_rate = 0.3;
+  options.time_jitter_s = 0.01;
+  std::string pattern;
+  for (int k = 0; k < 20; ++k) pattern += sim::FrameFateOf(options, 1, k).dropped ? 'x' : '.';
+  EXPECT_EQ(pattern, ".x...x.x.x.xx..x..xx");  // 8 of 20 at 0.3
+  EXPECT_EQ(sim::FrameFateOf(options, 7, 0).jitter_s, 0.0);
+  constexpr int kN = 100000;
+  int dropped = 0;
+  double sum = 0.0, sum2 = 0.0, largest = 0.0;
+  for (int k = 1; k <= kN; ++k) {
+    const sim::FrameFate fate = sim::FrameFateOf(options, 7, k);
+    dropped += fate.dropped;
+    sum += fate.jitter_s;
+    sum2 += fate.jitter_s * fate.jitter_s;
+    largest = std::max(largest, std::abs(fate.jitter_s));
+  }
+  EXPECT_NEAR(dropped, 0.3 * kN, 5.0 * std::sqrt(kN * 0.3 * 0.7));
+  const double j = options.time_jitter_s;
+  EXPECT_NEAR(sum / kN, 0.0, 5.0 * j / std::sqrt(3.0 * kN));
+  EXPECT_NEAR(sum2 / kN, j * j / 3.0, 5.0 * j * j * std::sqrt(4.0 / 45.0 / kN));
+  EXPECT_LE(largest, j);
+  EXPECT_GT(largest, 0.999 * j);
+  options = sim::FrameOptions();  // off: nothing dropped, no jitter
+  EXPECT_FALSE(sim::FrameFateOf(options, 7, 3).dropped);
+  EXPECT_EQ(sim::FrameFateOf(options, 7, 3).jitter_s, 0.0);
+
+  // In the simulator: the kept frames are the undropped sequence's frames at their index, their
+  // stamps the capture time plus the frame's jitter, and no IMU sample is lost with a drop.
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  s.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.6, 0)};
+  std::vector<sim::StereoFrame> all, kept;
+  size_t all_imu = 0, kept_imu = 0;
+  for (auto* run : {&all, &kept}) {
+    if (run == &kept) s.frames = {0.3, 0.02};
+    auto simulator = sim::Simulator::Create(s, &error);
+    ASSERT_TRUE(simulator) << error;
+    sim::StereoFrame f;
+    while (simulator->Next(&f, &error)) {
+      (run == &all ? all_imu : kept_imu) += f.imu.size();
+      run->push_back(f);
+    }
+    ASSERT_TRUE(error.empty()) << error;
+  }
+  ASSERT_GT(all.size(), 10u);
+  size_t expected_kept = 0, drops_before_last = 0;
+  for (size_t k = 0; k < all.size(); ++k)
+    if (!sim::FrameFateOf(s.frames, s.seed, static_cast<int>(k)).dropped) ++expected_kept;
+  EXPECT_EQ(kept.size(), expected_kept);
+  EXPECT_LT(kept.size(), all.size());
+  for (const sim::StereoFrame& f : kept) {
+    ASSERT_LT(static_cast<size_t>(f.index), all.size());
+    const sim::StereoFrame& same = all[f.index];
+    EXPECT_EQ(cv::norm(f.left, same.left, cv::NORM_INF), 0) << f.index;
+    EXPECT_EQ(cv::norm(f.right, same.right, cv::NORM_INF), 0) << f.index;
+    EXPECT_TRUE(f.T_world_cam0.matrix() == same.T_world_cam0.matrix()) << f.index;
+    EXPECT_EQ(f.time_s, same.time_s + sim::FrameFateOf(s.frames, s.seed, f.index).jitter_s);
+  }
+  for (size_t k = static_cast<size_t>(kept.back().index) + 1; k < all.size(); ++k)
+    drops_before_last += all[k].imu.size();  // dropped after the last frame kept: not carried
+  EXPECT_EQ(kept_imu + drops_before_last, all_imu);
+}
+
+TEST(SimulatorTest, DistortedRenderRectifiesBackToThePinholeRender) {
+  // The round trip: render through a radtan lens, rectify with the calibration's lens
+  // (OpenCV's initUndistortRectifyMap onto the same K), compare with the pinhole render of the
+  // same frame: closer than the pinhole render is to itself shifted by half a pixel.
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  s.path = {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.6, 0)};
+  s.noise = sim::NoiseOptions();
+  sim::StereoFrame pinhole, raw;
+  for (auto* f : {&pinhole, &raw}) {
+    if (f == &raw) s.camera.distortion = {sim::kRadTan, {-0.28, 0.07, 0.0002, 0.00002}};
+    auto simulator = sim::Simulator::Create(s, &error);
+    ASSERT_TRUE(simulator) << error;
+    ASSERT_TRUE(simulator->Next(f, &error)) << error;
+    EXPECT_EQ(simulator->calibration().lens.model, s.camera.distortion.model);
+  }
+  ASSERT_EQ(raw.left.size(), pinhole.left.size());
+  const double f = 0.5 * s.camera.height / std::tan(0.5 * s.camera.fovy_deg * M_PI / 180.0);
+  const cv::Matx33d K(f, 0, 0.5 * (s.camera.width - 1), 0, f, 0.5 * (s.camera.height - 1), 0, 0, 1);
+  cv::Mat map_x, map_y, rectified, shifted;
+  cv::initUndistortRectifyMap(K, cv::Mat(s.camera.distortion.coeffs, true), cv::Matx33d::eye(), K,
+                              raw.left.size(), CV_32FC1, map_x, map_y);
+  cv::remap(raw.left, rectified, map_x, map_y, cv::INTER_LINEAR);
+  const cv::Matx23d half_px(1, 0, 0.5, 0, 1, 0);
+  cv::warpAffine(pinhole.left, shifted, half_px, pinhole.left.size());
+  const cv::Rect inner(20, 20, s.camera.width - 40, s.camera.height - 40);
+  cv::Mat a, b;
+  cv::absdiff(rectified(inner), pinhole.left(inner), a);
+  cv::absdiff(shifted(inner), pinhole.left(inner), b);
+  const double round_trip = cv::mean(a)[0], half_pixel = cv::mean(b)[0];
+  EXPECT_LT(round_trip, half_pixel) << "grey levels";
+  EXPECT_GT(cv::norm(raw.left, pinhole.left, cv::NORM_L1), 0);  // the lens did change the image
 }
 
 TEST(SimulatorTest, NoiseModelsChangeTheImageAsConfigured) {
