@@ -34,10 +34,10 @@ int main(int argc, char** argv) {
 
   // In the order of `vobench --help`.
   const std::vector<harness::Command> commands = {
-      harness::AddRenderCommand(app),     harness::AddSceneCommand(app),
-      harness::AddMatchEvalCommand(app),  harness::AddRunCommand(app),
-      harness::AddEvalCommand(app),       harness::AddScoreCommand(app),
-      harness::AddTuneCommand(app),       harness::AddBreakpointCommand(app),
+      harness::AddRenderCommand(app),    harness::AddSceneCommand(app),
+      harness::AddMatchEvalCommand(app), harness::AddRunCommand(app),
+      harness::AddEvalCommand(app),      harness::AddScoreCommand(app),
+      harness::AddTuneCommand(app),      harness::AddBreakpointCommand(app),
       harness::AddSuiteCommand(app),  // suite, suite merge
       harness::AddCheckCommand(app)};
 

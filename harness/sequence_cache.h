@@ -19,17 +19,16 @@
 //
 // Sharing: OpenSharedScenarioSequence(scenario, max_frames, cache_dir) takes the writer lock
 // "<entry>.writer.lock" beside the entry cache_dir/<key> (key: FNV-1a of the scenario's YAML
-// without its name, its scene files' hash, and max_frames), waiting while another process holds it; simulates the
-// entry when it is missing or not usable (no marker, an unreadable sequence.json, another
-// format, version, scenario, scene files (the MJCF and its includes, or the floor plan and its
-// robot, by content) or max_frames, a frames.bin of another size: the entry is written
-// again); releases the lock; and reads the frames from the entry. A record whose hash does not
-// match (the file changed after it was written) fails the run with a message naming the file
-// and frame. The entry is not tied to the code that simulated it beyond the version string:
-// `git describe` does not see uncommitted changes, so remove a cache folder kept across builds
-// (a suite's lives in its work folder and is removed when the call ends). A closed-loop scenario
-// (navigation: vo) is never cached: its frames depend on the VO (`run --sequence-cache`
-// simulates it in the loop).
+// without its name, its scene files' hash, and max_frames), waiting while another process holds it;
+// simulates the entry when it is missing or not usable (no marker, an unreadable sequence.json,
+// another format, version, scenario, scene files (the MJCF and its includes, or the floor plan and
+// its robot, by content) or max_frames, a frames.bin of another size: the entry is written again);
+// releases the lock; and reads the frames from the entry. A record whose hash does not match (the
+// file changed after it was written) fails the run with a message naming the file and frame. The
+// entry is not tied to the code that simulated it beyond the version string: `git describe` does
+// not see uncommitted changes, so remove a cache folder kept across builds (a suite's lives in its
+// work folder and is removed when the call ends). A closed-loop scenario (navigation: vo) is never
+// cached: its frames depend on the VO (`run --sequence-cache` simulates it in the loop).
 #pragma once
 
 #include <string>
