@@ -10,12 +10,14 @@
 
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "harness/trajectory_io.h"
 
@@ -318,6 +320,17 @@ namespace {
 
 constexpr const char* kLockSignature = "vobench-lock pid=";
 
+// A lock file is created (O_EXCL), locked, then written: another vobench may see it empty for
+// a moment. An empty one is waited for (kEmptyLockWaits × kEmptyLockPoll, 2 s) before it counts
+// as not vobench's (a user's empty file of that name is refused after that wait).
+constexpr int kEmptyLockWaits = 200;
+constexpr std::chrono::milliseconds kEmptyLockPoll{10};
+
+bool IsEmptyFile(int fd) {
+  struct stat st = {};
+  return ::fstat(fd, &st) == 0 && st.st_size == 0;
+}
+
 // The pid in a lock file's text "vobench-lock pid=N host=H\n"; 0 when it is not such a text.
 long LockHolder(int fd) {
   char buf[256] = {};
@@ -338,6 +351,7 @@ bool FolderLock::Acquire(const std::string& lock_path, const std::string& what,
   const std::string not_ours = lock_path +
                                ": exists and is not a vobench lock file; remove it yourself or "
                                "choose another --out";
+  int empty_waits = 0;
   for (int attempt = 0; attempt < kLockAttempts; ++attempt) {
     // Created exclusively: a file of that name that vobench did not create now is never written.
     int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
@@ -355,9 +369,17 @@ bool FolderLock::Acquire(const std::string& lock_path, const std::string& what,
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
       const int flock_errno = errno;
       const long holder = LockHolder(fd);
+      const bool empty = IsEmptyFile(fd);
       ::close(fd);
       if (flock_errno != EWOULDBLOCK)
         return Fail(error, lock_path + ": cannot lock: " + std::strerror(flock_errno));
+      if (holder <= 0 && empty && empty_waits < kEmptyLockWaits) {
+        // Another vobench created and locked it and is writing its text now.
+        ++empty_waits;
+        --attempt;
+        std::this_thread::sleep_for(kEmptyLockPoll);
+        continue;
+      }
       if (holder <= 0) return Fail(error, not_ours + " (another process holds a lock on it)");
       return Fail(error, what + ": another vobench (pid " + std::to_string(holder) +
                              ") is writing this folder; wait for it to end or choose another "
@@ -375,7 +397,15 @@ bool FolderLock::Acquire(const std::string& lock_path, const std::string& what,
       // Nobody holds it. A lock file of a vobench killed outright (its own text, written by a
       // process that no longer holds it) is removed and created anew; anything else is kept.
       if (LockHolder(fd) <= 0) {
+        const bool empty = IsEmptyFile(fd);
         ::close(fd);
+        if (empty && empty_waits < kEmptyLockWaits) {
+          // Another vobench created it and has not locked it yet (open, then flock).
+          ++empty_waits;
+          --attempt;
+          std::this_thread::sleep_for(kEmptyLockPoll);
+          continue;
+        }
         return Fail(error, not_ours);
       }
       ::unlink(lock_path.c_str());  // while holding it: a concurrent opener re-checks the inode

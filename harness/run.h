@@ -3,10 +3,10 @@
 // plots, report page). The steps are the run pipeline's (pipeline.h, run_folder.h).
 //
 // Run folder (run_folder.h):
-//   trajectory_tum.txt                          the estimate T_world_cam0 in the VO's world
+//   trajectory_world_tum.txt                    the estimate T_world_cam0 in the VO's world
 //   estimate_in_gt_world_tum.txt                the estimate anchored at the first ground-truth
-//                                               pose (same frame as groundtruth_tum.txt)
-//   groundtruth_tum.txt                         ground truth T_world_cam0 (simulator world)
+//                                               pose (same frame as groundtruth_world_tum.txt)
+//   groundtruth_world_tum.txt                   ground truth T_world_cam0 (simulator world)
 //   trajectory_kitti.txt / groundtruth_kitti.txt  the same relative to their first pose (the
 //                                               first line is the identity; KITTI's convention)
 //   per_frame.csv      status, counts, per-stage ms, errors per frame

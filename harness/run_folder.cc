@@ -271,7 +271,7 @@ void MakePlots(const std::string& folder, bool has_ground_truth, const std::stri
   bool ok = true;
   if (has_ground_truth) {
     const fs::path navigation = p / "navigation.csv";  // a closed-loop run's
-    ok = RunTrajectoryPlot((p / "groundtruth_tum.txt").string(),
+    ok = RunTrajectoryPlot((p / "groundtruth_world_tum.txt").string(),
                            (p / "estimate_in_gt_world_tum.txt").string(),
                            (p / "trajectory.png").string(), outline_scene, &plot_error,
                            fs::exists(navigation) ? navigation.string() : "") &&
@@ -292,7 +292,7 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s,
   const fs::path p = folder->path();
   const Trajectories t =
       InitialisedTrajectories(records, static_cast<size_t>(s.frames_not_initialised));
-  if (!WriteTum((p / "trajectory_tum.txt").string(), Stamped(t.times, t.est), error) ||
+  if (!WriteTum((p / "trajectory_world_tum.txt").string(), Stamped(t.times, t.est), error) ||
       !WriteKittiPoses((p / "trajectory_kitti.txt").string(), KittiRelativeToFirst(t.est), error) ||
       !WriteTextFile((p / "per_frame.csv").string(), PerFrameCsv(records, s, t), error) ||
       !WriteTextFile((p / "vo_options.yaml").string(), contents.options_yaml, error) ||
@@ -313,7 +313,7 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s,
     }
     // groundtruth_kitti.txt has no stamps: written only when it lines up with the estimate.
     const bool all_gt = t.gt_frames.size() == t.times.size();
-    if (!WriteTum((p / "groundtruth_tum.txt").string(), Stamped(times_at_gt, gt_at_gt), error) ||
+    if (!WriteTum((p / "groundtruth_world_tum.txt").string(), Stamped(times_at_gt, gt_at_gt), error) ||
         (all_gt && !WriteKittiPoses((p / "groundtruth_kitti.txt").string(),
                                     KittiRelativeToFirst(t.gt), error)) ||
         !WriteTum((p / "estimate_in_gt_world_tum.txt").string(),

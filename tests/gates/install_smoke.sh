@@ -35,7 +35,7 @@ grep -qF "$data/scenes" no_such.log ||
 
 "$prefix/bin/vobench" run l_hallway --max-frames 20 --no-plots --out run20 > run20.log 2>&1 ||
   { cat run20.log; echo "FAIL: installed vobench run l_hallway"; exit 1; }
-for f in metrics.json trajectory_tum.txt per_frame.csv report.md; do
+for f in metrics.json trajectory_world_tum.txt per_frame.csv report.md; do
   [ -s "run20/$f" ] || { echo "FAIL: run20/$f not written"; status=1; }
 done
 # The plot scripts from the prefix (when matplotlib is there).

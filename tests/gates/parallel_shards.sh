@@ -78,7 +78,7 @@ if ! diff -u unsharded.csv merged.csv; then
 fi
 for run in out/unsharded/runs/*/; do
   id="$(basename "$run")"
-  cmp "$run/trajectory_tum.txt" "out/suite/hallway/runs/$id/trajectory_tum.txt" ||
+  cmp "$run/trajectory_world_tum.txt" "out/suite/hallway/runs/$id/trajectory_world_tum.txt" ||
     { echo "FAIL: run $id: the merged trajectory differs"; status=1; }
 done
 ((status == 0)) && echo "parallel_shards: merged summary of 4 shards == unsharded summary ($(($(wc -l < merged.csv) - 1)) runs)"

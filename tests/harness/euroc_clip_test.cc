@@ -125,7 +125,7 @@ TEST(EurocClipTest, StandingStillRunStaysAtItsStart) {
   EXPECT_LE(s.lost_frames, kMaxStandStillLostFrames);
   // The estimate, from the run folder: finite and near the first pose all along.
   std::vector<StampedPose> est;
-  ASSERT_TRUE(ReadTum(run.out_dir + "/trajectory_tum.txt", &est, &error)) << error;
+  ASSERT_TRUE(ReadTum(run.out_dir + "/trajectory_world_tum.txt", &est, &error)) << error;
   ASSERT_EQ(est.size(), 20u);
   double max_displacement_m = 0.0;
   for (const StampedPose& p : est) {

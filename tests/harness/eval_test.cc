@@ -196,7 +196,7 @@ TEST_F(EvalTest, SimulatorExportsInEachFormatGiveTheRunsTrajectoryAndMetrics) {
     // Same frames -> the same trajectory, bit for bit, and the same metrics.
     EXPECT_EQ(ReadAll(out + "/trajectory_kitti.txt"), run_trajectory) << name;
     ExpectSameAccuracy(ReadJson(out + "/metrics.json"), run, name);
-    for (const char* f : {"trajectory_tum.txt", "groundtruth_tum.txt", "per_frame.csv",
+    for (const char* f : {"trajectory_world_tum.txt", "groundtruth_world_tum.txt", "per_frame.csv",
                           "vo_options.yaml", "report.md", "estimate_in_gt_world_tum.txt"})
       EXPECT_TRUE(fs::exists(out + "/" + f)) << name << ": " << f;
   }
@@ -238,8 +238,8 @@ TEST_F(EvalTest, GroundTruthAtAnotherRateCoveringPartOfTheFrames) {
   const std::string data = Copy(DatasetFormat::kTum);
   std::vector<StampedPose> gt, est;
   std::string error;
-  ASSERT_TRUE(ReadTum(RunDir() + "/groundtruth_tum.txt", &gt, &error)) << error;
-  ASSERT_TRUE(ReadTum(RunDir() + "/trajectory_tum.txt", &est, &error)) << error;
+  ASSERT_TRUE(ReadTum(RunDir() + "/groundtruth_world_tum.txt", &gt, &error)) << error;
+  ASSERT_TRUE(ReadTum(RunDir() + "/trajectory_world_tum.txt", &est, &error)) << error;
   const size_t n = gt.size(), covered = n * 6 / 10;
   const double period_s = gt[1].time_s - gt[0].time_s;
   std::vector<StampedPose> fast;
@@ -277,7 +277,7 @@ TEST_F(EvalTest, GroundTruthAtAnotherRateCoveringPartOfTheFrames) {
   EXPECT_NEAR(j["path_length_m"].get<double>(), expected.path_length_m, kMetricTolerance);
   // The run folder's ground truth holds the associated frames only; the per-frame log all.
   std::vector<StampedPose> written;
-  ASSERT_TRUE(ReadTum(Out() + "/groundtruth_tum.txt", &written, &error)) << error;
+  ASSERT_TRUE(ReadTum(Out() + "/groundtruth_world_tum.txt", &written, &error)) << error;
   EXPECT_EQ(written.size(), covered);
   EXPECT_FALSE(fs::exists(Out() + "/groundtruth_kitti.txt"));  // would not line up
   const std::string csv = ReadAll(Out() + "/per_frame.csv");
@@ -330,7 +330,7 @@ TEST_F(EvalTest, WithoutGroundTruthTheRunHasNoAccuracyMetrics) {
     EXPECT_FALSE(j.contains(k)) << k;
   EXPECT_EQ(ReadAll(Out() + "/trajectory_kitti.txt"), ReadAll(RunDir() + "/trajectory_kitti.txt"));
   EXPECT_TRUE(fs::exists(Out() + "/per_frame.csv"));
-  EXPECT_FALSE(fs::exists(Out() + "/groundtruth_tum.txt"));
+  EXPECT_FALSE(fs::exists(Out() + "/groundtruth_world_tum.txt"));
 }
 
 // --- Bad input: a message naming the file, a non-zero exit, no run folder ----------------------

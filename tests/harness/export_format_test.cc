@@ -365,7 +365,7 @@ TEST_F(ExportFormatTest, RunFolderKittiTrajectoriesStartAtTheIdentity) {
     std::vector<harness::StampedPose> world;
     std::string error;
     ASSERT_TRUE(harness::ReadKittiPoses(out + "/" + name + "_kitti.txt", &kitti, &error)) << error;
-    ASSERT_TRUE(harness::ReadTum(out + "/" + name + "_tum.txt", &world, &error)) << error;
+    ASSERT_TRUE(harness::ReadTum(out + "/" + name + "_world_tum.txt", &world, &error)) << error;
     ASSERT_EQ(kitti.size(), world.size()) << name;
     ASSERT_GT(kitti.size(), 5u) << name;
     EXPECT_EQ(Lines(out + "/" + name + "_kitti.txt").front(), "1 0 0 0 0 1 0 0 0 0 1 0") << name;

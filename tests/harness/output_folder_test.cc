@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -216,6 +217,39 @@ TEST(OutputFolderTest, AFileNamedLikeTheLockThatIsNotOneIsKept) {
     EXPECT_THAT(error, HasSubstr(out + ".vobench-lock: exists and is not a vobench lock file"));
     EXPECT_EQ(ReadAll(out + ".vobench-lock"), text);
   }
+}
+
+// A lock file is created, locked and then written: a second vobench that finds it still empty
+// and locked waits for the text (it is the first one's, not a user's file).
+TEST(OutputFolderTest, ALockFileBeingWrittenIsAnotherVobenchs) {
+  TempDir dir("of_lock_race");
+  const std::string out = dir / "run";
+  const std::string lock_path = out + ".vobench-lock";
+  int ready[2];
+  ASSERT_EQ(pipe(ready), 0);
+  const pid_t child = fork();
+  if (child == 0) {  // FolderLock::Acquire's steps, with a pause before the text
+    const int fd = open(lock_path.c_str(), O_RDWR | O_CREAT | O_EXCL, 0644);
+    const char ok = fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0 ? '1' : '0';
+    (void)!write(ready[1], &ok, 1);
+    usleep(300 * 1000);
+    const std::string text = "vobench-lock pid=" + std::to_string(getpid()) + " host=h\n";
+    (void)!pwrite(fd, text.data(), text.size(), 0);
+    pause();  // until SIGKILL
+    _exit(0);
+  }
+  char ok = 0;
+  ASSERT_EQ(read(ready[0], &ok, 1), 1);
+  ASSERT_EQ(ok, '1');
+  OutputFolder blocked;
+  std::string error;
+  EXPECT_FALSE(blocked.Create(out, "run", &error));
+  EXPECT_THAT(error, HasSubstr("another vobench (pid " + std::to_string(child) + ")"));
+  kill(child, SIGKILL);
+  int status = 0;
+  waitpid(child, &status, 0);
+  close(ready[0]);
+  close(ready[1]);
 }
 
 TEST(OutputFolderTest, LockOfAKilledWriterIsTakenOver) {

@@ -84,12 +84,12 @@ TEST(PlotScriptsTest, EveryScriptWritesAPngFromTheCommittedResults) {
   std::set<std::string> ran;
 
   EXPECT_TRUE(harness::RunTrajectoryPlot(
-      l_run + "/groundtruth_tum.txt", l_run + "/estimate_in_gt_world_tum.txt",
+      l_run + "/groundtruth_world_tum.txt", l_run + "/estimate_in_gt_world_tum.txt",
       dir / "trajectory.png", kSource + "/scenes/hallway_l.xml", &error))
       << error;
   ExpectPng(dir / "trajectory.png");
   EXPECT_FALSE(fs::exists(dir / "trajectory.png.outline.csv")) << "the outline file is left behind";
-  EXPECT_TRUE(harness::RunTrajectoryPlot(l_run + "/groundtruth_tum.txt",
+  EXPECT_TRUE(harness::RunTrajectoryPlot(l_run + "/groundtruth_world_tum.txt",
                                          l_run + "/estimate_in_gt_world_tum.txt",
                                          dir / "trajectory_no_outline.png", "", &error))
       << error;

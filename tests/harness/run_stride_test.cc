@@ -28,7 +28,7 @@ std::vector<harness::StampedPose> RunAndReadGroundTruth(const sim::Scenario& sce
   EXPECT_TRUE(harness::RunScenario(scenario, vo::OdometryOptions(), options, summary, &error))
       << error;
   std::vector<harness::StampedPose> gt;
-  EXPECT_TRUE(harness::ReadTum(out + "/groundtruth_tum.txt", &gt, &error)) << error;
+  EXPECT_TRUE(harness::ReadTum(out + "/groundtruth_world_tum.txt", &gt, &error)) << error;
   return gt;
 }
 
@@ -136,7 +136,7 @@ TEST(RunBadStartTest, BlackFirstFramesAreNotInitialisedAndCostNothing) {
   EXPECT_LT(bad.metrics.end_rotation_error_deg, clean.metrics.end_rotation_error_deg + 0.5);
   // No pose for the black frames: the trajectories start at the first initialised frame.
   std::vector<harness::StampedPose> traj;
-  ASSERT_TRUE(harness::ReadTum(dir / "dark/trajectory_tum.txt", &traj, &error)) << error;
+  ASSERT_TRUE(harness::ReadTum(dir / "dark/trajectory_world_tum.txt", &traj, &error)) << error;
   ASSERT_EQ(traj.size(), frames.size());
   EXPECT_EQ(traj.front().time_s, frames.front().time_s);
   std::ifstream csv(dir / "dark/per_frame.csv");

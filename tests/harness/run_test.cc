@@ -54,7 +54,7 @@ TEST(RunTest, PapersConfigurationOnTheLHallwayMeetsThePapersFigure) {
   EXPECT_GT(s.match_stats.inlier_precision(), 0.99);
   // The run folder has what the issue names.
   for (const char* f :
-       {"trajectory_tum.txt", "trajectory_kitti.txt", "groundtruth_tum.txt", "per_frame.csv",
+       {"trajectory_world_tum.txt", "trajectory_kitti.txt", "groundtruth_world_tum.txt", "per_frame.csv",
         "vo_options.yaml", "scenario.yaml", "metrics.json", "report.md"})
     EXPECT_TRUE(fs::exists(fs::path(options.out_dir) / f)) << f;
   const nlohmann::json j = ReadJson(options.out_dir + "/metrics.json");
@@ -82,7 +82,7 @@ TEST(RunTest, SameScenarioGivesIdenticalAccuracyMetricsAndTrajectory) {
     harness::RunSummary s;
     ASSERT_TRUE(harness::RunScenario(scenario, vo::OdometryOptions(), options, &s, &error))
         << error;
-    std::ifstream in(options.out_dir + "/trajectory_tum.txt");
+    std::ifstream in(options.out_dir + "/trajectory_world_tum.txt");
     traj[k].assign(std::istreambuf_iterator<char>(in), {});
     metrics[k] = ReadJson(options.out_dir + "/metrics.json");
   }
