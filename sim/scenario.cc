@@ -885,6 +885,21 @@ std::string ScenarioToYaml(const Scenario& s) {
   return std::string(out.c_str()) + "\n";
 }
 
+std::string ScenarioKeysYaml(const Scenario& scenario) {
+  Scenario s = scenario;
+  s.robot.stop_s = 1.0;
+  s.robot.final_heading_deg = 0.0;
+  s.camera.distortion.model = kRadTan;
+  s.camera.distortion.coeffs.assign(4, 0.0);
+  s.camera.auto_exposure.enabled = !AutoExposureOptions().enabled;
+  s.calibration_error.baseline_pct = 1.0;
+  s.frames.drop_rate = 0.1;
+  s.people.count = 1;
+  s.lights.switches.assign(1, LightSwitch{0.0, 0, "", false});
+  s.lights.flicker_hz = 1.0;
+  return ScenarioToYaml(s);
+}
+
 std::string BuiltinScenarioPath(const std::string& name) {
   return (fs::path(DataDir()) / "scenes" / (name + ".yaml")).string();
 }

@@ -221,6 +221,12 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
 // Writes the effective scenario as YAML (every field, defaults included).
 std::string ScenarioToYaml(const Scenario& scenario);
 
+// Every key a scenario may have, as YAML (the values meaningless): ScenarioToYaml of `scenario`
+// with each optional section (robot.stop_s and final_heading_deg, camera.distortion and
+// auto_exposure, calibration_error, frames, people, lights) filled in, which it writes only where
+// set. A suite checks its scenario overrides' keys against it (harness/suite/spec.cc).
+std::string ScenarioKeysYaml(const Scenario& scenario);
+
 // Path of a scenario shipped in scenes/ by name ("l_hallway" -> <data dir>/scenes/l_hallway.yaml,
 // sim/data_dir.h: the source tree, or <prefix>/share/vobench when installed).
 std::string BuiltinScenarioPath(const std::string& name);
