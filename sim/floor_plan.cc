@@ -978,24 +978,56 @@ bool PlanPath(const FloorPlan& plan, const Eigen::Vector2d& from, const Eigen::V
   return true;
 }
 
-mjModel* LoadSceneModel(const std::string& scene_path, std::string* error) {
+namespace {
+
+// `extra` inserted before the last "</mujoco>" of `xml`: false when there is none.
+bool AddToMujoco(std::string* xml, const std::string& extra) {
+  if (extra.empty()) return true;
+  const size_t end = xml->rfind("</mujoco>");
+  if (end == std::string::npos) return false;
+  xml->insert(end, extra);
+  return true;
+}
+
+}  // namespace
+
+mjModel* LoadSceneModel(const std::string& scene_path, std::string* error,
+                        const std::string& extra_mjcf) {
   char load_error[1024] = "";
-  if (!IsFloorPlanPath(scene_path)) {
+  if (!IsFloorPlanPath(scene_path) && extra_mjcf.empty()) {
     mjModel* m = mj_loadXML(scene_path.c_str(), nullptr, load_error, sizeof(load_error));
     if (!m) *error = scene_path + ": cannot load MJCF scene: " + load_error;
     return m;
   }
-  FloorPlan plan;
-  if (!LoadFloorPlan(scene_path, &plan, error)) return nullptr;
-  std::string robot;
-  if (!ReadInputFile(plan.robot_path, "robot MJCF file", &robot, error)) return nullptr;
-  // MuJoCo's virtual file system holds the generated scene and the robot it includes.
-  const std::string scene_name = "vobench_floor_plan_scene.xml";
-  const std::string robot_name = "vobench_floor_plan_robot.xml";
-  const std::string xml = FloorPlanToMjcf(plan, robot_name);
+  std::vector<std::pair<std::string, std::string>> files;  // VFS name, text
+  std::string load_name;  // what mj_loadXML opens: its folder is where includes are looked up
+  if (!IsFloorPlanPath(scene_path)) {
+    std::string xml;
+    if (!ReadInputFile(scene_path, "MJCF scene", &xml, error)) return nullptr;
+    if (!AddToMujoco(&xml, extra_mjcf)) {
+      *error = scene_path + ": cannot load MJCF scene: no </mujoco> element";
+      return nullptr;
+    }
+    const std::filesystem::path p(scene_path);
+    const std::string name = "vobench_with_people_" + p.filename().string();
+    load_name = (p.parent_path() / name).string();
+    files.emplace_back(name, xml);
+  } else {
+    FloorPlan plan;
+    if (!LoadFloorPlan(scene_path, &plan, error)) return nullptr;
+    std::string robot;
+    if (!ReadInputFile(plan.robot_path, "robot MJCF file", &robot, error)) return nullptr;
+    // MuJoCo's virtual file system holds the generated scene and the robot it includes.
+    const std::string scene_name = "vobench_floor_plan_scene.xml";
+    const std::string robot_name = "vobench_floor_plan_robot.xml";
+    std::string xml = FloorPlanToMjcf(plan, robot_name);
+    AddToMujoco(&xml, extra_mjcf);
+    files = {{scene_name, xml}, {robot_name, robot}};
+    load_name = scene_name;
+  }
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
-  for (const auto& [name, text] : {std::pair{scene_name, xml}, std::pair{robot_name, robot}}) {
+  for (const auto& [name, text] : files) {
     if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(text.size())) != 0) {
       *error = scene_path + ": cannot hold the generated scene in MuJoCo's virtual file system";
       mj_deleteVFS(vfs.get());
@@ -1004,10 +1036,14 @@ mjModel* LoadSceneModel(const std::string& scene_path, std::string* error) {
     const int i = mj_findFileVFS(vfs.get(), name.c_str());
     std::memcpy(vfs->filedata[i], text.data(), text.size());
   }
-  mjModel* m = mj_loadXML(scene_name.c_str(), vfs.get(), load_error, sizeof(load_error));
+  mjModel* m = mj_loadXML(load_name.c_str(), vfs.get(), load_error, sizeof(load_error));
   mj_deleteVFS(vfs.get());
   if (!m)
-    *error = scene_path + ": the scene generated from the floor plan does not load: " + load_error;
+    *error =
+        scene_path +
+        (IsFloorPlanPath(scene_path) ? ": the scene generated from the floor plan does not load: "
+                                     : ": cannot load MJCF scene: ") +
+        load_error;
   return m;
 }
 

@@ -152,7 +152,11 @@ bool IsFloorPlanPath(const std::string& path);
 
 // Loads a scene: an MJCF file, or a floor plan generated in memory (MuJoCo's virtual file
 // system, with the plan's robot file). nullptr with *error naming the file on failure.
-mjModel* LoadSceneModel(const std::string& scene_path, std::string* error);
+// `extra_mjcf` (top-level MJCF elements: the people of sim/people.h) is added at the end of the
+// scene's <mujoco> element; an MJCF scene is then loaded from MuJoCo's virtual file system under
+// a name in its own folder, so that its includes resolve as from the file. Empty: the file as is.
+mjModel* LoadSceneModel(const std::string& scene_path, std::string* error,
+                        const std::string& extra_mjcf = "");
 
 // A path between two points of a checked plan, for a robot that must stay `clearance_m` from
 // every wall piece, jamb and box side below 1.5 m (lintels and soffits are above the robot):

@@ -1,5 +1,6 @@
 #include "sim/scenario.h"
 
+#include <mujoco/mujoco.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -16,6 +17,8 @@
 
 #include "sim/data_dir.h"
 #include "sim/floor_plan.h"
+#include "sim/lighting.h"
+#include "sim/people.h"
 #include "sim/scene_walls.h"
 #include "sim/yaml_input.h"
 
@@ -234,6 +237,182 @@ void EmitCalibrationAndFrames(const Scenario& s, YAML::Emitter* out) {
          << s.frames.time_jitter_s << YAML::EndMap;
 }
 
+// people, lights and camera.auto_exposure (issue #34): "" when fine, else the problem, and *key
+// names the key to blame.
+std::string PeopleAndLightsProblem(const Scenario& s, std::string* key) {
+  const PeopleOptions& p = s.people;
+  *key = "people.count";
+  if (!(p.count >= 0 && p.count <= kMaxPeople))
+    return "expected 0 .. " + std::to_string(kMaxPeople) + " people, got " +
+           std::to_string(p.count);
+  *key = "people.speed_mps";
+  if (!(p.speed_mps > 0 && p.speed_mps <= 3))
+    return "expected in (0, 3] m/s, got " + Num(p.speed_mps);
+  *key = "people.height_m";
+  if (!(p.height_m >= 1.0 && p.height_m <= 2.3))
+    return "expected in [1, 2.3] m, got " + Num(p.height_m);
+  const LightsOptions& l = s.lights;
+  *key = "lights.brightness_drift";
+  if (!(l.brightness_drift >= -1.0 && l.brightness_drift <= 1.0))
+    return "expected a fraction per minute in [-1, 1], got " + Num(l.brightness_drift);
+  *key = "lights.flicker_hz";
+  if (!(l.flicker_hz >= 0.0 && l.flicker_hz <= 1000.0))
+    return "expected in [0, 1000] Hz, got " + Num(l.flicker_hz);
+  *key = "lights.flicker_depth";
+  if (!(l.flicker_depth >= 0.0 && l.flicker_depth <= 1.0))
+    return "expected in [0, 1], got " + Num(l.flicker_depth);
+  for (size_t i = 0; i < l.switches.size(); ++i) {
+    const LightSwitch& w = l.switches[i];
+    *key = YamlReader::Item("lights.switch", i) + ".at_s";
+    if (!(w.at_s >= 0.0 && std::isfinite(w.at_s)))
+      return "expected a time >= 0 s, got " + Num(w.at_s);
+    if (i > 0 && w.at_s < l.switches[i - 1].at_s)
+      return "expected the switches in time order: " + Num(w.at_s) + " s is before the previous " +
+             Num(l.switches[i - 1].at_s) + " s";
+    *key = YamlReader::Item("lights.switch", i) + ".light";
+    if (w.light < 0) return "expected a light of the scene (its index or name)";
+  }
+  const AutoExposureOptions& a = s.camera.auto_exposure;
+  *key = "camera.auto_exposure.target_mean";
+  if (!(a.target_mean > 0.0 && a.target_mean < 255.0))
+    return "expected a grey level in (0, 255), got " + Num(a.target_mean);
+  *key = "camera.auto_exposure.time_constant_s";
+  if (!(a.time_constant_s > 0.0 && a.time_constant_s <= 60.0))
+    return "expected in (0, 60] s, got " + Num(a.time_constant_s);
+  return "";
+}
+
+// Reads people, lights and camera.auto_exposure (their ranges as PeopleAndLightsProblem's,
+// checked here at each key's line). A switch's light is kept by name; ResolveLights finds it.
+void ReadPeopleAndLights(const YAML::Node& root, YamlReader* r, Scenario* s) {
+  if (const YAML::Node n = root["people"]; n.IsDefined() && r->ok()) {
+    r->CheckKeys(n, "people", {"count", "seed", "speed_mps", "height_m"});
+    PeopleOptions& o = s->people;
+    r->Int(n, "people", "count", 0, kMaxPeople, &o.count);
+    r->Uint64(n, "people", "seed", &o.seed);
+    r->Double(n, "people", "speed_mps", &o.speed_mps);
+    r->Check(o.speed_mps > 0 && o.speed_mps <= 3, n, "people", "speed_mps",
+             "expected in (0, 3] m/s, got " + Num(o.speed_mps));
+    r->Double(n, "people", "height_m", &o.height_m);
+    r->Check(o.height_m >= 1.0 && o.height_m <= 2.3, n, "people", "height_m",
+             "expected in [1, 2.3] m, got " + Num(o.height_m));
+  }
+  if (const YAML::Node n = root["lights"]; n.IsDefined() && r->ok()) {
+    r->CheckKeys(n, "lights", {"switch", "brightness_drift", "flicker_hz", "flicker_depth"});
+    LightsOptions& o = s->lights;
+    r->Double(n, "lights", "brightness_drift", &o.brightness_drift);
+    r->Check(o.brightness_drift >= -1 && o.brightness_drift <= 1, n, "lights", "brightness_drift",
+             "expected a fraction per minute in [-1, 1], got " + Num(o.brightness_drift));
+    r->Double(n, "lights", "flicker_hz", &o.flicker_hz);
+    r->Check(o.flicker_hz >= 0 && o.flicker_hz <= 1000, n, "lights", "flicker_hz",
+             "expected in [0, 1000] Hz, got " + Num(o.flicker_hz));
+    r->Double(n, "lights", "flicker_depth", &o.flicker_depth);
+    r->Check(o.flicker_depth >= 0 && o.flicker_depth <= 1, n, "lights", "flicker_depth",
+             "expected in [0, 1], got " + Num(o.flicker_depth));
+    if (const YAML::Node list = n["switch"]; list.IsDefined() && r->ok()) {
+      if (!list.IsSequence())
+        r->Fail(list, "lights.switch", "expected a list of {at_s, light, on}");
+      for (size_t i = 0; r->ok() && i < list.size(); ++i) {
+        const std::string item = YamlReader::Item("lights.switch", i);
+        const YAML::Node w = list[i];
+        r->CheckKeys(w, item, {"at_s", "light", "on"});
+        r->Require(w, item, "at_s", "the time of the switch (s from frame 0)");
+        r->Require(w, item, "light", "the light's index in the scene (0, 1, ...) or its name");
+        r->Require(w, item, "on", "true (switched on) or false (off)");
+        LightSwitch sw;
+        r->Double(w, item, "at_s", &sw.at_s);
+        r->Check(sw.at_s >= 0, w, item, "at_s", "expected a time >= 0 s, got " + Num(sw.at_s));
+        r->Check(o.switches.empty() || sw.at_s >= o.switches.back().at_s, w, item, "at_s",
+                 "expected the switches in time order: " + Num(sw.at_s) +
+                     " s is before the previous switch");
+        r->String(w, item, "light", &sw.name, false);
+        r->Bool(w, item, "on", &sw.on);
+        o.switches.push_back(sw);
+      }
+    }
+  }
+  const YAML::Node camera = root["camera"];
+  if (const YAML::Node n =
+          camera.IsMap() ? camera["auto_exposure"] : YAML::Node(YAML::NodeType::Undefined);
+      n.IsDefined() && r->ok()) {
+    r->CheckKeys(n, "camera.auto_exposure", {"enabled", "target_mean", "time_constant_s"});
+    AutoExposureOptions& o = s->camera.auto_exposure;
+    r->Bool(n, "camera.auto_exposure", "enabled", &o.enabled);
+    r->Double(n, "camera.auto_exposure", "target_mean", &o.target_mean);
+    r->Check(o.target_mean > 0 && o.target_mean < 255, n, "camera.auto_exposure", "target_mean",
+             "expected a grey level in (0, 255), got " + Num(o.target_mean));
+    r->Double(n, "camera.auto_exposure", "time_constant_s", &o.time_constant_s);
+    r->Check(o.time_constant_s > 0 && o.time_constant_s <= 60, n, "camera.auto_exposure",
+             "time_constant_s", "expected in (0, 60] s, got " + Num(o.time_constant_s));
+  }
+}
+
+// The switches' lights found in the scene (by name, or by index given as a number), at the line
+// of a light that is not there.
+bool ResolveLights(const YAML::Node& root, YamlReader* r, Scenario* s, std::string* error) {
+  if (s->lights.switches.empty()) return true;
+  mjModel* m = LoadSceneModel(s->scene_path, error);
+  if (!m) return false;
+  for (size_t i = 0; i < s->lights.switches.size(); ++i) {
+    LightSwitch& sw = s->lights.switches[i];
+    std::string known;
+    sw.light = FindLight(m, sw.name, &known);
+    if (sw.light < 0) {
+      r->Fail(root["lights"]["switch"][i]["light"], YamlReader::Item("lights.switch", i) + ".light",
+              "no light '" + sw.name + "' in " + s->scene_path +
+                  " (lights: " + (known.empty() ? "none" : known) + ")");
+      break;
+    }
+    // Kept by name when given by name, else by index.
+    const char* name = mj_id2name(m, mjOBJ_LIGHT, sw.light);
+    if (!name || sw.name != name) sw.name.clear();
+  }
+  mj_deleteModel(m);
+  return r->Report(error);
+}
+
+// The people and lights sections in ScenarioToYaml, only where they differ from the defaults.
+void EmitPeopleAndLights(const Scenario& s, YAML::Emitter* out) {
+  const PeopleOptions p = s.people, d;
+  if (p.count != d.count || p.seed != d.seed || p.speed_mps != d.speed_mps ||
+      p.height_m != d.height_m)
+    *out << YAML::Key << "people" << YAML::Value << YAML::BeginMap << YAML::Key << "count"
+         << YAML::Value << p.count << YAML::Key << "seed" << YAML::Value << p.seed << YAML::Key
+         << "speed_mps" << YAML::Value << p.speed_mps << YAML::Key << "height_m" << YAML::Value
+         << p.height_m << YAML::EndMap;
+  const LightsOptions& l = s.lights;
+  if (!l.switches.empty() || l.brightness_drift != 0.0 || l.flicker_hz != 0.0 ||
+      l.flicker_depth != 0.0) {
+    *out << YAML::Key << "lights" << YAML::Value << YAML::BeginMap;
+    if (!l.switches.empty()) {
+      *out << YAML::Key << "switch" << YAML::Value << YAML::BeginSeq;
+      for (const LightSwitch& w : l.switches) {
+        *out << YAML::Flow << YAML::BeginMap << YAML::Key << "at_s" << YAML::Value << w.at_s
+             << YAML::Key << "light" << YAML::Value;
+        if (w.name.empty())
+          *out << w.light;
+        else
+          *out << w.name;
+        *out << YAML::Key << "on" << YAML::Value << w.on << YAML::EndMap;
+      }
+      *out << YAML::EndSeq;
+    }
+    *out << YAML::Key << "brightness_drift" << YAML::Value << l.brightness_drift << YAML::Key
+         << "flicker_hz" << YAML::Value << l.flicker_hz << YAML::Key << "flicker_depth"
+         << YAML::Value << l.flicker_depth << YAML::EndMap;
+  }
+}
+
+// camera.auto_exposure in ScenarioToYaml's camera map, only where it differs from the defaults.
+void EmitAutoExposure(const Scenario& s, YAML::Emitter* out) {
+  const AutoExposureOptions a = s.camera.auto_exposure, d;
+  if (a.enabled != d.enabled || a.target_mean != d.target_mean ||
+      a.time_constant_s != d.time_constant_s)
+    *out << YAML::Key << "auto_exposure" << YAML::Value << YAML::BeginMap << YAML::Key << "enabled"
+         << YAML::Value << a.enabled << YAML::Key << "target_mean" << YAML::Value << a.target_mean
+         << YAML::Key << "time_constant_s" << YAML::Value << a.time_constant_s << YAML::EndMap;
+}
+
 }  // namespace
 
 int EstimatedFrames(const Scenario& s) {
@@ -327,6 +506,8 @@ bool Scenario::IsValid(std::string* error) const {
     e << imu_key << ": " << imu;
   else if (std::string cf_key, cf = CalibrationAndFramesProblem(*this, &cf_key); !cf.empty())
     e << cf_key << ": " << cf;
+  else if (std::string pl_key, pl = PeopleAndLightsProblem(*this, &pl_key); !pl.empty())
+    e << pl_key << ": " << pl;
   else {
     for (size_t i = 0; i < path.size(); ++i) {
       if (!path[i].allFinite()) {
@@ -363,9 +544,26 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   constexpr int kIntMin = std::numeric_limits<int>::min();
   constexpr int kIntMax = std::numeric_limits<int>::max();
   r.CheckKeys(root, "",
-              {"camera", "max_duration_s", "name", "noise", "path", "physics_dt_s", "rate_hz",
-               "robot", "scene", "floor_plan", "route", "seed", "settle_s", "textures", "imu",
-               "navigation", "calibration_error", "frames"});
+              {"camera",
+               "max_duration_s",
+               "name",
+               "noise",
+               "path",
+               "physics_dt_s",
+               "rate_hz",
+               "robot",
+               "scene",
+               "floor_plan",
+               "route",
+               "seed",
+               "settle_s",
+               "textures",
+               "imu",
+               "navigation",
+               "calibration_error",
+               "frames",
+               "people",
+               "lights"});
   r.String(root, "", "name", &s.name);
   // The scene: an MJCF file, or a floor plan it is generated from (sim/floor_plan.h).
   std::string scene, floor_plan;
@@ -441,8 +639,8 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   }
   if (const YAML::Node n = root["camera"]; n.IsDefined() && r.ok()) {
     r.CheckKeys(n, "camera",
-                {"baseline_m", "distortion", "forward_m", "fovy_deg", "height", "height_m",
-                 "pitch_deg", "width"});
+                {"auto_exposure", "baseline_m", "distortion", "forward_m", "fovy_deg", "height",
+                 "height_m", "pitch_deg", "width"});
     CameraOptions& o = s.camera;
     r.Int(n, "camera", "width", kIntMin, kIntMax, &o.width);
     r.Check(o.width >= 16 && o.width <= 4096, n, "camera", "width",
@@ -517,6 +715,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     for (size_t i = 0; i < std::size(keys) && r.ok(); ++i) r.Double(n, "imu", keys[i], values[i]);
   }
   ReadCalibrationAndFrames(root, &r, &s);
+  ReadPeopleAndLights(root, &r, &s);
   if (std::string key, imu = ImuProblem(s, &key);
       r.ok() && !imu.empty() && s.physics_dt_s > 0 && s.physics_dt_s <= 0.01) {
     // At the imu key's line, else at physics_dt_s (a step that the default rate does not fit).
@@ -579,6 +778,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   if (s.name.empty()) s.name = fs::path(source_name).stem().string();
   s.source_path = source_name;
   std::string why;
+  if (!ResolveLights(root, &r, &s, error)) return false;
   if (!s.IsValid(&why)) {
     // At the line of the key the problem names: "rate_hz: ...", "robot.speed_mps: ...",
     // "path[3]: ...", "camera.width/height: ..." (a key left at its default: no line).
@@ -597,6 +797,11 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   if (const std::string problem = PathProblem(s, walls, floors, &waypoint); !problem.empty()) {
     const std::string key = "path[" + std::to_string(waypoint) + "]";
     r.Fail(NodeOfKey(root, key), key, problem);
+    return r.Report(error);
+  }
+  // The people's paths (sim/people.h), refused here when there are none.
+  if (std::vector<PersonPath> people; !PlanPeople(s, walls, floors, &people, &why)) {
+    r.Fail(NodeOfKey(root, "people.count"), "people.count", why);
     return r.Report(error);
   }
   *scenario = std::move(s);
@@ -648,6 +853,7 @@ std::string ScenarioToYaml(const Scenario& s) {
       << s.camera.height_m << YAML::Key << "forward_m" << YAML::Value << s.camera.forward_m
       << YAML::Key << "pitch_deg" << YAML::Value << s.camera.pitch_deg;
   EmitLens(s, &out);
+  EmitAutoExposure(s, &out);
   out << YAML::EndMap;
   out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap << YAML::Key << "pixel_sigma"
       << YAML::Value << s.noise.pixel_sigma << YAML::Key << "gain_sigma" << YAML::Value
@@ -674,8 +880,24 @@ std::string ScenarioToYaml(const Scenario& s) {
     out << YAML::Key << k << YAML::Value << v;
   out << YAML::EndMap;
   EmitCalibrationAndFrames(s, &out);
+  EmitPeopleAndLights(s, &out);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
+}
+
+std::string ScenarioKeysYaml(const Scenario& scenario) {
+  Scenario s = scenario;
+  s.robot.stop_s = 1.0;
+  s.robot.final_heading_deg = 0.0;
+  s.camera.distortion.model = kRadTan;
+  s.camera.distortion.coeffs.assign(4, 0.0);
+  s.camera.auto_exposure.enabled = !AutoExposureOptions().enabled;
+  s.calibration_error.baseline_pct = 1.0;
+  s.frames.drop_rate = 0.1;
+  s.people.count = 1;
+  s.lights.switches.assign(1, LightSwitch{0.0, 0, "", false});
+  s.lights.flicker_hz = 1.0;
+  return ScenarioToYaml(s);
 }
 
 std::string BuiltinScenarioPath(const std::string& name) {

@@ -41,6 +41,18 @@ constexpr double kMaxFovDeg = 170.0;     // exclusive
 // Renders averaged over a motion-blur exposure, at most (each one is a full stereo render).
 constexpr int kMaxMotionBlurSamples = 1000;
 
+// Auto-exposure (camera.auto_exposure, sim/lighting.h): a first-order loop that scales the
+// rendered grey levels by a gain g (before the noise model). At each frame k the gain wanted is
+// target_mean / mean_k (mean_k: the mean grey level of the left render at gain 1); the gain
+// moves toward it as g_k = g_{k-1} + (1 - exp(-T / time_constant_s)) (wanted_k - g_{k-1}), T the
+// frame period, so a step in the scene's brightness is followed with that time constant. Frame 0
+// starts converged (g_0 = wanted_0). Gains are kept in [1/16, 16]. Both cameras get the same gain.
+struct AutoExposureOptions {
+  bool enabled = false;
+  double target_mean = 110.0;    // grey level the loop steers the mean to, (0, 255)
+  double time_constant_s = 0.5;  // (s), > 0 and <= 60
+};
+
 // Rectified stereo pair on the robot (the paper's Videre head by default).
 struct CameraOptions {
   int width = 320;           // image width (pixels), 16..4096
@@ -54,6 +66,7 @@ struct CameraOptions {
   // camera.distortion.model (radtan | equidistant) and camera.distortion.coeffs (4 numbers);
   // the images are then the raw, distorted ones, rendered wider and remapped.
   LensDistortion distortion;
+  AutoExposureOptions auto_exposure;  // camera.auto_exposure.*: off by default
 };
 
 // Camera noise models; each is off at 0.
@@ -122,6 +135,46 @@ struct FrameOptions {
   bool any() const { return drop_rate != 0.0 || time_jitter_s != 0.0; }
 };
 
+// People (issue #34): kinematic (mocap) bodies of human proportions (sim/people.h), each walking
+// its own path back and forth at speed_mps: in a floor-plan scene between two of the plan's
+// named places (PlanPath), in an MJCF scene (or a plan with fewer than two places) along a line
+// beside the robot's path, clear of the walls and of the robot. They do not collide (no contacts,
+// never wall contacts). Deterministic from `seed`; count 0 (the default) adds nothing.
+constexpr int kMaxPeople = 20;
+struct PeopleOptions {
+  int count = 0;           // people in the scene, [0, kMaxPeople]
+  uint64_t seed = 1;       // their paths, phases and clothes' textures
+  double speed_mps = 1.2;  // walking speed (m/s), (0, 3]
+  double height_m = 1.75;  // body height (m), [1, 2.3]
+};
+
+// A lamp switched at a time (lights.switch): light `light` (index in the scene's lights, model
+// order, or its name) turned on or off at at_s (s from frame 0) and kept so until the next switch.
+struct LightSwitch {
+  double at_s = 0.0;  // >= 0
+  int light = -1;     // index into the scene's lights (the name resolved when read)
+  std::string name;   // the light's name as given ("" when given by index)
+  bool on = false;
+};
+
+// Lights (issue #34, sim/lighting.h), each off by default, applied to MuJoCo's light and material
+// properties before every render, at the render's time t (s from frame 0):
+//   brightness(t) = max(0, 1 + brightness_drift * t / 60)
+//                   * (1 - flicker_depth * (1 - cos(2 pi flicker_hz t)) / 2)
+// scales every light's diffuse, ambient and specular colour and every material's emission (the
+// scenes light their surfaces mostly by emission, the building's even ambient light), and a lamp
+// switched off gives no light (its colours 0; sim/lighting.h SceneLighting).
+struct LightsOptions {
+  std::vector<LightSwitch> switches;  // in time order
+  double brightness_drift = 0.0;      // fraction of the initial brightness gained per minute,
+                                      // [-1, 1] (negative: dimming; clamped at 0)
+  double flicker_hz = 0.0;            // flicker frequency (Hz), [0, 1000]; 0 = none
+  double flicker_depth = 0.0;         // the dip of the flicker, [0, 1]: brightness 1 .. 1 - depth
+  bool any() const {
+    return !switches.empty() || brightness_drift != 0.0 || (flicker_hz > 0 && flicker_depth > 0);
+  }
+};
+
 struct Scenario {
   std::string name;             // scenario name (file stem unless given)
   std::string source_path;      // the YAML file it was read from (empty if built in code)
@@ -145,6 +198,8 @@ struct Scenario {
   std::string navigation = "ground_truth";
   CalibrationErrorOptions calibration_error;
   FrameOptions frames;
+  PeopleOptions people;
+  LightsOptions lights;
 
   bool IsValid(std::string* error) const;
 };
@@ -165,6 +220,12 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
 
 // Writes the effective scenario as YAML (every field, defaults included).
 std::string ScenarioToYaml(const Scenario& scenario);
+
+// Every key a scenario may have, as YAML (the values meaningless): ScenarioToYaml of `scenario`
+// with each optional section (robot.stop_s and final_heading_deg, camera.distortion and
+// auto_exposure, calibration_error, frames, people, lights) filled in, which it writes only where
+// set. A suite checks its scenario overrides' keys against it (harness/suite/spec.cc).
+std::string ScenarioKeysYaml(const Scenario& scenario);
 
 // Path of a scenario shipped in scenes/ by name ("l_hallway" -> <data dir>/scenes/l_hallway.yaml,
 // sim/data_dir.h: the source tree, or <prefix>/share/vobench when installed).

@@ -9,8 +9,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sim/floor_plan.h"
+#include "sim/lighting.h"
 #include "sim/noise.h"
 #include "sim/path_follower.h"
+#include "sim/people.h"
 #include "sim/random.h"
 #include "sim/renderer.h"
 #include "sim/scene_walls.h"
@@ -156,6 +158,11 @@ struct Simulator::Impl {
   NavigationReport nav;
   std::vector<char> robot_geom, building_geom;  // per geom: on the robot; the building to touch
   bool touching = false;                        // in contact with the building at the last step
+  // People, lights and auto-exposure (issue #34; sim/people.h, sim/lighting.h).
+  People people;
+  std::vector<int> person_body;  // body id of each person
+  std::unique_ptr<SceneLighting> lighting;
+  std::unique_ptr<AutoExposure> auto_exposure;
 
   ~Impl() {
     renderer.reset();
@@ -180,7 +187,9 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   Impl& im = *sim->impl_;
   const std::string& scene = scenario.scene_path;
 
-  im.m = LoadSceneModel(scene, error);  // an MJCF file or a floor plan (sim/floor_plan.h)
+  // An MJCF file or a floor plan (sim/floor_plan.h), with the people's bodies (sim/people.h).
+  im.m = LoadSceneModel(scene, error,
+                        scenario.people.count > 0 ? PeopleMjcf(scenario.people) : std::string());
   if (!im.m) return nullptr;
   mjModel* m = im.m;
   im.body = mj_name2id(m, mjOBJ_BODY, kRobotBody);
@@ -240,6 +249,28 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
              std::to_string(waypoint) + "]': " + through;
     return nullptr;
   }
+  if (scenario.people.count > 0) {  // their paths (sim/people.h), then their bodies' textures
+    std::vector<PersonPath> paths;
+    if (!PlanPeople(scenario, walls, floors, &paths, error) ||
+        !im.people.Init(m, scenario.people, std::move(paths), error)) {
+      *error = (scenario.source_path.empty() ? "scenario" : scenario.source_path) +
+               ": key 'people.count': " + *error;
+      return nullptr;
+    }
+    for (int i = 0; i < scenario.people.count; ++i)
+      im.person_body.push_back(mj_name2id(m, mjOBJ_BODY, ("person" + std::to_string(i)).c_str()));
+  }
+  for (const LightSwitch& sw : scenario.lights.switches)
+    if (sw.light < 0 || sw.light >= m->nlight) {
+      *error = (scenario.source_path.empty() ? "scenario" : scenario.source_path) +
+               ": key 'lights.switch': light " + std::to_string(sw.light) + " of " + scene +
+               ", which has " + std::to_string(m->nlight) + " lights";
+      return nullptr;
+    }
+  im.lighting = std::make_unique<SceneLighting>(m, scenario.lights);
+  if (scenario.camera.auto_exposure.enabled)
+    im.auto_exposure =
+        std::make_unique<AutoExposure>(scenario.camera.auto_exposure, 1.0 / scenario.rate_hz);
 
   // Stereo rig: place both cameras from the scenario (body frame: x forward, y left, z up,
   // origin at the wheel axle, which rests at wheel-radius height).
@@ -315,6 +346,7 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   im.d->qpos[qadr + 4] = 0;
   im.d->qpos[qadr + 5] = 0;
   im.d->qpos[qadr + 6] = std::sin(yaw / 2);
+  if (scenario.people.count > 0) im.people.Apply(m, im.d, -scenario.settle_s);
   mj_forward(m, im.d);
   im.follower = std::make_unique<PathFollower>(scenario.path, scenario.robot);
   // Navigation: the belief starts at the known start pose. The building's geoms to touch: those
@@ -415,9 +447,12 @@ bool Simulator::Capture(StereoFrame* frame, std::string* error) {
   const int qadr = m->jnt_qposadr[im.root_joint];
   const int vadr = m->jnt_dofadr[im.root_joint];
   while (true) {
-    // Kinematics of the current state, consistent with d->time.
-    mj_step1(m, d);
+    // The people where they are at this step, then the kinematics of the current state,
+    // consistent with d->time.
     const long step = std::lround(d->time / dt);
+    const double t_step = (step - im.start_step) * dt;  // from frame 0
+    if (sc.people.count > 0) im.people.Apply(m, d, t_step);
+    mj_step1(m, d);
     const PlanarPose truth{Eigen::Vector2d(d->qpos[qadr], d->qpos[qadr + 1]),
                            YawOf(d->qpos + qadr + 3)};
     if (im.closed_loop && im.step_estimator && step >= im.start_step)
@@ -462,6 +497,7 @@ bool Simulator::Capture(StereoFrame* frame, std::string* error) {
       for (int c = 0; c < 2; ++c) {
         cv::Mat rgb, grey;
         cv::Mat* depth = (c == 0 && !blur) ? &frame->depth_m : nullptr;
+        im.lighting->Apply(m, t_step);  // lights.* at this render's time (none: no change)
         im.renderer->Render(m, d, c == 0 ? im.cam0 : im.cam1, &rgb, depth);
         cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
         if (acc[c].empty()) acc[c] = cv::Mat::zeros(grey.size(), CV_32FC1);
@@ -472,6 +508,9 @@ bool Simulator::Capture(StereoFrame* frame, std::string* error) {
     if (step == gt_step) {
       frame->T_world_cam0 = CameraPoseCv(d, im.cam0);
       frame->T_world_body = BodyPose(d, im.body);
+      people_at_frame_.clear();
+      for (int b : im.person_body)
+        people_at_frame_.emplace_back(d->xpos[3 * b], d->xpos[3 * b + 1], d->xpos[3 * b + 2]);
       if (blur) im.renderer->Render(m, d, im.cam0, nullptr, &frame->depth_m);
       have_gt = true;
       NavigationFrame nf;
@@ -544,7 +583,8 @@ bool Simulator::Capture(StereoFrame* frame, std::string* error) {
     if (step >= last_step && have_gt && rendered == samples) break;
   }
 
-  // Average the exposure samples, then the per-image noise (seeded by frame and camera).
+  // Average the exposure samples, then the auto-exposure's gain (one for both cameras, from the
+  // left image), then the per-image noise (seeded by frame and camera).
   for (int c = 0; c < 2; ++c) {
     acc[c] *= 1.0 / samples;
     if (sc.camera.distortion.any()) {  // the lens: the wide pinhole render remapped (bilinear)
@@ -552,6 +592,13 @@ bool Simulator::Capture(StereoFrame* frame, std::string* error) {
       cv::remap(acc[c], raw, im.lens.map_x, im.lens.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
       acc[c] = raw;
     }
+  }
+  if (im.auto_exposure) {
+    const double gain = im.auto_exposure->Update(acc[0]);
+    for (int c = 0; c < 2; ++c) acc[c] *= gain;
+  }
+  exposure_gain_ = im.auto_exposure ? im.auto_exposure->gain() : 1.0;
+  for (int c = 0; c < 2; ++c) {
     cv::Mat out =
         ApplyCameraNoise(acc[c], sc.noise, DeriveSeed(sc.seed, static_cast<uint64_t>(k), c));
     (c == 0 ? frame->left : frame->right) = out;

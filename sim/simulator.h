@@ -67,6 +67,11 @@ class Simulator {
   int EstimatedFrames() const;
   // Robot base position (x, y, z in the world, m) after every physics step since frame 0.
   const std::vector<Eigen::Vector3d>& body_track() const { return body_track_; }
+  // The people (people.count, sim/people.h): where each one's body origin (on the floor, below
+  // the torso) was at the time of the frame Next() gave last.
+  const std::vector<Eigen::Vector3d>& people_at_last_frame() const { return people_at_frame_; }
+  // The auto-exposure's gain of the frame Next() gave last (1 without camera.auto_exposure).
+  double exposure_gain() const { return exposure_gain_; }
 
   // Closed loop (navigation: vo; sim/navigation.h). What the follower believed at the time of
   // the frame Next() gave last, before any fix of it.
@@ -89,6 +94,8 @@ class Simulator {
   Scenario scenario_;
   StereoCalibration calibration_;
   std::vector<Eigen::Vector3d> body_track_;
+  std::vector<Eigen::Vector3d> people_at_frame_;
+  double exposure_gain_ = 1.0;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -251,7 +251,8 @@ bool ParseSuite(const std::string& yaml_text, const std::string& source_name,
         r.Fail(set, key + ".set", "expected a mapping of scenario keys to values");
         break;
       }
-      CheckOverrideKeys(set, YAML::Load(sim::ScenarioToYaml(base)), key + ".set", "scenario", &r);
+      // Every key, the optional sections too (written only where set).
+      CheckOverrideKeys(set, YAML::Load(sim::ScenarioKeysYaml(base)), key + ".set", "scenario", &r);
       std::string why;
       if (r.ok() && !ApplyScenarioOverrides(base, set, kOverridesSource, &sc.scenario, &why))
         r.SetError(OverrideErrorAt(r.Where(set), key + ".set", why));
