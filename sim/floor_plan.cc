@@ -760,7 +760,62 @@ std::vector<PlanSurface> PlanSurfaces(const FloorPlan& plan) {
   return out;
 }
 
-std::string FloorPlanToMjcf(const FloorPlan& plan, const std::string& robot_include) {
+std::vector<PlanSolid> PlanSolids(const FloorPlan& plan) {
+  const std::vector<PlanSurface> surfaces = PlanSurfaces(plan);
+  // The surfaces of the boxes come last: four sides and a top unless the box is as high as the
+  // ceiling; floor and ceiling before them. Walls, jambs and soffits before those.
+  size_t box_surfaces = 0;
+  for (const PlanBox& b : plan.boxes)
+    box_surfaces += b.height_m >= plan.ceiling_height_m - kEps ? 4 : 5;
+  const size_t walls_end = surfaces.size() - box_surfaces - 2;
+  struct Vertical {
+    const PlanSurface* s;
+    Eigen::Vector2d a, b, n;  // its ends and its normal (into the space it faces)
+  };
+  std::vector<Vertical> vertical;
+  for (size_t i = 0; i < walls_end; ++i) {
+    const PlanSurface& s = surfaces[i];
+    if (std::abs(s.y_axis.z()) < 0.5) continue;  // a soffit: above the robot
+    const Eigen::Vector2d c = s.centre.head<2>(), x = s.x_axis.head<2>();
+    vertical.push_back({&s, c - s.half_width_m * x, c + s.half_width_m * x,
+                        s.x_axis.cross(s.y_axis).head<2>().normalized()});
+  }
+  std::vector<PlanSolid> out;
+  for (const Vertical& v : vertical) {
+    // As thick as kSolidThicknessM, but no more than half the gap to a wall facing the other way
+    // behind it (two spaces 0.1 m apart get 0.05 m each; coincident walls kMinSolidThicknessM).
+    double t = kSolidThicknessM;
+    const Eigen::Vector2d along = (v.b - v.a).normalized();
+    const double len = (v.b - v.a).norm();
+    for (const Vertical& w : vertical) {
+      if (&w == &v || v.n.dot(w.n) > -1.0 + 1e-6) continue;  // not antiparallel
+      const double gap = (v.a - w.a).dot(v.n);               // w behind v by this much
+      if (gap < -kEps || gap >= 2.0 * t) continue;
+      const double s0 = (w.a - v.a).dot(along), s1 = (w.b - v.a).dot(along);
+      if (std::max(s0, s1) <= kEps || std::min(s0, s1) >= len - kEps) continue;  // no overlap
+      t = std::max(kMinSolidThicknessM, std::min(t, 0.5 * gap));
+    }
+    PlanSolid s;
+    s.name = "solid_" + v.s->name;
+    s.centre = v.s->centre - 0.5 * t * Eigen::Vector3d(v.n.x(), v.n.y(), 0.0);
+    s.x_axis = v.s->x_axis;
+    s.y_axis = v.s->y_axis;
+    s.half_size = Eigen::Vector3d(v.s->half_width_m, v.s->half_height_m, 0.5 * t);
+    out.push_back(s);
+  }
+  for (const PlanBox& b : plan.boxes) {
+    PlanSolid s;
+    s.name = "solid_box_" + b.name;
+    s.centre = Eigen::Vector3d(b.centre_xy.x(), b.centre_xy.y(), 0.5 * b.height_m);
+    s.x_axis = Eigen::Vector3d(std::cos(b.yaw_rad), std::sin(b.yaw_rad), 0.0);
+    s.y_axis = Eigen::Vector3d(-std::sin(b.yaw_rad), std::cos(b.yaw_rad), 0.0);
+    s.half_size = Eigen::Vector3d(0.5 * b.size_m.x(), 0.5 * b.size_m.y(), 0.5 * b.height_m);
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::string FloorPlanToMjcf(const FloorPlan& plan, const std::string& robot_include, bool solids) {
   const std::vector<PlanSurface> surfaces = PlanSurfaces(plan);
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
   for (const PlanSpace& sp : plan.spaces)
@@ -821,6 +876,20 @@ std::string FloorPlanToMjcf(const FloorPlan& plan, const std::string& robot_incl
       << " " << Num(s.x_axis.z()) << " " << Num(s.y_axis.x()) << " " << Num(s.y_axis.y()) << " "
       << Num(s.y_axis.z()) << "\" material=\"" << s.texture
       << "\" contype=\"0\" conaffinity=\"0\" group=\"0\"/>\n";
+  }
+  if (solids) {
+    x << "    <!-- The building's solid side, collision only (group 3 is never drawn): a box "
+         "behind "
+         "each wall\n         piece and jamb, and each box itself, so that a robot meets them "
+         "(navigation: vo). -->\n";
+    for (const PlanSolid& s : PlanSolids(plan)) {
+      x << "    <geom name=\"" << s.name << "\" type=\"box\" size=\"" << Num(s.half_size.x()) << " "
+        << Num(s.half_size.y()) << " " << Num(s.half_size.z()) << "\" pos=\"" << Num(s.centre.x())
+        << " " << Num(s.centre.y()) << " " << Num(s.centre.z()) << "\" xyaxes=\""
+        << Num(s.x_axis.x()) << " " << Num(s.x_axis.y()) << " " << Num(s.x_axis.z()) << " "
+        << Num(s.y_axis.x()) << " " << Num(s.y_axis.y()) << " " << Num(s.y_axis.z())
+        << "\" group=\"3\" rgba=\"0 0 0 0\"/>\n";
+    }
   }
   x << "  </worldbody>\n</mujoco>\n";
   return x.str();

@@ -144,8 +144,27 @@ bool ParseFloorPlan(const std::string& yaml_text, const std::string& source_name
 // door jambs and soffits, floor, ceiling, boxes.
 std::vector<PlanSurface> PlanSurfaces(const FloorPlan& plan);
 
-// The MJCF of a checked plan; `robot_include` is the include's file attribute.
-std::string FloorPlanToMjcf(const FloorPlan& plan, const std::string& robot_include);
+// The building's solid side, for the physics only (the drawn planes do not collide: MuJoCo
+// planes collide as infinite planes): a box of kSolidThicknessM behind each wall piece and jamb,
+// as long and as high as it (thinner where another space's wall faces the other way closer
+// behind it: half the gap, at least kMinSolidThicknessM), and each furniture box as a solid box.
+// Written in geom group 3 (never drawn, sim/renderer.cc), so the renders are those without them;
+// the robot's chassis and wheels collide with them (Simulator's wall_contacts, sim/navigation.h).
+constexpr double kSolidThicknessM = 0.05;
+constexpr double kMinSolidThicknessM = 0.005;
+struct PlanSolid {
+  std::string name;  // "solid_" + the surface's name, or "solid_box_" + the box's
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX();  // the box's axes (unit)
+  Eigen::Vector3d y_axis = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d half_size = Eigen::Vector3d::Zero();  // half extents along x, y, x × y (m)
+};
+std::vector<PlanSolid> PlanSolids(const FloorPlan& plan);
+
+// The MJCF of a checked plan; `robot_include` is the include's file attribute. `solids`: with
+// the collision-only solids of PlanSolids (false: the drawn planes alone, as before them).
+std::string FloorPlanToMjcf(const FloorPlan& plan, const std::string& robot_include,
+                            bool solids = true);
 
 // True for a path that names a floor plan rather than an MJCF scene (".yaml" or ".yml").
 bool IsFloorPlanPath(const std::string& path);

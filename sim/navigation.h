@@ -23,9 +23,9 @@
 //   end_error_m           the wheel axle where the run ended vs the path's last waypoint (m)
 //   max_waypoint_error_m  at each moment the follower believed it reached a waypoint (the target
 //                         moves on, or the path is done), the true distance of the axle from it;
-//                         the largest (m). In corner_mode arc the follower cuts the corners and
-//                         moves its target on a look-ahead before them: only the last waypoint
-//                         counts there. NaN when no waypoint was reached
+//                         the largest (m). At an arc corner (corner_mode arc, or the waypoint's
+//                         turn: arc) the follower does not go to the waypoint: only the waypoints
+//                         it stops at count (in-place corners, the last). NaN when none was reached
 //   wall_contacts         contact events between the robot's geoms and the building's collision
 //                         geoms (geoms fixed to the world other than upward-facing planes, the
 //                         floor): a step with at least one such MuJoCo contact after a step with

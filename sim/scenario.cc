@@ -18,6 +18,7 @@
 #include "sim/data_dir.h"
 #include "sim/floor_plan.h"
 #include "sim/lighting.h"
+#include "sim/path_follower.h"
 #include "sim/people.h"
 #include "sim/scene_walls.h"
 #include "sim/yaml_input.h"
@@ -413,19 +414,121 @@ void EmitAutoExposure(const Scenario& s, YAML::Emitter* out) {
          << YAML::Key << "time_constant_s" << YAML::Value << a.time_constant_s << YAML::EndMap;
 }
 
+// path: a list of waypoints, each [x, y] or {at: [x, y], turn, radius_m, stop_s, speed_mps} (the
+// waypoint's own goals, WaypointOptions; their ranges and how they fit: WaypointProblem).
+bool ReadPath(const YAML::Node& list, YamlReader* r, Scenario* s) {
+  bool maps = false;
+  for (size_t i = 0; list.IsSequence() && i < list.size(); ++i) maps = maps || list[i].IsMap();
+  if (!maps) {  // pairs only, as always
+    std::vector<std::pair<double, double>> path;
+    if (!r->ReadPairs(list, "path", &path, "a list of waypoints [x, y] (m)", "a pair [x, y] (m)"))
+      return false;
+    for (const auto& [x, y] : path) s->path.emplace_back(x, y);
+    return true;
+  }
+  std::vector<WaypointOptions> own(list.size());
+  for (size_t i = 0; i < list.size() && r->ok(); ++i) {
+    const YAML::Node item = list[i];
+    const std::string key = YamlReader::Item("path", i);
+    std::vector<double> xy;
+    if (!item.IsMap()) {
+      r->ReadNumbers(item, key, 2, &xy, "a pair [x, y] (m) or a map {at: [x, y], ...}");
+    } else {
+      WaypointOptions& w = own[i];
+      r->CheckKeys(item, key, {"at", "turn", "radius_m", "stop_s", "speed_mps"});
+      r->Require(item, key, "at", "the waypoint [x, y] (m)");
+      r->ReadNumbers(item["at"], key + ".at", 2, &xy, "a pair [x, y] (m)");
+      r->String(item, key, "turn", &w.turn, false);
+      r->Check(w.turn.empty() || w.turn == "in_place" || w.turn == "arc", item, key, "turn",
+               "expected 'in_place' or 'arc', got '" + w.turn + "'");
+      r->Double(item, key, "radius_m", &w.radius_m);
+      r->Double(item, key, "stop_s", &w.stop_s);
+      r->Double(item, key, "speed_mps", &w.speed_mps);
+    }
+    if (r->ok()) s->path.emplace_back(xy[0], xy[1]);
+  }
+  s->waypoints = own;
+  return r->ok();
+}
+
+// The waypoints' own goals (WaypointOptions): "" when fine, else "path[i].KEY: problem".
+std::string WaypointProblem(const Scenario& s) {
+  if (s.waypoints.empty()) return "";
+  std::ostringstream e;
+  const size_t n = s.path.size();
+  if (s.waypoints.size() != n) {
+    e << "path: " << s.waypoints.size() << " waypoint goals for " << n << " waypoints";
+    return e.str();
+  }
+  const std::vector<WaypointGoal> goals = ResolveWaypoints(s.path, s.robot, s.waypoints);
+  auto tangent = [&](size_t i) {  // how much of each leg the circular arc at path[i] takes (m)
+    return goals[i].radius_m > 0.0
+               ? ArcAtCorner(s.path[i - 1], s.path[i], s.path[i + 1], goals[i].radius_m).tangent_m
+               : 0.0;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    const WaypointOptions& w = s.waypoints[i];
+    const std::string key = "path[" + std::to_string(i) + "].";
+    const bool inner = i > 0 && i + 1 < n;
+    if (!w.turn.empty() && w.turn != "in_place" && w.turn != "arc") {
+      e << key << "turn: expected 'in_place' or 'arc', got '" << w.turn << "'";
+    } else if (!w.turn.empty() && !inner) {
+      e << key << "turn: the first and the last waypoint have no corner to turn";
+    } else if (!std::isnan(w.radius_m) && !(w.radius_m > 0 && std::isfinite(w.radius_m))) {
+      e << key << "radius_m: expected a finite radius > 0 m, got " << w.radius_m;
+    } else if (!std::isnan(w.radius_m) && !goals[i].arc) {
+      e << key << "radius_m: an arc's radius, at a corner turned in place"
+        << (inner ? " (give turn: arc here, or robot.corner_mode: arc)"
+                  : " (the first and the last waypoint have no corner)");
+    } else if (!std::isnan(w.stop_s) && !(w.stop_s >= 0 && w.stop_s <= 600)) {
+      e << key << "stop_s: expected in [0, 600] s, got " << w.stop_s;
+    } else if (!std::isnan(w.stop_s) && w.stop_s > 0 && goals[i].arc) {
+      e << key << "stop_s: the robot does not stop at an arc corner (give turn: in_place here)";
+    } else if (!std::isnan(w.speed_mps) && !(w.speed_mps > 0 && w.speed_mps <= 3)) {
+      e << key << "speed_mps: expected in (0, 3] m/s, got " << w.speed_mps;
+    } else if (!std::isnan(w.speed_mps) && i + 1 == n) {
+      e << key
+        << "speed_mps: the speed of the leg that starts here; no leg starts at the last "
+           "waypoint";
+    } else if (inner && goals[i].radius_m > 0.0) {
+      // The arc's tangent points on both legs, after the previous arc's and before the next's.
+      const double t = tangent(i);
+      const double in = (s.path[i] - s.path[i - 1]).norm(),
+                   out = (s.path[i + 1] - s.path[i]).norm();
+      const double t_prev = i > 1 ? tangent(i - 1) : 0.0;
+      const double t_next = i + 2 < n ? tangent(i + 1) : 0.0;
+      if (!(t + t_prev <= in && t + t_next <= out))
+        e << key << "radius_m: an arc of " << w.radius_m << " m at this corner takes " << t
+          << " m of each leg; the leg in is " << in << " m"
+          << (t_prev > 0
+                  ? " (less " + Num(t_prev) + " m for path[" + std::to_string(i - 1) + "]'s arc)"
+                  : "")
+          << ", the leg out " << out << " m"
+          << (t_next > 0
+                  ? " (less " + Num(t_next) + " m for path[" + std::to_string(i + 1) + "]'s arc)"
+                  : "")
+          << ": a smaller radius";
+    }
+    if (e.tellp() != 0) break;
+  }
+  return e.str();
+}
+
 }  // namespace
 
 int EstimatedFrames(const Scenario& s) {
   // Driving at speed_mps, turning in place at turn_rate_dps at each corner (arc corners: no
   // extra time), at rate_hz; capped by max_duration_s.
-  double seconds = 0.0;
+  // The waypoints' own goals: each leg at its speed, stops where the robot stops.
+  const std::vector<WaypointGoal> goals = ResolveWaypoints(s.path, s.robot, s.waypoints);
+  double seconds = goals.empty() ? 0.0 : goals.front().stop_s + goals.back().stop_s;
   for (size_t i = 1; i < s.path.size(); ++i) {
     const Eigen::Vector2d d = s.path[i] - s.path[i - 1];
-    seconds += d.norm() / s.robot.speed_mps;
-    if (i + 1 < s.path.size() && s.robot.corner_mode == "in_place") {
+    seconds += d.norm() / goals[i - 1].speed_mps;
+    if (i + 1 < s.path.size() && !goals[i].arc) {
       const Eigen::Vector2d next = s.path[i + 1] - s.path[i];
       const double turn = std::abs(std::atan2(d.x() * next.y() - d.y() * next.x(), d.dot(next)));
-      seconds += turn * 180.0 / M_PI / s.robot.turn_rate_dps + s.robot.stop_s;
+      seconds += turn * 180.0 / M_PI / s.robot.turn_rate_dps + goals[i].stop_s;
     }
   }
   if (std::isfinite(s.robot.final_heading_deg) && s.path.size() >= 2) {  // the final turn
@@ -519,6 +622,7 @@ bool Scenario::IsValid(std::string* error) const {
         break;
       }
     }
+    if (e.tellp() == 0) e << WaypointProblem(*this);
     if (const double shortest = ShortestSegmentM(path);
         e.tellp() == 0 && !(robot.goal_tolerance_m < shortest))
       e << "robot.goal_tolerance_m: " << robot.goal_tolerance_m
@@ -589,8 +693,6 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   r.Check(s.navigation == "ground_truth" || s.navigation == "vo", root, "", "navigation",
           "expected 'ground_truth' or 'vo', got '" + s.navigation + "'");
 
-  // path: a sequence of [x, y] pairs.
-  std::vector<std::pair<double, double>> path;
   // route: {from: PLACE, to: PLACE}, the path planned through the floor plan (below).
   std::string route_from, route_to;
   const bool route = YamlReader::Has(root, "route");
@@ -606,9 +708,7 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
     r.String(n, "route", "from", &route_from, false);
     r.String(n, "route", "to", &route_to, false);
   } else if (r.Require(root, "", "path", "a list of at least 2 waypoints [x, y] (m)") &&
-             r.ReadPairs(root["path"], "path", &path, "a list of waypoints [x, y] (m)",
-                         "a pair [x, y] (m)")) {
-    for (const auto& [x, y] : path) s.path.emplace_back(x, y);
+             ReadPath(root["path"], &r, &s)) {
     r.Check(s.path.size() >= 2, root, "", "path",
             "expected at least 2 waypoints, got " + std::to_string(s.path.size()));
   }
@@ -794,8 +894,11 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
   std::vector<SceneFloor> floors;
   if (!WallsOfScene(s.scene_path, &walls, error, &floors)) return false;
   int waypoint = -1;
-  if (const std::string problem = PathProblem(s, walls, floors, &waypoint); !problem.empty()) {
-    const std::string key = "path[" + std::to_string(waypoint) + "]";
+  std::string field;
+  if (const std::string problem = PathProblem(s, walls, floors, &waypoint, &field);
+      !problem.empty()) {
+    const std::string key =
+        "path[" + std::to_string(waypoint) + "]" + (field.empty() ? "" : "." + field);
     r.Fail(NodeOfKey(root, key), key, problem);
     return r.Report(error);
   }
@@ -832,8 +935,21 @@ std::string ScenarioToYaml(const Scenario& s) {
   out << YAML::Key << "settle_s" << YAML::Value << s.settle_s;
   out << YAML::Key << "navigation" << YAML::Value << s.navigation;
   out << YAML::Key << "path" << YAML::Value << YAML::BeginSeq;
-  for (const auto& p : s.path)
-    out << YAML::Flow << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;
+  for (size_t i = 0; i < s.path.size(); ++i) {
+    const Eigen::Vector2d& p = s.path[i];
+    const WaypointOptions* w = i < s.waypoints.size() ? &s.waypoints[i] : nullptr;
+    if (!w || !w->any()) {  // a waypoint without goals of its own: a pair, as always
+      out << YAML::Flow << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;
+      continue;
+    }
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "at" << YAML::Value << YAML::Flow
+        << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;
+    if (!w->turn.empty()) out << YAML::Key << "turn" << YAML::Value << w->turn;
+    for (const auto& [k, v] : std::initializer_list<std::pair<const char*, double>>{
+             {"radius_m", w->radius_m}, {"stop_s", w->stop_s}, {"speed_mps", w->speed_mps}})
+      if (!std::isnan(v)) out << YAML::Key << k << YAML::Value << v;
+    out << YAML::EndMap;
+  }
   out << YAML::EndSeq;
   out << YAML::Key << "robot" << YAML::Value << YAML::BeginMap << YAML::Key << "speed_mps"
       << YAML::Value << s.robot.speed_mps << YAML::Key << "max_accel_mps2" << YAML::Value

@@ -31,6 +31,25 @@ struct RobotOptions {
   double track_m = 0.33;          // distance between the driven wheels (m), as in the MJCF robot
 };
 
+// A waypoint's own goals (issue #34): a path entry written as a map
+// {at: [x, y], turn: in_place | arc, radius_m: R, stop_s: S, speed_mps: V}; what it leaves out is
+// the robot's (RobotOptions). sim/path_follower.h resolves them (ResolveWaypoints) and says how
+// each is driven; scenes/README.md documents the keys.
+struct WaypointOptions {
+  std::string turn;  // "" (the robot's corner_mode), "in_place" or "arc"; inner waypoints only
+  // turn arc: a circular arc of this radius tangent to both legs (m), > 0; NaN: the pure-pursuit
+  // corner cut of corner_mode arc
+  double radius_m = std::numeric_limits<double>::quiet_NaN();
+  // Stand still here this long (s), [0, 600], where the robot stops (an in-place corner, the
+  // first or the last waypoint); NaN: robot.stop_s at in-place corners, none at the ends
+  double stop_s = std::numeric_limits<double>::quiet_NaN();
+  // Cruise speed of the leg that starts here (m/s), (0, 3]; NaN: robot.speed_mps
+  double speed_mps = std::numeric_limits<double>::quiet_NaN();
+  bool any() const {
+    return !turn.empty() || !std::isnan(radius_m) || !std::isnan(stop_s) || !std::isnan(speed_mps);
+  }
+};
+
 // Plausible ranges, shared by the scenario reader and the dataset readers (harness/dataset/):
 // a stereo rig from a phone's 1 mm to a car's or a tower's 5 m, and a field of view a pinhole
 // model describes (the reader also checks the focal length that gives).
@@ -187,7 +206,8 @@ struct Scenario {
   double physics_dt_s = 0.002;  // physics time step (s), (0, 0.01]
   double max_duration_s = 300;  // safety limit on simulated time (s)
   double settle_s = 0.5;        // robot stands still this long before frame 0 (s), >= 0
-  std::vector<Eigen::Vector2d> path;  // waypoints (x, y) in the world frame (m), >= 2
+  std::vector<Eigen::Vector2d> path;       // waypoints (x, y) in the world frame (m), >= 2
+  std::vector<WaypointOptions> waypoints;  // each waypoint's own goals: empty, or one per waypoint
   RobotOptions robot;
   CameraOptions camera;
   NoiseOptions noise;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "sim/floor_plan.h"
+#include "sim/path_follower.h"
 
 namespace sim {
 namespace {
@@ -131,13 +132,14 @@ void WallEnds(const SceneWall& w, Eigen::Vector2d* a, Eigen::Vector2d* b) {
 }  // namespace
 
 std::string PathProblem(const Scenario& s, const std::vector<SceneWall>& walls,
-                        const std::vector<SceneFloor>& floors, int* waypoint) {
+                        const std::vector<SceneFloor>& floors, int* waypoint, std::string* field) {
+  if (field) field->clear();
   const std::string scene = fs::path(s.scene_path).filename().string();
   const double top_z = std::max(s.camera.height_m, 0.3);  // the robot: floor to camera
   std::vector<SceneWall> near;                            // the walls that span the robot's height
   for (const SceneWall& w : walls)
     if (w.z_max_m >= 0.0 && w.z_min_m <= top_z) near.push_back(w);
-  const bool arc = s.robot.corner_mode == "arc";
+  const std::vector<WaypointGoal> goals = ResolveWaypoints(s.path, s.robot, s.waypoints);
   for (size_t i = 1; i < s.path.size(); ++i) {
     const Eigen::Vector2d p0 = s.path[i - 1], p1 = s.path[i];
     std::ostringstream where;
@@ -177,8 +179,37 @@ std::string PathProblem(const Scenario& s, const std::vector<SceneWall>& walls,
         return msg.str();
       }
     }
+    // A circular arc at path[i] (turn arc, radius_m): every 2 cm of it (chords of R (1 - cos)
+    // below 0.2 mm at R >= 0.25 m) keeps the clearance, over the floor.
+    if (i + 1 < s.path.size() && goals[i].arc && goals[i].radius_m > 0.0) {
+      const CornerArc c = ArcAtCorner(p0, p1, s.path[i + 1], goals[i].radius_m);
+      const int steps = std::max(1, static_cast<int>(std::ceil(c.length_m() / 0.02)));
+      if (field) *field = "radius_m";
+      for (int k = 1; k <= steps; ++k) {
+        const Eigen::Vector2d q0 = c.PointAt(c.length_m() * (k - 1) / steps);
+        const Eigen::Vector2d q1 = c.PointAt(c.length_m() * k / steps);
+        std::ostringstream msg;
+        for (const SceneWall& w : near) {
+          Eigen::Vector2d e0, e1;
+          WallEnds(w, &e0, &e1);
+          if (const double d = SegmentDistance(q0, q1, e0, e1); d < kRobotClearanceM) {
+            msg << "the arc of radius " << goals[i].radius_m << " m at path[" << i << "] "
+                << Point(p1) << " comes within " << d << " m of wall '" << w.name << "' of "
+                << scene << " at " << Point(q1) << "; the robot needs " << kRobotClearanceM
+                << " m (a smaller radius keeps closer to the corner)";
+            return msg.str();
+          }
+        }
+        if (!floors.empty() && !OverFloor(q1, floors)) {
+          msg << "the arc of radius " << goals[i].radius_m << " m at path[" << i << "] "
+              << Point(p1) << " leaves the building of " << scene << " at " << Point(q1);
+          return msg.str();
+        }
+      }
+    }
+    if (field) field->clear();
     // An arc corner at path[i]: the robot cuts it within lookahead_m of the corner.
-    if (arc && i + 1 < s.path.size()) {
+    if (i + 1 < s.path.size() && goals[i].arc && goals[i].radius_m == 0.0) {
       const Eigen::Vector2d p2 = s.path[i + 1];
       const double l_in = std::min(s.robot.lookahead_m, (p1 - p0).norm());
       const double l_out = std::min(s.robot.lookahead_m, (p2 - p1).norm());

@@ -12,8 +12,8 @@
 // chassis' farthest corner is 0.32 m from the axle, and it turns in place about the axle), kept
 // that far from every wall along each segment of the polyline and, in corner_mode "arc", along
 // the corner it cuts (the triangle of the corner and the points lookahead_m before and after
-// it); and the axle stays over the building's floor (a path that leaves the building renders
-// black frames).
+// it), or along its circular arc (a waypoint's radius_m); and the axle stays over the building's
+// floor (a path that leaves the building renders black frames).
 #pragma once
 
 #include <Eigen/Core>
@@ -47,11 +47,15 @@ struct SceneFloor {
 constexpr double kRobotClearanceM = 0.33;
 
 // The first place where the path leaves free space (see above): "" when none, else the problem,
-// and *waypoint = i for the segment path[i-1] -> path[i] (or the corner at path[i]). The walls
-// that count span the robot's height (floor to the camera, at least 0.3 m); without floors the
-// building's extent is not checked.
+// and *waypoint = i for the segment path[i-1] -> path[i] (or the corner at path[i]); *field, when
+// given, "radius_m" where the circular arc of path[i] is the problem, else "". The walls that
+// count span the robot's height (floor to the camera, at least 0.3 m); without floors the
+// building's extent is not checked. A waypoint's own turn (Scenario::waypoints) decides its
+// corner: in place (the legs only), cut (the triangle above), or a circular arc of radius_m
+// (sim/path_follower.h ArcAtCorner), checked every 2 cm along the arc besides the legs.
 std::string PathProblem(const Scenario& scenario, const std::vector<SceneWall>& walls,
-                        const std::vector<SceneFloor>& floors, int* waypoint);
+                        const std::vector<SceneFloor>& floors, int* waypoint,
+                        std::string* field = nullptr);
 
 // The walls (and floors) of a loaded model (Simulator::Create checks the path against its own
 // model's).

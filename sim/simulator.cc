@@ -348,7 +348,7 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
   im.d->qpos[qadr + 6] = std::sin(yaw / 2);
   if (scenario.people.count > 0) im.people.Apply(m, im.d, -scenario.settle_s);
   mj_forward(m, im.d);
-  im.follower = std::make_unique<PathFollower>(scenario.path, scenario.robot);
+  im.follower = std::make_unique<PathFollower>(scenario.path, scenario.robot, scenario.waypoints);
   // Navigation: the belief starts at the known start pose. The building's geoms to touch: those
   // welded to the world that collide, except planes facing up (the floor).
   im.closed_loop = scenario.navigation == "vo";
@@ -542,8 +542,8 @@ bool Simulator::Capture(StereoFrame* frame, std::string* error) {
       const bool was_done = im.follower->done();
       cmd = im.follower->Update(steer.position, steer.yaw_rad, dt);
       // A waypoint the follower believes reached: where the robot really is.
-      const bool reached = im.follower->done() || (im.follower->target_index() != target &&
-                                                   sc.robot.corner_mode == "in_place");
+      const bool reached = im.follower->done() ||
+                           (im.follower->target_index() != target && im.follower->stops_at(target));
       if (!was_done && reached) {
         const double err = (truth.position - sc.path[target]).norm();
         if (!(err <= im.nav.max_waypoint_error_m)) im.nav.max_waypoint_error_m = err;

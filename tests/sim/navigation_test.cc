@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <opencv2/core.hpp>
 
+#include "sim/floor_plan.h"
 #include "sim/simulator.h"
 #include "tests/sim/sim_test_util.h"
 
@@ -14,6 +17,7 @@ namespace {
 using vobench_test::MakeScenario;
 using vobench_test::TempDir;
 using vobench_test::WriteScene;
+using vobench_test::WriteText;
 
 // A building of collision-only boxes (group 3: never drawn), as the hallway's solid walls.
 std::string Box(const std::string& name, double x, double y, double hx, double hy) {
@@ -222,6 +226,80 @@ TEST(NavigationTest, AWallAcrossThePathIsTouchedAndTheRunEndsAtTheTimeLimit) {
   EXPECT_NE(error.find("did not finish its path within max_duration_s"), std::string::npos)
       << error;
   EXPECT_GE(open->navigation().wall_contacts, 1);
+}
+
+// A floor plan's building is solid (sim/floor_plan.h PlanSolids): collision-only boxes behind the
+// drawn walls and in the furniture, in geom group 3. The renders are those of the same plan
+// without them, byte for byte; open loop nothing is touched (wall_contacts 0, not -1: there is
+// something to touch); an estimate 0.9 m off sideways steers the robot into the corridor's
+// south wall (at y = -1; the chassis is 0.19 m wide each side of the axle), and the contact is
+// counted.
+TEST(NavigationTest, AFloorPlansWallsAreSolidAndItsRendersUnchanged) {
+  TempDir dir("navigation");
+  WriteText(dir / "plan.yaml",
+            "corridors:\n  - {name: c, centre: [[0, 0], [6, 0]], width_m: 2}\nrooms:\n"
+            "  - {name: r, rect: [2, 1.1, 5, 4]}\ndoors:\n"
+            "  - {between: [c, r], at: [3.5, 1.05], width_m: 1.2, height_m: 2.1}\n"
+            "boxes:\n  - {name: desk, at: [3.5, 3], size_m: [1, 0.5], height_m: 0.7}\n");
+  sim::FloorPlan plan;
+  std::string error;
+  ASSERT_TRUE(sim::LoadFloorPlan(dir / "plan.yaml", &plan, &error)) << error;
+  // The solids: one per wall piece and jamb, and one per box; the corridor's and the room's walls
+  // are 0.1 m apart, so each solid behind them is 0.05 m thick (half the gap), the others too.
+  const std::vector<sim::PlanSolid> solids = sim::PlanSolids(plan);
+  size_t vertical = 0;
+  for (const sim::PlanSurface& surface : sim::PlanSurfaces(plan))
+    vertical +=
+        std::abs(surface.y_axis.z()) > 0.5 && surface.name.find("_box_") == std::string::npos;
+  EXPECT_EQ(solids.size(), vertical + 1);
+  for (const sim::PlanSolid& solid : solids)
+    if (solid.name.rfind("solid_box_", 0) != 0) {
+      EXPECT_NEAR(solid.half_size.z(), 0.025, 1e-12) << solid.name;
+    }
+  std::filesystem::copy_file(plan.robot_path, dir / "robot.xml");  // included beside the scene
+  WriteText(dir / "drawn_only.xml", sim::FloorPlanToMjcf(plan, "robot.xml", false));
+
+  sim::Scenario with = SmallScenario(dir / "plan.yaml", 3.5);
+  with.path[0] = Eigen::Vector2d(0.6, 0.0);        // the corridor's end wall is at x = 0
+  with.path.push_back(Eigen::Vector2d(3.5, 2.4));  // through the door into the room
+  sim::Scenario without = with;
+  without.scene_path = dir / "drawn_only.xml";
+  auto a = sim::Simulator::Create(with, &error);
+  ASSERT_TRUE(a) << error;
+  auto b = sim::Simulator::Create(without, &error);
+  ASSERT_TRUE(b) << error;
+  std::vector<sim::StereoFrame> fa, fb;
+  ASSERT_TRUE(RunToEnd(*a, &fa, &error)) << error;
+  ASSERT_TRUE(RunToEnd(*b, &fb, &error)) << error;
+  ASSERT_GT(fa.size(), 50u);
+  ASSERT_EQ(fa.size(), fb.size());
+  for (size_t k = 0; k < fa.size(); ++k) {
+    ASSERT_EQ(cv::norm(fa[k].left, fb[k].left, cv::NORM_INF), 0.0) << "frame " << k;
+    ASSERT_EQ(cv::norm(fa[k].right, fb[k].right, cv::NORM_INF), 0.0) << "frame " << k;
+    ASSERT_TRUE(fa[k].T_world_body.matrix() == fb[k].T_world_body.matrix()) << "frame " << k;
+  }
+  EXPECT_EQ(a->navigation().wall_contacts, 0);
+  EXPECT_EQ(b->navigation().wall_contacts, -1);  // drawn planes only: nothing to touch
+  EXPECT_TRUE(a->navigation().reached_goal);
+
+  sim::Scenario off = SmallScenario(dir / "plan.yaml", 5.0);
+  off.path[0] = Eigen::Vector2d(0.6, 0.0);
+  off.navigation = "vo";
+  off.max_duration_s = 20.0;
+  auto c = sim::Simulator::Create(off, &error);
+  ASSERT_TRUE(c) << error;
+  c->SetStepEstimator([](const sim::PlanarPose& truth) {
+    sim::PlanarPose p = truth;
+    p.position.y() += 0.9;
+    return p;
+  });
+  std::vector<sim::StereoFrame> fc;
+  ASSERT_TRUE(RunToEnd(*c, &fc, &error)) << error;
+  EXPECT_GE(c->navigation().wall_contacts, 1);
+  EXPECT_GT(c->navigation().wall_contact_s, 0.0);
+  // Held off the wall by it: the axle the chassis' half width from y = -1, less the soft
+  // contact's give while the robot pushes against it (measured 1.0 cm; 2 cm allowed).
+  EXPECT_GT(fc.back().T_world_body.translation().y(), -1.0 + 0.19 - 0.02);
 }
 
 }  // namespace

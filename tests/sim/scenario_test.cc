@@ -399,4 +399,72 @@ TEST_F(ScenarioFileTest, ImuKeysAreCheckedAndRoundTrip) {
   EXPECT_NE(why.find("imu.rate_hz: the sample period"), std::string::npos) << why;
 }
 
+// Waypoints as pairs and as maps with their own goals, mixed in one path; the goals round-trip
+// through the effective YAML (a path of pairs writes pairs, as before); a bad goal is refused at
+// its line with its key path[i].KEY.
+TEST_F(ScenarioFileTest, WaypointGoalsParseInBothFormsAndAreCheckedAtTheirLines) {
+  const std::string head = "name: t\nscene: scene.xml\npath:\n  - [0, 0]\n";
+  const std::string good = head +
+                           "  - {at: [3, 0], turn: arc, radius_m: 1.0, speed_mps: 0.6}\n"
+                           "  - at: [3, 4]\n    stop_s: 2\n    turn: in_place\n"
+                           "  - [6, 4]\n";
+  sim::Scenario s, again, plain;
+  ASSERT_EQ(Load(good, &s), "");
+  ASSERT_EQ(s.path.size(), 4u);
+  EXPECT_EQ(s.path[1], Eigen::Vector2d(3, 0));
+  EXPECT_EQ(s.path[2], Eigen::Vector2d(3, 4));
+  EXPECT_EQ(s.path[3], Eigen::Vector2d(6, 4));
+  ASSERT_EQ(s.waypoints.size(), 4u);
+  EXPECT_FALSE(s.waypoints[0].any());
+  EXPECT_EQ(s.waypoints[1].turn, "arc");
+  EXPECT_EQ(s.waypoints[1].radius_m, 1.0);
+  EXPECT_EQ(s.waypoints[1].speed_mps, 0.6);
+  EXPECT_TRUE(std::isnan(s.waypoints[1].stop_s));
+  EXPECT_EQ(s.waypoints[2].stop_s, 2.0);
+  EXPECT_EQ(s.waypoints[2].turn, "in_place");
+  EXPECT_FALSE(s.waypoints[3].any());
+  const std::string path = dir_ / "effective.yaml";
+  WriteText(path, sim::ScenarioToYaml(s));
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(path, &again, &error)) << error;
+  EXPECT_EQ(sim::ScenarioToYaml(again), sim::ScenarioToYaml(s));
+  ASSERT_EQ(again.waypoints.size(), 4u);
+  EXPECT_EQ(again.waypoints[1].radius_m, 1.0);
+  ASSERT_EQ(Load(kGood, &plain), "");
+  EXPECT_TRUE(plain.waypoints.empty());
+  EXPECT_EQ(sim::ScenarioToYaml(plain).find("at:"), std::string::npos);
+  // Its frames estimate: the legs at their speeds, the stop and the in-place turn at path[2].
+  const double seconds = 3 / 0.4 + 4 / 0.6 + 3 / 0.4 + 2.0 + 90.0 / 30.0;
+  EXPECT_EQ(sim::EstimatedFrames(s), static_cast<int>(std::floor(seconds * 10)) + 1);
+
+  const std::pair<std::string, std::string> bad[] = {
+      {"  - {at: [3, 0], radius_m: 1.0}\n  - [3, 4]\n",
+       "s.yaml:5: key 'path[1].radius_m': an arc's radius, at a corner turned in place"},
+      {"  - {at: [3, 0], turn: arc, radius_m: 5}\n  - [3, 4]\n",
+       "s.yaml:5: key 'path[1].radius_m': an arc of 5 m at this corner takes 5 m of each leg; the "
+       "leg in is 3 m"},
+      {"  - {at: [3, 0], turn: arc, radius_m: -1}\n  - [3, 4]\n",
+       "s.yaml:5: key 'path[1].radius_m': expected a finite radius > 0 m"},
+      {"  - {at: [3, 0], turn: arc, stop_s: 1}\n  - [3, 4]\n",
+       "s.yaml:5: key 'path[1].stop_s': the robot does not stop at an arc corner"},
+      {"  - {at: [3, 0], stop_s: 700}\n  - [3, 4]\n",
+       "s.yaml:5: key 'path[1].stop_s': expected in [0, 600] s"},
+      {"  - {at: [3, 0], turn: spin}\n  - [3, 4]\n",
+       "s.yaml:5: key 'path[1].turn': expected 'in_place' or 'arc', got 'spin'"},
+      {"  - {at: [3, 0], speed_mps: 0}\n  - [3, 4]\n",
+       "s.yaml:5: key 'path[1].speed_mps': expected in (0, 3] m/s"},
+      {"  - [3, 0]\n  - {at: [3, 4], speed_mps: 1}\n",
+       "s.yaml:6: key 'path[2].speed_mps': the speed of the leg that starts here; no leg starts"},
+      {"  - [3, 0]\n  - {at: [3, 4], turn: arc}\n",
+       "s.yaml:6: key 'path[2].turn': the first and the last waypoint have no corner"},
+      {"  - {at: [3, 0], wait: 1}\n  - [3, 4]\n", "s.yaml:5: key 'path[1].wait': unknown key"},
+      {"  - {turn: arc}\n  - [3, 4]\n", "s.yaml:5: key 'path[1].at': required"},
+      {"  - {at: [3, 0, 1]}\n  - [3, 4]\n", "s.yaml:5: key 'path[1].at'"},
+      {"  - {at: [3, 0]}\n  - [3, 4, 5]\n", "s.yaml:6: key 'path[2]'"}};
+  for (const auto& [yaml, expected] : bad) {
+    const std::string e = Load(head + yaml);
+    EXPECT_NE(e.find(expected), std::string::npos) << yaml << " -> " << e;
+  }
+}
+
 }  // namespace
