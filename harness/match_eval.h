@@ -53,8 +53,8 @@ struct MatchEvalOptions {
                                          // previous pair of the same stride; none for the first
                                          // pair), as the VO predicts; kNone: previous positions
   double prediction_radius_scale =
-      vo::RobustTrackingOptions().prior_radius_scale;  // gate scale around that prediction,
-                                                       // as the VO's prior pass uses it
+      vo::TrackerOptions().prior_radius_scale;  // gate scale around that prediction,
+                                                // as the VO's prior pass uses it
   double correct_px = 2.0;            // a match is correct within this of the GT position (px)
   double depth_agree_rel = 0.03;      // visibility: |z_gt - z_proj| <= this * z_proj + 0.01 m
   double ambiguous_depth_rel = 0.05;  // GT depth spread in 3x3 above this * z: feature left out

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <utility>
+
+#include "vo/options_check.h"
 
 namespace vo {
 namespace {
@@ -12,8 +15,74 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
+DetectorOptions DefaultOdometryDetectorOptions() {
+  DetectorOptions options;
+  options.type = DetectorType::kHarris;
+  options.max_features = 300;
+  options.bucket_cols = 8;
+  options.bucket_rows = 6;
+  options.max_per_bucket = 10;
+  // A lower relative threshold than the detector's 0.01: one bright ceiling light or door
+  // edge otherwise sets the bar so high that a weakly textured wall in front of the camera
+  // yields 10-15 corners and tracking is lost (seen on the L-hallway's corner approach).
+  options.harris.quality_level = 0.001;
+  return options;
+}
+
+DisparityOptions DefaultOdometryDisparityOptions() {
+  DisparityOptions options;
+  // The same correlation as cv::StereoBM, with the left-right check's right view taken from
+  // the same cost volume instead of a second pass (vo/sad_block_matcher.h).
+  options.algorithm = DisparityAlgorithm::kBlockMatchingOneVolume;
+  return options;
+}
+
+bool FrontEndOptions::IsValid(std::string* error) const {
+  DisparityOptions disparity_checked = disparity;
+  if (derive_num_disparities) disparity_checked.num_disparities = 16;  // replaced later
+  if (!PartIsValid(detector, "detector", error) ||
+      !PartIsValid(disparity_checked, "disparity", error) || !PartIsValid(depth, "depth", error)) {
+    return false;
+  }
+  std::ostringstream msg;
+  if (!(disparity_min_depth_m > 0.0) || !std::isfinite(disparity_min_depth_m)) {
+    msg << "disparity_min_depth_m must be finite and > 0, got " << disparity_min_depth_m;
+  } else if (max_num_disparities < 16 || max_num_disparities % 16 != 0) {
+    msg << "max_num_disparities must be a multiple of 16 and >= 16, got " << max_num_disparities;
+  } else if (disparity_mode != DisparityMode::kDense &&
+             disparity_mode != DisparityMode::kAtFeatures) {
+    msg << "disparity_mode: unknown value " << static_cast<int>(disparity_mode);
+  } else if (disparity_mode == DisparityMode::kAtFeatures &&
+             disparity.algorithm != DisparityAlgorithm::kBlockMatchingOneVolume) {
+    msg << "disparity_mode at_features needs disparity.algorithm "
+        << ToString(DisparityAlgorithm::kBlockMatchingOneVolume) << " (got "
+        << ToString(disparity.algorithm) << "); use disparity_mode dense with it";
+  } else if (!(disparity_range_margin >= 0.0) || !std::isfinite(disparity_range_margin) ||
+             !(disparity_range_margin_px >= 0.0) || !std::isfinite(disparity_range_margin_px)) {
+    msg << "disparity_range_margin and disparity_range_margin_px must be finite and >= 0, got "
+        << disparity_range_margin << " and " << disparity_range_margin_px;
+  } else if (adaptive_min_features < 0) {
+    msg << "adaptive_min_features must be >= 0 (0 = off), got " << adaptive_min_features;
+  } else if (!(adaptive_quality_level >= 0.0 && adaptive_quality_level < 1.0)) {
+    msg << "adaptive_quality_level must be in [0, 1), got " << adaptive_quality_level;
+  } else if (min_features < 3) {
+    msg << "min_features must be >= 3, got " << min_features;
+  }
+  return NoBrokenRule(msg, error);
+}
+
+int DerivedNumDisparities(const StereoCamera& camera, const FrontEndOptions& options) {
+  const double needed = camera.fx_px * camera.baseline_m / options.disparity_min_depth_m;
+  const int width_cap = std::max(16, (camera.width - 1) / 16 * 16);
+  const int cap = std::min(options.max_num_disparities, width_cap);
+  // Clamped in floating point first: an absurd camera (huge fx · baseline) must not overflow.
+  const double blocks = std::ceil(std::min(needed, static_cast<double>(cap)) / 16.0);
+  const int n = std::min(static_cast<int>(blocks) * 16, cap);
+  return std::max(16, n);
+}
+
 std::unique_ptr<FrontEnd> FrontEnd::Create(const StereoCamera& camera,
-                                           const OdometryOptions& options, std::string* error) {
+                                           const FrontEndOptions& options, std::string* error) {
   std::unique_ptr<FrontEnd> front(new FrontEnd(camera, options));
   std::string why;
   front->detector_ = CreateFeatureDetector(options.detector, &why);
@@ -31,7 +100,7 @@ std::unique_ptr<FrontEnd> FrontEnd::Create(const StereoCamera& camera,
   return front;
 }
 
-FrontEnd::FrontEnd(const StereoCamera& camera, const OdometryOptions& options)
+FrontEnd::FrontEnd(const StereoCamera& camera, const FrontEndOptions& options)
     : camera_(camera),
       depth_(options.depth),
       adaptive_min_features_(options.adaptive_min_features),
@@ -97,7 +166,7 @@ FrontEndFrame FrontEnd::Process(const cv::Mat& left, const cv::Mat& right, int n
   return out;
 }
 
-int SceneNumDisparities(const std::vector<Feature>& features, const OdometryOptions& options) {
+int SceneNumDisparities(const std::vector<Feature>& features, const FrontEndOptions& options) {
   if (!options.disparity_range_from_scene) return 0;
   double max_disparity = 0.0;
   for (const Feature& f : features) {

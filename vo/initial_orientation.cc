@@ -4,12 +4,13 @@
 #include <cmath>
 #include <sstream>
 
+#include "vo/options_check.h"
 #include "vo/plane_refinement.h"
 
 namespace vo {
 namespace {
 
-// The vehicle's up in the camera frame (tracking.vehicle_planar_ba): σ of the first frame's
+// The vehicle's up in the camera frame (back_end.vehicle_planar): σ of the first frame's
 // floor fit as evidence of it. Texture seed 7's floor fit is 0.77° off; the reliable tracked
 // motions move it over tens of frames (seed 7: 0.77° -> 0.35° off; odometry.cc).
 constexpr double kVehicleUpPriorSigmaDeg = 1.0;
@@ -21,7 +22,19 @@ constexpr double kVehicleUpRefinedFloorSigmaDeg = 0.15;
 
 }  // namespace
 
-bool RefineInitialFloor(const StereoCamera& camera, const OdometryOptions& options,
+bool InitialOrientationOptions::IsValid(std::string* error) const {
+  if (enabled && (!PartIsValid(planes, "planes", error) ||
+                  (refine_floor && !PartIsValid(floor_refinement, "floor_refinement", error)))) {
+    return false;
+  }
+  if (sample_step_px < 1) {
+    if (error) *error = "sample_step_px must be >= 1, got " + std::to_string(sample_step_px);
+    return false;
+  }
+  return true;
+}
+
+bool RefineInitialFloor(const StereoCamera& camera, const InitialOrientationOptions& options,
                         const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity_px,
                         PlaneOrientationResult* planes, std::string* message) {
   PlaneOrientationResult& o = *planes;
@@ -38,7 +51,7 @@ bool RefineInitialFloor(const StereoCamera& camera, const OdometryOptions& optio
       if (!(row[u] > 0.0f)) continue;
       const Eigen::Vector3d p = camera.Backproject(u, v, row[u]);
       if (std::abs(floor.normal_cam0.dot(p) + floor.offset_m) <=
-          PlaneInlierDistance(p, options.orientation)) {
+          PlaneInlierDistance(p, options.planes)) {
         pixels.emplace_back(u, v);
       }
     }
@@ -77,25 +90,25 @@ bool RefineInitialFloor(const StereoCamera& camera, const OdometryOptions& optio
 }
 
 InitialOrientation EstimateInitialOrientation(const StereoCamera& camera,
-                                              const OdometryOptions& options,
+                                              const InitialOrientationOptions& options,
                                               const std::vector<Eigen::Vector3d>& points_cam0,
                                               const cv::Mat& left, const cv::Mat& right,
                                               const cv::Mat& disparity_px) {
   InitialOrientation out;
   PlaneOrientationResult& planes = out.planes;
-  planes = EstimateHallwayOrientation(points_cam0, options.orientation);
-  if (options.orientation_floor_refinement && !disparity_px.empty() &&
+  planes = EstimateHallwayOrientation(points_cam0, options.planes);
+  if (options.refine_floor && !disparity_px.empty() &&
       (planes.floor_index >= 0 || planes.ceiling_index >= 0) &&
       (planes.ok() || planes.status == PlaneOrientationResult::Status::kNoWall)) {
     out.floor_refined =
         RefineInitialFloor(camera, options, left, right, disparity_px, &planes, &out.message);
   }
-  bool ok = planes.ok() || (planes.status == PlaneOrientationResult::Status::kNoWall &&
-                            !options.orientation_requires_wall);
-  if (!ok && options.orientation_up_from_mounting &&
+  bool ok = planes.ok() ||
+            (planes.status == PlaneOrientationResult::Status::kNoWall && !options.requires_wall);
+  if (!ok && options.up_from_mounting &&
       planes.status == PlaneOrientationResult::Status::kNoFloor) {
     // The mounting's up; x_hall the camera's forward axis made horizontal (zero yaw).
-    const Eigen::Vector3d up = options.orientation.expected_up_cam0.normalized();
+    const Eigen::Vector3d up = options.planes.expected_up_cam0.normalized();
     Eigen::Vector3d x_hall, y_hall;
     HorizontalBasis(up, &x_hall, &y_hall);
     planes.R_hall_cam0.row(0) = x_hall.transpose();

@@ -6,8 +6,37 @@
 #include <utility>
 
 #include "vo/motion_model.h"
+#include "vo/options_check.h"
 
 namespace vo {
+
+bool MotionOptions::IsValid(std::string* error) const {
+  if (!PartIsValid(ransac, "ransac", error) ||
+      (few_point_motion && !PartIsValid(few_point, "few_point", error))) {
+    return false;
+  }
+  std::ostringstream msg;
+  if (min_inliers < 3) {
+    msg << "min_inliers must be >= 3, got " << min_inliers;
+  } else if (reliable_min_inliers < 3) {
+    msg << "reliable_min_inliers must be >= 3, got " << reliable_min_inliers;
+  } else if (!(prior_update_exponent >= 1.0) || !std::isfinite(prior_update_exponent)) {
+    msg << "prior_update_exponent must be finite and >= 1, got " << prior_update_exponent;
+  } else if (!(few_point_max_shift_disagreement_px >= 0.0) ||
+             !std::isfinite(few_point_max_shift_disagreement_px)) {
+    msg << "few_point_max_shift_disagreement_px must be finite and >= 0, got "
+        << few_point_max_shift_disagreement_px;
+  } else if (!(vehicle_max_weak_tilt_deg > 0.0) || !std::isfinite(vehicle_max_weak_tilt_deg) ||
+             !(vehicle_max_weak_lift_m > 0.0) || !std::isfinite(vehicle_max_weak_lift_m)) {
+    msg << "vehicle_max_weak_tilt_deg and vehicle_max_weak_lift_m must be finite and > 0, got "
+        << vehicle_max_weak_tilt_deg << " and " << vehicle_max_weak_lift_m;
+  } else if (few_point_min_features < 1) {
+    msg << "few_point_min_features must be >= 1, got " << few_point_min_features;
+  } else if (!(few_point_prior_update >= 0.0 && few_point_prior_update <= 1.0)) {
+    msg << "few_point_prior_update must be in [0, 1], got " << few_point_prior_update;
+  }
+  return NoBrokenRule(msg, error);
+}
 
 MotionAttempt EstimateMotion(const StereoCamera& camera, const RansacOptions& ransac,
                              const std::vector<Feature>& ref_features,
@@ -59,13 +88,13 @@ bool AgreesWithImageShift(const StereoCamera& camera, const std::vector<Feature>
   return motion_px <= prior_px + max_disagreement_px;
 }
 
-double PriorUpdateWeight(int num_inliers, const RobustTrackingOptions& tracking) {
-  return std::pow(std::min(1.0, static_cast<double>(num_inliers) / tracking.reliable_min_inliers),
-                  tracking.prior_update_exponent);
+double PriorUpdateWeight(int num_inliers, const MotionOptions& options) {
+  return std::pow(std::min(1.0, static_cast<double>(num_inliers) / options.reliable_min_inliers),
+                  options.prior_update_exponent);
 }
 
-FrameMotion ResolveFrameMotion(const StereoCamera& camera, const OdometryOptions& options,
-                               int num_features, const std::vector<Feature>& ref_features,
+FrameMotion ResolveFrameMotion(const StereoCamera& camera, const MotionOptions& options,
+                               bool few_features, const std::vector<Feature>& ref_features,
                                const Eigen::Vector3d* up_ref,
                                const Eigen::Isometry3d* T_ref_curr_prior, bool prior_measured,
                                bool shift_ok, const Eigen::Vector2d& shift_px,
@@ -77,29 +106,27 @@ FrameMotion ResolveFrameMotion(const StereoCamera& camera, const OdometryOptions
   // of 13.) So does a ground vehicle's frame whose weak RANSAC motion tilts or lifts it: until
   // 2026-12-04 it was left lost when that motion had min_inliers inliers or more (9 of the 31
   // lost frames of texture seeds 1-10 at stride 1, 12-27 inliers each).
-  const RobustTrackingOptions& tracking = options.tracking;
   RansacResult& ransac = attempt->ransac;
   const std::vector<StereoCorrespondence>& correspondences = attempt->correspondences;
   FrameMotion m;
-  m.few_features = num_features < options.min_features;
+  m.few_features = few_features;
   m.ransac_failed = m.few_features || !ransac.ok() || ransac.num_inliers < options.min_inliers ||
                     !IsFinitePose(ransac.T_prev_curr);
   // A ground vehicle neither tilts nor lifts: a weak motion that does is a wrong consensus.
   m.not_vehicle_like =
-      !m.ransac_failed && up_ref != nullptr && ransac.num_inliers < tracking.reliable_min_inliers &&
-      !IsVehicleLike(ransac.T_prev_curr, *up_ref, tracking.vehicle_max_weak_tilt_deg,
-                     tracking.vehicle_max_weak_lift_m);
+      !m.ransac_failed && up_ref != nullptr && ransac.num_inliers < options.reliable_min_inliers &&
+      !IsVehicleLike(ransac.T_prev_curr, *up_ref, options.vehicle_max_weak_tilt_deg,
+                     options.vehicle_max_weak_lift_m);
   if (m.not_vehicle_like) m.ransac_failed = true;
-  if (m.ransac_failed && tracking.few_point_motion && T_ref_curr_prior != nullptr &&
-      prior_measured && options.matcher.prediction != PredictionMode::kNone &&
-      !correspondences.empty() &&
+  if (m.ransac_failed && options.few_point_motion && T_ref_curr_prior != nullptr &&
+      prior_measured && !correspondences.empty() &&
       (m.few_features || m.not_vehicle_like || ransac.num_inliers < options.min_inliers)) {
     Eigen::Isometry3d few_prior;
-    const PriorMotionResult few = FewPointMotion(camera, tracking.few_point, correspondences,
+    const PriorMotionResult few = FewPointMotion(camera, options.few_point, correspondences,
                                                  *T_ref_curr_prior, up_ref, &few_prior);
     const bool agrees =
         few.ok && AgreesWithImageShift(camera, ref_features, few.T_prev_curr, few_prior, shift_ok,
-                                       shift_px, tracking.few_point_max_shift_disagreement_px);
+                                       shift_px, options.few_point_max_shift_disagreement_px);
     if (agrees) {
       ransac.status = RansacResult::Status::kOk;
       ransac.message.clear();

@@ -47,7 +47,7 @@ Eigen::Isometry3d VehicleMotionFromImageShift(const StereoCamera& camera,
 // Whether the motion T_a_b (p_a = T_a_b · p_b) of a ground vehicle whose up direction in frame a
 // is up_a (any length > 0) tilts by at most max_tilt_deg (the angle of its rotation left after
 // the twist about up, PlanarPart) and moves along up by at most max_lift_m. A non-finite input
-// is not vehicle-like. Used by tracking.vehicle_max_weak_tilt_deg / _lift_m.
+// is not vehicle-like. Used by MotionOptions::vehicle_max_weak_tilt_deg / _lift_m.
 bool IsVehicleLike(const Eigen::Isometry3d& T_a_b, const Eigen::Vector3d& up_a, double max_tilt_deg,
                    double max_lift_m);
 

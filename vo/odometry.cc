@@ -45,7 +45,7 @@ std::unique_ptr<StereoOdometry> StereoOdometry::Create(const StereoCamera& camer
 StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions& options)
     : camera_(camera),
       options_(EffectiveOdometryOptions(camera, options)),
-      recovery_(camera, options_),
+      recovery_(camera, options_.recovery, options_.motion, options_.tracker),
       back_end_(options_.back_end) {
   std::string why;
   if (!camera_.IsValid(&why)) {
@@ -56,8 +56,8 @@ StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions
     std::fprintf(stderr, "vo::StereoOdometry: invalid options: %s\n", why.c_str());
     std::abort();
   }
-  front_end_ = FrontEnd::Create(camera_, options_, &why);
-  if (front_end_) tracker_ = Tracker::Create(camera_, options_, &why);
+  front_end_ = FrontEnd::Create(camera_, options_.front_end, &why);
+  if (front_end_) tracker_ = Tracker::Create(camera_, options_.tracker, options_.motion, &why);
   if (!front_end_ || !tracker_) {
     std::fprintf(stderr, "vo::StereoOdometry: %s\n", why.c_str());
     std::abort();
@@ -104,8 +104,9 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
   previous_measured_ = result.motion_measured;
   recovery_.EndFrame(last_features_, result.T_prev_curr, current_left_);
   // Next frame's disparity search range from the depths of this one (full after a loss).
-  scene_num_disparities_ =
-      result.status != TrackingStatus::kLost ? SceneNumDisparities(last_features_, options_) : 0;
+  scene_num_disparities_ = result.status != TrackingStatus::kLost
+                               ? SceneNumDisparities(last_features_, options_.front_end)
+                               : 0;
   current_left_ = cv::Mat();
   result.times.total_ms = ElapsedMs(start);
   return result;
@@ -129,7 +130,7 @@ Eigen::Isometry3d StereoOdometry::PredictedPose(const MotionPrior* prior) const 
 
 const Eigen::Vector3d* StereoOdometry::VehicleUpAtReference(Eigen::Vector3d* storage) const {
   const Eigen::Isometry3d* T_world_ref = back_end_.Pose(reference_.frame_index);
-  if (!options_.tracking.ground_vehicle || !world_up_known_ || T_world_ref == nullptr) {
+  if (!options_.motion.ground_vehicle || !world_up_known_ || T_world_ref == nullptr) {
     return nullptr;
   }
   *storage = WorldUpInCamera(*T_world_ref);
@@ -153,8 +154,8 @@ OdometryResult StereoOdometry::Lost(OdometryResult result, const std::string& me
 std::string StereoOdometry::OrientFirstFrame(const std::vector<Eigen::Vector3d>& points,
                                              const cv::Mat& left, const cv::Mat& right,
                                              const cv::Mat& disparity_px, OdometryResult* result) {
-  const InitialOrientation orientation =
-      EstimateInitialOrientation(camera_, options_, points, left, right, disparity_px);
+  const InitialOrientation orientation = EstimateInitialOrientation(
+      camera_, options_.initial_orientation, points, left, right, disparity_px);
   orientation_result_ = orientation.planes;
   result->floor_refined = orientation.floor_refined;
   result->floor_refinement_message = orientation.message;
@@ -174,12 +175,12 @@ std::string StereoOdometry::OrientFirstFrame(const std::vector<Eigen::Vector3d>&
 
 VehicleGeometry StereoOdometry::Geometry() const {
   VehicleGeometry g;
-  g.vehicle = options_.tracking.ground_vehicle;
+  g.vehicle = options_.motion.ground_vehicle;
   g.up_known = world_up_known_ && vehicle_up_.known();
   g.up_cam = vehicle_up_.up();
   g.R_world_cam0_initial = R_hall_cam0_initial_;
   g.floor_found = orientation_result_.floor_index >= 0;
-  g.axle_behind_camera_m = options_.tracking.few_point.axle_behind_camera_m;
+  g.axle_behind_camera_m = options_.motion.few_point.axle_behind_camera_m;
   return g;
 }
 
@@ -233,14 +234,15 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   result.prediction = attempt.source;
 
   // The frame's motion: RANSAC's, or the few-point motion with the prior (motion_estimation.h).
-  const RobustTrackingOptions& tracking = options_.tracking;
+  const MotionOptions& motion_options = options_.motion;
   const Eigen::Isometry3d* T_world_ref = back_end_.Pose(reference_.frame_index);
   Eigen::Vector3d up_storage;
   const FrameMotion motion =
-      ResolveFrameMotion(camera_, options_, static_cast<int>(frame.features.size()), ref_features,
-                         VehicleUpAtReference(&up_storage), T_ref_curr_prior,
-                         previous_measured_ && consecutive_lost_ == 0, result.image_shift_ok,
-                         result.image_shift_px, &attempt);
+      ResolveFrameMotion(camera_, options_.motion,
+                         static_cast<int>(frame.features.size()) < options_.front_end.min_features,
+                         ref_features, VehicleUpAtReference(&up_storage), T_ref_curr_prior,
+                         previous_measured_ && consecutive_lost_ == 0 && Predicted(),
+                         result.image_shift_ok, result.image_shift_px, &attempt);
   if (motion.few_point) {
     result.few_point_motion = true;
     result.message = motion.message;
@@ -261,7 +263,7 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
 
   if (!motion.ok()) {
     std::ostringstream why;
-    why << MotionFailureMessage(motion, attempt, options_.min_inliers);
+    why << MotionFailureMessage(motion, attempt, options_.motion.min_inliers);
     result.times.motion_ms += ElapsedMs(motion_start);
     // The reference cannot measure this frame: the lost frames before it may (the pose and the
     // constant velocity from that chain; BridgedPose takes the pose).
@@ -275,8 +277,10 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     // After a loss, a frame that has plenty of features but cannot be matched to the last good
     // one (even with the coarse-to-fine search) starts again at once: waiting longer would
     // only extrapolate further.
-    const bool rich = static_cast<int>(frame.features.size()) >= 2 * options_.min_features;
-    if (consecutive_lost_ >= options_.reinit_after_lost_frames || (consecutive_lost_ > 0 && rich)) {
+    const bool rich =
+        static_cast<int>(frame.features.size()) >= 2 * options_.front_end.min_features;
+    if (consecutive_lost_ >= options_.recovery.reinit_after_lost_frames ||
+        (consecutive_lost_ > 0 && rich)) {
       // The reference is stale: start again from this frame at its predicted (or chained) pose.
       return Initialise(std::move(result), std::move(frame),
                         why.str() + "; re-initialised at the predicted pose", start, prior,
@@ -284,8 +288,8 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     }
     OdometryResult lost =
         Lost(std::move(result), why.str(), start, prior, chained ? &T_world_chained : nullptr);
-    if (options_.tracking.chain_lost_frames &&
-        static_cast<int>(frame.features.size()) >= options_.min_features) {
+    if (options_.recovery.chain_lost_frames &&
+        static_cast<int>(frame.features.size()) >= options_.front_end.min_features) {
       recovery_.ContinueChain(lost.frame_index, std::move(frame), lost.T_world_cam0);
     }
     return lost;
@@ -333,18 +337,19 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const Eigen::Isometry3d per_frame = Root(T_ref_curr, gap);
   // Weight of this motion in the prior: 1 from reliable_min_inliers inliers up, less below
   // (a weak motion moves the prior only part of the way), 0 when the BA was rejected.
-  const double weight = ba_rejected               ? 0.0
-                        : result.few_point_motion ? tracking.few_point_prior_update
-                                                  : PriorUpdateWeight(ransac.num_inliers, tracking);
+  const double weight = ba_rejected ? 0.0
+                        : result.few_point_motion
+                            ? motion_options.few_point_prior_update
+                            : PriorUpdateWeight(ransac.num_inliers, motion_options);
   velocity_.Move(per_frame, weight);
   if (IsFinitePose(per_frame) && !ba_rejected)
     velocity_.SetLastMeasured(per_frame, result.frame_index);
   result.motion_measured = true;
   // A reliable measured motion refines the vehicle's up (not a few-point or bundle-adjusted
   // one: both are made planar about the current estimate).
-  if (tracking.ground_vehicle && options_.back_end.vehicle_planar.enabled &&
+  if (motion_options.ground_vehicle && options_.back_end.vehicle_planar.enabled &&
       !result.few_point_motion && !ba_rejected &&
-      ransac.num_inliers >= tracking.reliable_min_inliers)
+      ransac.num_inliers >= motion_options.reliable_min_inliers)
     vehicle_up_.AddMotion(ransac.T_prev_curr, kVehicleUpTranslationSigmaM,
                           kVehicleUpRotationSigmaDeg * M_PI / 180.0);
 
@@ -397,12 +402,14 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   // The front end: the disparity (the whole map in dense mode or for the first frame's
   // plane-based orientation, else prepared at the features' pixels), features, depth.
   const bool orientation_frame =
-      !reference_.valid && !initialised_ && options_.estimate_initial_orientation;
-  const bool dense = options_.disparity_mode == DisparityMode::kDense || orientation_frame;
-  FrontEndFrame front = front_end_->Process(
-      left, right,
-      scene_num_disparities_ > 0 ? scene_num_disparities_ : options_.disparity.num_disparities,
-      dense, &result);
+      !reference_.valid && !initialised_ && options_.initial_orientation.enabled;
+  const bool dense =
+      options_.front_end.disparity_mode == DisparityMode::kDense || orientation_frame;
+  FrontEndFrame front =
+      front_end_->Process(left, right,
+                          scene_num_disparities_ > 0 ? scene_num_disparities_
+                                                     : options_.front_end.disparity.num_disparities,
+                          dense, &result);
   if (!front.ok) return Lost(std::move(result), front.message, start, prior);
   MatchFrame frame = std::move(front.frame);
   frame.frame_id = result.frame_index;
@@ -410,14 +417,13 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   // Below min_features a frame is still matched when the few-point solver can use it (a
   // reference, a prior, at least few_point_min_features features).
   const bool few_point_possible =
-      options_.tracking.few_point_motion && options_.matcher.prediction != PredictionMode::kNone &&
-      reference_.valid && (prior != nullptr || velocity_.known()) && previous_measured_ &&
-      consecutive_lost_ == 0 &&
-      result.num_features_with_depth >= options_.tracking.few_point_min_features;
-  if (result.num_features_with_depth < options_.min_features && !few_point_possible) {
+      options_.motion.few_point_motion && Predicted() && reference_.valid &&
+      (prior != nullptr || velocity_.known()) && previous_measured_ && consecutive_lost_ == 0 &&
+      result.num_features_with_depth >= options_.motion.few_point_min_features;
+  if (result.num_features_with_depth < options_.front_end.min_features && !few_point_possible) {
     std::ostringstream msg;
     msg << "too few features with depth (" << result.num_features_with_depth << " of "
-        << result.num_features << " features; need " << options_.min_features
+        << result.num_features << " features; need " << options_.front_end.min_features
         << "): black, textureless or unmatched frame";
     return Lost(std::move(result), msg.str(), start, prior);
   }
@@ -425,12 +431,12 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
 
   if (!reference_.valid) {
     std::string reason;
-    if (!initialised_ && options_.estimate_initial_orientation) {
+    if (!initialised_ && options_.initial_orientation.enabled) {
       // Initial orientation from the floor/wall planes of the dense disparity map.
       const Clock::time_point t = Clock::now();
-      const std::vector<Eigen::Vector3d> points =
-          SampleDisparityPoints(camera_, front.disparity_px, options_.orientation_sample_step_px,
-                                options_.depth.min_depth_m, options_.depth.max_depth_m);
+      const std::vector<Eigen::Vector3d> points = SampleDisparityPoints(
+          camera_, front.disparity_px, options_.initial_orientation.sample_step_px,
+          options_.front_end.depth.min_depth_m, options_.front_end.depth.max_depth_m);
       reason = OrientFirstFrame(points, left, right, front.disparity_px, &result);
       result.times.orientation_ms = ElapsedMs(t);
     }
@@ -497,19 +503,19 @@ OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
   prev_call_index_map_.clear();
 
   const bool few_point_possible =
-      options_.tracking.few_point_motion && options_.matcher.prediction != PredictionMode::kNone &&
-      prev_is_reference && velocity_.known() && previous_measured_ &&
-      result.num_features_with_depth >= options_.tracking.few_point_min_features;
-  if (result.num_features_with_depth < options_.min_features && !few_point_possible) {
+      options_.motion.few_point_motion && Predicted() && prev_is_reference && velocity_.known() &&
+      previous_measured_ &&
+      result.num_features_with_depth >= options_.motion.few_point_min_features;
+  if (result.num_features_with_depth < options_.front_end.min_features && !few_point_possible) {
     std::ostringstream msg;
     msg << "too few features with depth (" << result.num_features_with_depth << " of "
-        << result.num_features << "; need " << options_.min_features << ")";
+        << result.num_features << "; need " << options_.front_end.min_features << ")";
     return Lost(std::move(result), msg.str(), start);
   }
   prev_call_index_map_ = index_map;
   if (!prev_is_reference) {
     std::string reason;
-    if (!initialised_ && options_.estimate_initial_orientation) {
+    if (!initialised_ && options_.initial_orientation.enabled) {
       const Clock::time_point to = Clock::now();
       std::vector<Eigen::Vector3d> points;
       for (const Feature& f : frame.features) points.push_back(f.p_cam0);

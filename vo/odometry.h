@@ -2,6 +2,10 @@
 // Kwolek, docs/PAPER.md (the whole table), sections IV–V of the paper. StereoOdometry
 // orchestrates the stages, each in its own unit that receives only the data it needs:
 //
+// Each stage takes its own part of OdometryOptions (FrontEndOptions, InitialOrientationOptions,
+// TrackerOptions, MotionOptions, RecoveryOptions, BackEndOptions; the tracker and the recovery
+// also read MotionOptions, the recovery the tracker's image shift):
+//
 //   front end     disparity prepared (area-based; search range from the scene)
 //                 → features (Harris | SIFT, bucketed) → depth at the features'
 //                 pixels, features without depth dropped                      front_end.h
@@ -25,7 +29,7 @@
 // The reference frame is the last frame that was tracked (or initialised): normally the
 // previous frame; after lost frames, the last good one.
 //
-// World frame. With estimate_initial_orientation (default) and a floor (or ceiling) found in
+// World frame. With initial_orientation.enabled (default) and a floor (or ceiling) found in
 // the first frame: the hallway frame of plane_orientation.h (x along the corridor, y left,
 // z up), with its origin at the first camera centre, i.e. T_world_cam0(frame 0) =
 // [R_hall_cam0 | 0]. Otherwise the world is the first camera frame (T_world_cam0 = identity).
@@ -42,16 +46,16 @@
 //
 // Lost tracking. A frame is "lost" (TrackingStatus::kLost, with a message) when its input is
 // invalid (empty, not CV_8UC1, sizes differ from each other or from the camera), its disparity
-// fails, it has fewer than min_features features with depth (black or textureless frame), or
-// the motion fails (RANSAC without consensus, fewer than min_inliers inliers; but see "Few
+// fails, it has fewer than front_end.min_features features with depth (black or textureless frame),
+// or the motion fails (RANSAC without consensus, fewer than motion.min_inliers inliers; see "Few
 // points" in motion_estimation.h). Its pose is bridged (recovery.h); the reference frame, the
 // tracks and the window are kept, and the next frames are matched against that reference with
 // the coarse-to-fine pass, so the motion across the gap is measured (kRecovered). When the
-// motion still fails after reinit_after_lost_frames lost frames, or the current frame is rich
-// (at least 2 · min_features features) yet cannot be matched after a loss, the pipeline
+// motion still fails after recovery.reinit_after_lost_frames lost frames, or the current frame is
+// rich (at least 2 · min_features features) yet cannot be matched after a loss, the pipeline
 // re-initialises on the current frame at its bridged pose (kRecovered, reinitialised = true):
 // tracks and window restart, the constant velocity is kept. Each measured motion moves the
-// prior in proportion to its support (tracking.reliable_min_inliers; not at all when the BA was
+// prior in proportion to its support (motion.reliable_min_inliers; not at all when the BA was
 // rejected). Frames without a measured motion (lost and re-initialised ones, unless the direct
 // image alignment measured them) are what IsLostFrame() counts. The frame after a kRecovered
 // frame is kTracking again.
@@ -157,6 +161,8 @@ class StereoOdometry {
   // The world's up in the reference camera frame for a ground vehicle whose up is known (the
   // few-point motion and the weak-motion check are planar about it); null otherwise.
   const Eigen::Vector3d* VehicleUpAtReference(Eigen::Vector3d* storage) const;
+  // The tracker predicts its matches (matcher.prediction is not kNone).
+  bool Predicted() const { return options_.tracker.matcher.prediction != PredictionMode::kNone; }
   // A lost frame: pose bridged (or `chained`, see Recovery::BridgedPose), reference and
   // tracks kept.
   OdometryResult Lost(OdometryResult result, const std::string& message, TimePoint start,

@@ -94,17 +94,17 @@ struct OdometryResult {
                                      // alignment measured them (direct_motion)
   bool reinitialised = false;        // the pipeline restarted on this frame after a loss
   bool few_point_motion = false;     // the motion came from the few-point solver with the
-                                     // prior (RobustTrackingOptions::few_point_motion)
+                                     // prior (MotionOptions::few_point_motion)
   bool rotation_from_shift = false;  // lost or re-initialised, its pose is the prior corrected
                                      // by the image shift from the previous frame
   bool bridge_aligned = false;       // lost or re-initialised, its forward step or yaw was
                                      // measured against the previous frame's features
-                                     // (tracking.vehicle_bridge_alignment)
+                                     // (RecoveryOptions::vehicle_bridge_alignment)
   bool direct_motion = false;        // lost or re-initialised, its motion was measured by
                                      // direct image alignment (motion_measured;
-                                     // tracking.vehicle_direct_alignment)
+                                     // RecoveryOptions::vehicle_direct_alignment)
   int64_t chained_to_frame = -1;     // lost or re-initialised, its pose was measured against
-                                     // this earlier lost frame (tracking.chain_lost_frames;
+                                     // this earlier lost frame (RecoveryOptions::chain_lost_frames;
                                      // -1: not chained) ...
   int chain_inliers = 0;             // ... with this many RANSAC inliers
   PredictionSource prediction = PredictionSource::kNone;  // centre of the used matches' search

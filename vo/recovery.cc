@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <utility>
 
 #include "vo/bridge_alignment.h"
 #include "vo/image_motion.h"
 #include "vo/motion_estimation.h"
+#include "vo/options_check.h"
 #include "vo/prior_motion.h"
 
 namespace vo {
@@ -16,7 +18,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The planes of a frame's features for the direct alignment of the next lost frame
-// (tracking.vehicle_direct_alignment): up to 3 (a wall, the floor, a side wall); a feature is on
+// (vehicle_direct_alignment): up to 3 (a wall, the floor, a side wall); a feature is on
 // one within 1 px of disparity; each with at least 6 features spread at least 5 cm across (not
 // all along one edge), 60 % of the features on them. Without such planes a frame carries the
 // previous ones by its motion, for at most 30 frames.
@@ -29,8 +31,44 @@ constexpr int kMaxScenePlaneAge = 30;
 
 }  // namespace
 
-Recovery::Recovery(const StereoCamera& camera, const OdometryOptions& options)
-    : camera_(camera), options_(options) {}
+bool RecoveryOptions::IsValid(std::string* error) const {
+  if (vehicle_bridge_alignment &&
+      (!PartIsValid(vehicle_bridge, "vehicle_bridge", error) ||
+       (vehicle_direct_alignment && !PartIsValid(vehicle_direct, "vehicle_direct", error)))) {
+    return false;
+  }
+  std::ostringstream msg;
+  if (!(rotation_min_shift_score >= -1.0 && rotation_min_shift_score <= 1.0)) {
+    msg << "rotation_min_shift_score must be in [-1, 1], got " << rotation_min_shift_score;
+  } else if (!(rotation_min_peak_ratio >= 1.0) || !std::isfinite(rotation_min_peak_ratio)) {
+    msg << "rotation_min_peak_ratio must be finite and >= 1, got " << rotation_min_peak_ratio;
+  } else if (!(rotation_min_residual_px >= 0.0) || !std::isfinite(rotation_min_residual_px)) {
+    msg << "rotation_min_residual_px must be finite and >= 0, got " << rotation_min_residual_px;
+  } else if (!(vehicle_rotation_min_shift_score >= -1.0 &&
+               vehicle_rotation_min_shift_score <= 1.0)) {
+    msg << "vehicle_rotation_min_shift_score must be in [-1, 1], got "
+        << vehicle_rotation_min_shift_score;
+  } else if (!(vehicle_rotation_min_peak_ratio >= 1.0) ||
+             !std::isfinite(vehicle_rotation_min_peak_ratio)) {
+    msg << "vehicle_rotation_min_peak_ratio must be finite and >= 1, got "
+        << vehicle_rotation_min_peak_ratio;
+  } else if (!(vehicle_max_vertical_shift_ratio >= 0.0) ||
+             !std::isfinite(vehicle_max_vertical_shift_ratio)) {
+    msg << "vehicle_max_vertical_shift_ratio must be finite and >= 0, got "
+        << vehicle_max_vertical_shift_ratio;
+  } else if (reinit_after_lost_frames < 1) {
+    msg << "reinit_after_lost_frames must be >= 1, got " << reinit_after_lost_frames;
+  }
+  return NoBrokenRule(msg, error);
+}
+
+Recovery::Recovery(const StereoCamera& camera, const RecoveryOptions& options,
+                   const MotionOptions& motion, const TrackerOptions& tracker)
+    : camera_(camera),
+      options_(options),
+      motion_(motion),
+      image_shift_(tracker.image_shift),
+      predicted_(tracker.matcher.prediction != PredictionMode::kNone) {}
 
 void Recovery::Reset() {
   previous_frame_features_.clear();
@@ -45,9 +83,9 @@ void Recovery::Reset() {
 void Recovery::EndFrame(const std::vector<Feature>& features, const Eigen::Isometry3d& T_prev_curr,
                         cv::Mat left) {
   // Only the bridge alignment reads the previous frame's features: no copy per frame otherwise.
-  if (options_.tracking.ground_vehicle && options_.tracking.vehicle_bridge_alignment) {
+  if (motion_.ground_vehicle && options_.vehicle_bridge_alignment) {
     previous_frame_features_ = features;
-    if (options_.tracking.vehicle_direct_alignment) UpdateScenePlanes(features, T_prev_curr);
+    if (options_.vehicle_direct_alignment) UpdateScenePlanes(features, T_prev_curr);
   }
   previous_left_ = std::move(left);
 }
@@ -62,7 +100,7 @@ void Recovery::ContinueChain(int64_t frame_index, MatchFrame frame,
 
 Eigen::Isometry3d Recovery::BridgeMotion(const BridgeContext& c) const {
   const Eigen::Isometry3d T_prev_curr = c.velocity->Prior(c.prior);
-  if (c.prior != nullptr || !options_.tracking.ground_vehicle || !c.world_up_known) {
+  if (c.prior != nullptr || !motion_.ground_vehicle || !c.world_up_known) {
     return T_prev_curr;
   }
   return PlanarPart(T_prev_curr, WorldUpInCamera(c.T_world_prev));
@@ -72,9 +110,9 @@ Eigen::Isometry3d Recovery::BridgedPose(const BridgeContext& c, OdometryResult* 
                                         const Eigen::Isometry3d* chained) {
   if (chained != nullptr) return *chained;  // measured against the lost-frame chain
   const Eigen::Isometry3d bridged = ShiftCorrectedPose(c, result);
-  const RobustTrackingOptions& o = options_.tracking;
-  if (c.prior != nullptr || !o.ground_vehicle || !o.vehicle_bridge_alignment || !c.world_up_known ||
-      options_.matcher.prediction == PredictionMode::kNone) {
+  const RecoveryOptions& o = options_;
+  if (c.prior != nullptr || !motion_.ground_vehicle || !o.vehicle_bridge_alignment ||
+      !c.world_up_known || !predicted_) {
     return bridged;
   }
   const Eigen::Isometry3d aligned = AlignedBridgePose(c, bridged, result);
@@ -85,10 +123,10 @@ Eigen::Isometry3d Recovery::DirectAlignedPose(const BridgeContext& c,
                                               const Eigen::Isometry3d& bridged,
                                               OdometryResult* result) {
   if (scene_planes_.empty() || previous_left_.empty() || c.current_left.empty()) return bridged;
-  const RobustTrackingOptions& o = options_.tracking;
+  const RecoveryOptions& o = options_;
   const Clock::time_point t = Clock::now();
   const Eigen::Vector3d up = WorldUpInCamera(c.T_world_prev);
-  const double axle = o.few_point.axle_behind_camera_m;
+  const double axle = motion_.few_point.axle_behind_camera_m;
   const Eigen::Vector2d start =
       VehicleMotionParameters(c.T_world_prev.inverse() * bridged, up, axle);
   if (!start.allFinite()) return bridged;
@@ -129,7 +167,7 @@ Eigen::Isometry3d Recovery::AlignedBridgePose(const BridgeContext& c,
                                               const Eigen::Isometry3d& bridged,
                                               OdometryResult* result) {
   const std::vector<Feature>& last_features = *c.features;
-  const RobustTrackingOptions& o = options_.tracking;
+  const RecoveryOptions& o = options_;
   const Clock::time_point t = Clock::now();
   Eigen::Isometry3d T = c.T_world_prev.inverse() * bridged;
   int pairs = 0;
@@ -140,7 +178,7 @@ Eigen::Isometry3d Recovery::AlignedBridgePose(const BridgeContext& c,
     result->bridge_aligned = true;
   }
   const Eigen::Vector3d up = WorldUpInCamera(c.T_world_prev);
-  const double axle = o.few_point.axle_behind_camera_m;
+  const double axle = motion_.few_point.axle_behind_camera_m;
   const Eigen::Vector2d yaw_forward = VehicleMotionParameters(T, up, axle);
   double yaw = yaw_forward.x();
   if (yaw_forward.allFinite() &&
@@ -159,19 +197,18 @@ Eigen::Isometry3d Recovery::ShiftCorrectedPose(const BridgeContext& c, OdometryR
   const MotionPrior* prior = c.prior;
   const std::vector<Feature>& last_features = *c.features;
   const Eigen::Isometry3d predicted = c.T_world_prev * BridgeMotion(c);
-  const RobustTrackingOptions& o = options_.tracking;
-  if (options_.matcher.prediction == PredictionMode::kNone || !o.rotation_from_shift ||
-      previous_left_.empty() || c.current_left.empty() ||
+  const RecoveryOptions& o = options_;
+  if (!predicted_ || !o.rotation_from_shift || previous_left_.empty() || c.current_left.empty() ||
       previous_left_.size() != c.current_left.size()) {
     return predicted;
   }
   const Clock::time_point t = Clock::now();
-  const ImageShiftResult shift = EstimateImageShift(previous_left_, c.current_left, o.image_shift);
+  const ImageShiftResult shift = EstimateImageShift(previous_left_, c.current_left, image_shift_);
   result->times.predict_ms += ElapsedMs(t);
   // A ground vehicle (its motion a yaw and a forward step, the camera swinging about the axle)
   // reads the shift with that model: a sharp peak is trusted at a lower score, and a shift whose
   // vertical part (no pitch: zoom, parallax) is large against its horizontal part is no turn.
-  const bool vehicle = prior == nullptr && o.ground_vehicle && c.world_up_known;
+  const bool vehicle = prior == nullptr && motion_.ground_vehicle && c.world_up_known;
   const bool strong = shift.score >= o.rotation_min_shift_score &&
                       shift.second_best_ratio >= o.rotation_min_peak_ratio;
   const bool sharp = vehicle && shift.score >= o.vehicle_rotation_min_shift_score &&
@@ -198,8 +235,8 @@ Eigen::Isometry3d Recovery::ShiftCorrectedPose(const BridgeContext& c, OdometryR
       return predicted;
     }
     T_prev_curr = VehicleMotionFromImageShift(camera_, WorldUpInCamera(c.T_world_prev),
-                                              o.few_point.axle_behind_camera_m, T_prev_curr_prior,
-                                              shift.shift_px, depth_m);
+                                              motion_.few_point.axle_behind_camera_m,
+                                              T_prev_curr_prior, shift.shift_px, depth_m);
   } else {  // (not a ground vehicle whose up is known: PlanarBridge would change nothing)
     T_prev_curr = CorrectPriorWithImageShift(camera_, T_prev_curr_prior, shift.shift_px, depth_m);
   }
@@ -222,9 +259,8 @@ bool Recovery::ChainLostFrame(Tracker* tracker, const MatchFrame& frame, const B
                               OdometryResult* result, Eigen::Isometry3d* T_world_curr) {
   const MotionPrior* prior = c.prior;
   // A caller's prior (wheel odometry, a gyro) bridges a lost frame as given.
-  if (!options_.tracking.chain_lost_frames || prior != nullptr || !chain_valid_ ||
-      chain_frame_index_ >= result->frame_index ||
-      options_.matcher.prediction == PredictionMode::kNone ||
+  if (!options_.chain_lost_frames || prior != nullptr || !chain_valid_ ||
+      chain_frame_index_ >= result->frame_index || !predicted_ ||
       tracker->matcher_type() == MatcherType::kKalman) {
     return false;
   }
@@ -244,7 +280,7 @@ bool Recovery::ChainLostFrame(Tracker* tracker, const MatchFrame& frame, const B
   result->times.motion_ms += pass.times.motion_ms;
   result->times.guided_ms += pass.times.guided_ms;
   const RansacResult& ransac = attempt.ransac;
-  if (!matcher_error.empty() || attempt.inliers() < options_.min_inliers ||
+  if (!matcher_error.empty() || attempt.inliers() < motion_.min_inliers ||
       !IsFinitePose(ransac.T_prev_curr)) {
     return false;
   }
@@ -254,7 +290,7 @@ bool Recovery::ChainLostFrame(Tracker* tracker, const MatchFrame& frame, const B
   // The measured motion moves the constant velocity as a tracked one does (by its support).
   const Eigen::Isometry3d per_frame =
       Root(ransac.T_prev_curr, result->frame_index - chain_frame_index_);
-  c.velocity->Move(per_frame, PriorUpdateWeight(ransac.num_inliers, options_.tracking));
+  c.velocity->Move(per_frame, PriorUpdateWeight(ransac.num_inliers, motion_));
   return true;
 }
 

@@ -5,25 +5,28 @@
 // the direct alignment of the previous image), and keeps what the next frames need for that
 // (the previous frame's features, image and planes, the chain). It receives the previous
 // output, the prior, this frame and the constant velocity (BridgeContext), and the tracker for
-// the chain's matching; the re-initialisation itself is StereoOdometry's. Its options are the
-// `recovery` group of vo_options.yaml. In detail:
+// the chain's matching; the re-initialisation itself is StereoOdometry's. Its options are
+// RecoveryOptions (the `recovery` group of vo_options.yaml); it also reads the motion stage's
+// vehicle model and inlier thresholds (MotionOptions: ground_vehicle, few_point's axle,
+// min_inliers, the prior's update) and the tracker's image shift and prediction mode
+// (TrackerOptions). In detail:
 //
 // A lost frame's pose is the prior's prediction from the previous output, never NaN —
-// corrected, when the image shift from the previous frame is found (tracking.
-// rotation_from_shift), by the rotation that explains that shift (CorrectPriorWithImageShift;
+// corrected, when the image shift from the previous frame is found
+// (rotation_from_shift), by the rotation that explains that shift (CorrectPriorWithImageShift;
 // a ground vehicle's, VehicleMotionFromImageShift): a turn in front of a plain wall is
 // followed, not extrapolated (ShiftCorrectedPose). A lost frame that the reference cannot
-// measure is matched against the previous lost frame with features (tracking.chain_lost_frames,
+// measure is matched against the previous lost frame with features (chain_lost_frames,
 // ChainLostFrame): a turn in front of a plain wall leaves the reference's view behind, but the
 // frames of the gap overlap each other, so their motion is measured link by link (the frame
 // stays lost; OdometryResult::chained_to_frame).
 //
-// Ground vehicle (tracking.ground_vehicle; off on the free platform, on for a ground vehicle):
-// where the images cannot measure the motion it is a wheeled vehicle's, planar about the
+// Ground vehicle (MotionOptions::ground_vehicle; off on the free platform, on for a ground
+// vehicle): where the images cannot measure the motion it is a wheeled vehicle's, planar about the
 // world's up (PlanarBridge). A lost frame's forward step and yaw are then measured against the
-// previous frame's features without matching them (tracking.vehicle_bridge_alignment,
+// previous frame's features without matching them (vehicle_bridge_alignment,
 // bridge_alignment.h), and then by aligning the previous left image with this one on the planes
-// of the last features (tracking.vehicle_direct_alignment, direct_alignment.h): when that
+// of the last features (vehicle_direct_alignment, direct_alignment.h): when that
 // converges the frame's motion is measured (not a lost frame). Each measured bridge becomes the
 // constant velocity (the braking and the turn go on through the next lost frames).
 //
@@ -38,16 +41,108 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "vo/bridge_alignment.h"
 #include "vo/camera.h"
 #include "vo/direct_alignment.h"
 #include "vo/matcher.h"
+#include "vo/motion_estimation.h"
 #include "vo/motion_model.h"
-#include "vo/odometry_options.h"
 #include "vo/odometry_result.h"
 #include "vo/tracker.h"
 #include "vo/types.h"
 
 namespace vo {
+
+// The recovery's options (vo_options.yaml `recovery`): the bridge's rotation from the image
+// shift, the lost-frame chain, the ground vehicle's bridge and direct alignment, and when the
+// pipeline re-initialises.
+struct RecoveryOptions {
+  bool rotation_from_shift = true;  // a frame without a measured motion (too few features, no
+                                    // consensus) takes the prior's motion corrected by the
+                                    // image shift from the previous frame (the rotation that
+                                    // explains the shift left after the prior, see
+                                    // CorrectPriorWithImageShift), when that shift is found
+                                    // (TrackerOptions::image_shift); the measured rotation then
+                                    // becomes the prior's
+  double rotation_min_shift_score = 0.85;  // ... with at least this ZNCC, in [-1, 1]: real
+                                           // structure scores 0.9-0.99 between successive
+                                           // frames, false peaks on plain, smoothly shaded
+                                           // walls ~0.7 (measured on the plain corridor)
+  double rotation_min_peak_ratio = 1.05;   // ... and an unambiguous peak: best / second-best
+                                           // peak score (ImageShiftResult::second_best_ratio)
+                                           // at least this, >= 1
+  double rotation_min_residual_px = 3.0;   // ... and only when the shift differs from the one
+                                           // the prior predicts by more than this (pixels),
+                                           // >= 0: smaller residuals are within what a global
+                                           // shift cannot tell from parallax and zoom (forward
+                                           // motion past plain walls), so the prior stands
+  // With MotionOptions::ground_vehicle, a lost frame's rotation from the image shift
+  // (rotation_from_shift) is a vehicle's: the yaw whose motion, with the camera's swing about the
+  // axle (few_point.axle_behind_camera_m), predicts the shift (VehicleMotionFromImageShift). A
+  // peak with at least vehicle_rotation_min_shift_score ([-1, 1]) and a best / second-best ratio
+  // of at least vehicle_rotation_min_peak_ratio (>= 1) is used too (a turn past a plain wall
+  // scores low over the whole overlap but has one clear peak); a shift whose vertical residual
+  // (after the prior) exceeds max(rotation_min_residual_px, vehicle_max_vertical_shift_ratio ·
+  // its horizontal residual) (>= 0) is zoom and parallax of forward motion, not a turn (the
+  // prior stands).
+  double vehicle_rotation_min_shift_score = 0.7;
+  double vehicle_rotation_min_peak_ratio = 3.0;
+  double vehicle_max_vertical_shift_ratio = 0.25;
+  // A lost frame with at least min_features features is matched against the previous lost
+  // frame that had them (the chain), when matching against the reference failed: a turn in
+  // front of a plain wall takes the camera past the reference's view, and the frames of the
+  // gap, which do overlap each other, then measure the motion through it (rotation and
+  // translation, RANSAC with at least min_inliers inliers) instead of extrapolating the prior.
+  // The frame stays lost (no link to the window; it counts in lost_frames), its pose is the
+  // chain's pose times that motion, and the motion moves the constant-velocity prior as a
+  // tracked one does. Not with matcher.prediction none (the paper's form), the Kalman matcher
+  // (stateful), or a caller's MotionPrior (it bridges a lost frame as given). Measured on l_hallway
+  // texture seeds 1-10 x strides 1/2/3/5 (40 runs, results/robustness/, linear prior update):
+  // defaults' median end-pose error 0.206 -> 0.182 m, max 1.958 -> 1.663 m, mean 0.431 -> 0.442 m;
+  // plain_corridor better at every stride (0.268-0.569 -> 0.222-0.492 m); with few_point_motion and
+  // ground_vehicle mean 0.393 -> 0.328 m.
+  bool chain_lost_frames = true;
+  // With ground_vehicle (the up known, matcher.prediction motion_prior, no caller's prior), the
+  // bridged motion of a lost frame (the prior, its rotation corrected by the image shift) is
+  // measured against the previous frame's features without matching them (bridge_alignment.h):
+  // the forward step from their depth change, then the yaw that lays the previous features onto
+  // this frame's; each where at least vehicle_bridge.min_pairs features pair up. The result
+  // becomes the constant velocity (the braking and the turn go on through the next lost frames).
+  // The constant velocity otherwise keeps the cruise speed into a robot that stops and turns in
+  // front of a plain end wall (texture seed 3, stride 1: 4.2 cm a frame where it moved 0.6 cm)
+  // and reads the image shift of off-centre texture as too much yaw (2.8 deg a frame for 2.2).
+  // Measured on l_hallway texture seeds 1-10 x strides 1/2/3/5 (40 runs) with few_point_motion,
+  // vehicle_planar_ba and the rig's axle (0.15 m): mean end-pose error 0.270 -> 0.219 m, runs
+  // <= 0.29 m 31 -> 35, stride 1 max 0.507 -> 0.267 m (every seed under the paper's 0.29 m);
+  // without vehicle_planar_ba mean 0.294 -> 0.249 m; ground_vehicle and the axle alone 0.334 ->
+  // 0.253 m. It needs the rig's axle: with axle_behind_camera_m 0 on that rig (0.15 m off) the
+  // swing is misread and runs <= 0.29 m go 30 -> 26; and without vehicle_planar_ba the pitched
+  // camera goes 0.85 -> 1.30 % (ground_vehicle and the axle). Not for the 6-DoF default: without
+  // the axle's swing in the model a near wall's sideways flow reads as yaw (mean 0.375 -> 0.405 m).
+  bool vehicle_bridge_alignment = true;
+  BridgeAlignmentOptions vehicle_bridge;
+  // With vehicle_bridge_alignment, a lost (or re-initialised) frame's bridged motion is then
+  // measured by aligning the previous left image with this one directly (direct_alignment.h):
+  // the previous image's pixels with a gradient on the planes of the features (fitted in each
+  // frame with enough of them, carried by the measured or bridged motion through at most 30
+  // frames without), the vehicle's yaw and forward step by robust
+  // Gauss-Newton on the grey levels, coarse to fine. When it converges with enough pixels and a
+  // small enough covariance (vehicle_direct), the frame's motion counts as measured
+  // (motion_measured, direct_motion; it is not a lost frame) and becomes the constant velocity.
+  // A turn in front of a plain wall whose features are too few for any matcher (texture seed 3,
+  // stride 1: 1-14 a frame for 21 frames) is measured from its edges, shadows and specks.
+  bool vehicle_direct_alignment = true;
+  DirectAlignmentOptions vehicle_direct;
+  int reinit_after_lost_frames = 10;  // while this many consecutive frames (or more) have been
+                                      // lost, a frame whose motion fails against the reference
+                                      // re-initialises the pipeline on itself, >= 1. Before
+                                      // that, each new frame is matched against the last good
+                                      // frame (wide, coarse-to-fine search), so the motion
+                                      // across the gap is measured, not extrapolated
+
+  // vehicle_bridge and vehicle_direct are checked when they are on (whatever the platform).
+  bool IsValid(std::string* error) const;
+};
 
 // What the recovery of one frame knows of the pipeline.
 struct BridgeContext {
@@ -62,7 +157,11 @@ struct BridgeContext {
 
 class Recovery {
  public:
-  Recovery(const StereoCamera& camera, const OdometryOptions& options);
+  // motion: the vehicle model (ground_vehicle, few_point.axle_behind_camera_m), the chain's
+  // min_inliers and the prior's update; tracker: the image shift's options and whether the
+  // matches are predicted (matcher.prediction; the paper's form bridges with the prior alone).
+  Recovery(const StereoCamera& camera, const RecoveryOptions& options, const MotionOptions& motion,
+           const TrackerOptions& tracker);
 
   // The pose of a frame without a measured motion: `chained` when ChainLostFrame measured one
   // (non-null), else the predicted pose corrected by the image shift from the previous frame
@@ -73,7 +172,7 @@ class Recovery {
   Eigen::Isometry3d BridgedPose(const BridgeContext& context, OdometryResult* result,
                                 const Eigen::Isometry3d* chained = nullptr);
 
-  // tracking.chain_lost_frames: `frame`, which the reference could not measure, against the
+  // chain_lost_frames: `frame`, which the reference could not measure, against the
   // chain (the last lost frame with features). True with *T_world_curr when RANSAC finds at
   // least min_inliers inliers; the motion then moves the constant velocity. Times go to
   // `result`.
@@ -107,7 +206,10 @@ class Recovery {
                          const Eigen::Isometry3d& T_prev_curr);
 
   StereoCamera camera_;
-  OdometryOptions options_;
+  RecoveryOptions options_;
+  MotionOptions motion_;
+  ImageShiftOptions image_shift_;                 // the tracker's
+  bool predicted_ = true;                         // the tracker's matcher.prediction is not kNone
   std::vector<Feature> previous_frame_features_;  // the previous call's features
   // The planes of the features in the previous output's camera frame
   // (vehicle_direct_alignment), carried for scene_planes_age_ frames since they were fitted.

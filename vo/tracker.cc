@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <sstream>
 #include <utility>
 
 #include "vo/image_motion.h"
+#include "vo/options_check.h"
 
 namespace vo {
 namespace {
@@ -13,25 +15,51 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
-std::unique_ptr<Tracker> Tracker::Create(const StereoCamera& camera, const OdometryOptions& options,
-                                         std::string* error) {
+ImageShiftOptions DefaultTrackingImageShiftOptions() {
+  ImageShiftOptions options;
+  options.min_score = 0.1;
+  return options;
+}
+
+bool TrackerOptions::IsValid(std::string* error) const {
+  if (!PartIsValid(matcher, "matcher", error) ||
+      (coarse_to_fine && !PartIsValid(image_shift, "image_shift", error))) {
+    return false;
+  }
+  std::ostringstream msg;
+  if (!(prior_radius_scale >= 0.05 && prior_radius_scale <= 20.0)) {
+    msg << "prior_radius_scale must be in [0.05, 20], got " << prior_radius_scale;
+  } else if (!(shift_radius_scale >= 0.05 && shift_radius_scale <= 20.0)) {
+    msg << "shift_radius_scale must be in [0.05, 20], got " << shift_radius_scale;
+  } else if (confident_min_inliers < 0) {
+    msg << "confident_min_inliers must be >= 0, got " << confident_min_inliers;
+  } else if (!(confident_inlier_fraction >= 0.0 && confident_inlier_fraction <= 1.0)) {
+    msg << "confident_inlier_fraction must be in [0, 1], got " << confident_inlier_fraction;
+  } else if (!(guided_radius_scale >= 0.05 && guided_radius_scale <= 20.0)) {
+    msg << "guided_radius_scale must be in [0.05, 20], got " << guided_radius_scale;
+  }
+  return NoBrokenRule(msg, error);
+}
+
+std::unique_ptr<Tracker> Tracker::Create(const StereoCamera& camera, const TrackerOptions& options,
+                                         const MotionOptions& motion, std::string* error) {
   std::string why;
   std::unique_ptr<FrameMatcher> matcher = CreateFrameMatcher(options.matcher, &why);
   if (!matcher) {
     if (error) *error = why;
     return nullptr;
   }
-  return std::unique_ptr<Tracker>(new Tracker(camera, options, std::move(matcher)));
+  return std::unique_ptr<Tracker>(new Tracker(camera, options, motion, std::move(matcher)));
 }
 
-Tracker::Tracker(const StereoCamera& camera, const OdometryOptions& options,
-                 std::unique_ptr<FrameMatcher> matcher)
-    : camera_(camera), options_(options), matcher_(std::move(matcher)) {}
+Tracker::Tracker(const StereoCamera& camera, const TrackerOptions& options,
+                 const MotionOptions& motion, std::unique_ptr<FrameMatcher> matcher)
+    : camera_(camera), options_(options), motion_(motion), matcher_(std::move(matcher)) {}
 
 MotionAttempt Tracker::Estimate(const std::vector<Feature>& ref_features,
                                 const std::vector<Feature>& curr_features,
                                 std::vector<Match> matches, PredictionSource source) const {
-  return EstimateMotion(camera_, options_.ransac, ref_features, curr_features, std::move(matches),
+  return EstimateMotion(camera_, motion_.ransac, ref_features, curr_features, std::move(matches),
                         source);
 }
 
@@ -39,7 +67,7 @@ MotionAttempt Tracker::MatchAndEstimate(const MatchFrame& ref, const MatchFrame&
                                         const TrackingContext& context, OdometryResult* result,
                                         std::string* matcher_error) {
   const Eigen::Isometry3d* T_ref_curr_prior = context.T_ref_curr_prior;
-  const RobustTrackingOptions& o = options_.tracking;
+  const TrackerOptions& o = options_;
   // One pass: match around `prediction`, then RANSAC. Times go to `match_ms` / `motion_ms`.
   auto pass = [&](const MatchPrediction& prediction, PredictionSource source, double* match_ms,
                   double* motion_ms, MotionAttempt* attempt) {
@@ -85,7 +113,7 @@ MotionAttempt Tracker::MatchAndEstimate(const MatchFrame& ref, const MatchFrame&
   const double smaller = static_cast<double>(std::min(ref.features.size(), frame.features.size()));
   const bool weak = T_ref_curr_prior == nullptr || context.after_loss;
   auto confident = [&](const MotionAttempt& a) {
-    return a.inliers() >= std::max(options_.min_inliers, o.confident_min_inliers) &&
+    return a.inliers() >= std::max(motion_.min_inliers, o.confident_min_inliers) &&
            a.inliers() >= o.confident_inlier_fraction * smaller;
   };
   if (o.coarse_to_fine && (weak || !confident(best))) {
@@ -106,17 +134,18 @@ MotionAttempt Tracker::MatchAndEstimate(const MatchFrame& ref, const MatchFrame&
       }
       if (attempt.inliers() > best.inliers()) {
         best = std::move(attempt);
-      } else if (best.inliers() == 0 && attempt.inliers() == 0 && o.few_point_motion &&
+      } else if (best.inliers() == 0 && attempt.inliers() == 0 && motion_.few_point_motion &&
                  context.few_point_tie && T_ref_curr_prior != nullptr) {
         // Neither pass has a RANSAC consensus (too few features: the few-point solver will
         // decide). The prior's pass must not win by default: a prior that lags a turn centres
         // its gates where the features are not and picks up neighbours that agree with it.
         // The pass whose matches support more of the few-point motion is kept.
         Eigen::Isometry3d unused;
-        const PriorMotionResult few_best = FewPointMotion(
-            camera_, o.few_point, best.correspondences, *T_ref_curr_prior, context.up_ref, &unused);
+        const PriorMotionResult few_best =
+            FewPointMotion(camera_, motion_.few_point, best.correspondences, *T_ref_curr_prior,
+                           context.up_ref, &unused);
         const PriorMotionResult few_shift =
-            FewPointMotion(camera_, o.few_point, attempt.correspondences, *T_ref_curr_prior,
+            FewPointMotion(camera_, motion_.few_point, attempt.correspondences, *T_ref_curr_prior,
                            context.up_ref, &unused);
         if (few_shift.ok && (!few_best.ok || few_shift.num_inliers > few_best.num_inliers)) {
           best = std::move(attempt);

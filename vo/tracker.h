@@ -6,8 +6,9 @@
 // motion just estimated; each pass is followed by RANSAC (motion_estimation.h), the pass with
 // the most inliers is kept and OdometryResult::prediction says which. It receives the two
 // frames, the prior's motion, the constant velocity and the reference's up (TrackingContext),
-// nothing else of the pipeline; its options are the `tracker` group of vo_options.yaml
-// (tracker.matcher, the gates, the confidence thresholds). The passes in detail:
+// nothing else of the pipeline; its options are TrackerOptions (the `tracker` group of
+// vo_options.yaml: tracker.matcher, the gates, the confidence thresholds), and each pass's RANSAC
+// and the few-point tie-break read the motion stage's MotionOptions. The passes in detail:
 //
 // Predicted matching (matcher.prediction = kMotionPrior, the default; kNone = the paper's
 // unpredicted form, every position gate centred on the previous position). Beyond the paper,
@@ -17,7 +18,7 @@
 //      projected (PredictFeaturePositions); every matcher centres its position gate there
 //      (MatchPrediction), then RANSAC.
 //   2. coarse-to-fine pass, when the prior is weak (no motion known yet, after a lost frame)
-//      or contradicted (fewer inliers than tracking.confident_min_inliers or
+//      or contradicted (fewer inliers than confident_min_inliers or
 //      confident_inlier_fraction of the features): the dominant image shift from the reference
 //      to this frame on an image pyramid (image_motion.h, the paper's "multi-scale analysis"),
 //      matching around uv + shift with gates widened by shift_radius_scale, then RANSAC; the
@@ -26,7 +27,7 @@
 //      would otherwise win the tie).
 //   2b. last-motion pass, when still not confident and the reference (the previous frame)
 //      measured its own motion: matching around that motion as measured
-//      (tracking.last_motion_pass). The prior takes a weak motion in only in part, so it lags
+//      (last_motion_pass). The prior takes a weak motion in only in part, so it lags
 //      a turn that starts; the pass with more inliers is kept.
 //   3. guided pass: every reference feature predicted with the motion just estimated, matched
 //      in a tight window (guided_radius_scale), RANSAC; kept when it has at least as many
@@ -41,13 +42,56 @@
 #include <string>
 
 #include "vo/camera.h"
+#include "vo/image_motion.h"
 #include "vo/matcher.h"
 #include "vo/motion_estimation.h"
 #include "vo/motion_model.h"
-#include "vo/odometry_options.h"
 #include "vo/odometry_result.h"
 
 namespace vo {
+
+// Image-shift defaults for the pipeline's coarse-to-fine pass: min_score 0.1 instead of 0.3. A
+// wrong shift only costs one matching pass that loses to the other on inliers, while a turn
+// past nearby walls (perspective, parallax) scores ZNCC ~0.3 at the right shift; the pose
+// bridge of a lost frame asks for more (RecoveryOptions::rotation_min_shift_score).
+ImageShiftOptions DefaultTrackingImageShiftOptions();
+
+// The tracker's options (vo_options.yaml `tracker`): the matcher and its passes (beyond the
+// paper's unpredicted matcher when matcher.prediction is kMotionPrior; see the header comment).
+struct TrackerOptions {
+  MatcherOptions matcher;      // inter-frame matcher (default: SVD · NCC · Gabor)
+  bool coarse_to_fine = true;  // when the prior is weak (no reliable motion yet, after a lost
+                               // frame) or contradicted (the first pass is not confident),
+                               // estimate the dominant image shift coarse-to-fine
+                               // (image_motion.h) and match again around it
+  ImageShiftOptions image_shift = DefaultTrackingImageShiftOptions();  // the coarse-to-fine
+                                                                       // estimate (also the
+                                                                       // recovery's shift)
+  bool last_motion_pass = true;     // still not confident after that: when the reference (the
+                                    // previous frame) measured its own motion and it predicts
+                                    // otherwise than the prior (which blends a weak motion in only
+                                    // in part), match again around that motion; the pass with more
+                                    // inliers wins
+  double prior_radius_scale = 0.5;  // the matcher's position gates around the motion prior's
+                                    // prediction are scaled by this, in [0.05, 20]: the
+                                    // prediction leaves a few pixels (SVD σ 10 → 5 px), and
+                                    // a contradicted prior falls to the coarse-to-fine pass
+  double shift_radius_scale = 2.0;  // the matcher's position gates are widened by this around
+                                    // a shift estimate (a global shift ignores parallax),
+                                    // in [0.05, 20]
+  int confident_min_inliers = 30;   // a first pass with fewer RANSAC inliers than this (or than
+                                    // MotionOptions::min_inliers) ...
+  double confident_inlier_fraction = 0.2;  // ... or than this fraction of the smaller feature
+                                           // count of the two frames, in [0, 1], is not
+                                           // confident: the coarse-to-fine pass is tried too
+                                           // and the one with more inliers is kept
+  bool guided_rematch = true;              // after RANSAC, predict every reference feature with the
+                               // estimated motion and match again in a tight window; the
+                               // second pass is kept when it has at least as many inliers
+  double guided_radius_scale = 0.3;  // gate scale of that pass (σ 10 px → 3 px), [0.05, 20]
+
+  bool IsValid(std::string* error) const;
+};
 
 // What one matching of a frame knows besides the two frames.
 struct TrackingContext {
@@ -64,9 +108,11 @@ struct TrackingContext {
 
 class Tracker {
  public:
-  // nullptr (and *error filled) when options.matcher cannot build a matcher.
-  static std::unique_ptr<Tracker> Create(const StereoCamera& camera, const OdometryOptions& options,
-                                         std::string* error);
+  // nullptr (and *error filled) when options.matcher cannot build a matcher. motion: each
+  // pass's RANSAC (ransac, min_inliers) and the few-point tie-break (few_point_motion,
+  // few_point).
+  static std::unique_ptr<Tracker> Create(const StereoCamera& camera, const TrackerOptions& options,
+                                         const MotionOptions& motion, std::string* error);
   Tracker(const Tracker&) = delete;
   Tracker& operator=(const Tracker&) = delete;
 
@@ -87,11 +133,12 @@ class Tracker {
   MatcherType matcher_type() const { return matcher_->type(); }
 
  private:
-  Tracker(const StereoCamera& camera, const OdometryOptions& options,
+  Tracker(const StereoCamera& camera, const TrackerOptions& options, const MotionOptions& motion,
           std::unique_ptr<FrameMatcher> matcher);
 
   StereoCamera camera_;
-  OdometryOptions options_;
+  TrackerOptions options_;
+  MotionOptions motion_;
   std::unique_ptr<FrameMatcher> matcher_;
 };
 

@@ -70,8 +70,8 @@ int RunMatchEval(const MatchEvalArgs& args) {
       std::fprintf(stderr, "vobench match-eval: %s\n", error.c_str());
       return 2;
     }
-    options.matcher = vo_options.matcher;
-    options.prediction_radius_scale = vo_options.tracking.prior_radius_scale;
+    options.matcher = vo_options.tracker.matcher;
+    options.prediction_radius_scale = vo_options.tracker.prior_radius_scale;
   }
   if (!ParseIntList(args.strides, &options.strides)) {
     std::fprintf(stderr,

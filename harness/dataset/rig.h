@@ -1,7 +1,7 @@
 // The stereo camera's mounting on a ground vehicle, written beside a dataset as rig.yaml by
 // `vobench render` and read by `vobench run --dataset` / `eval` when present: a KITTI, EuRoC or
-// TUM folder otherwise carries no rig, and a tracking.ground_vehicle run needs the wheel
-// axle's distance behind the camera (tracking.few_point.axle_behind_camera_m, vo::ResolvePlatform).
+// TUM folder otherwise carries no rig, and a ground-vehicle run (vehicle.enabled) needs the wheel
+// axle's distance behind the camera (vehicle.axle_behind_camera_m, vo::ResolvePlatform).
 //
 //   # rig.yaml (metres, degrees)
 //   camera_forward_m: 0.15   # optical centre ahead of the wheel axle

@@ -227,11 +227,11 @@ BENCHMARK(BM_OdometryDefault)->Unit(benchmark::kMillisecond)->Iterations(3);
 // mode (0 = at_features, the default; 1 = dense).
 void BM_OdometryAtSize(benchmark::State& state) {
   vo::OdometryOptions options;
-  options.disparity_mode =
+  options.front_end.disparity_mode =
       state.range(1) == 0 ? vo::DisparityMode::kAtFeatures : vo::DisparityMode::kDense;
   const vo::StereoCamera cam = RigCamera(static_cast<int>(state.range(0)));
   state.SetLabel(std::to_string(cam.width) + "x" + std::to_string(cam.height) + " " +
-                 vo::ToString(options.disparity_mode));
+                 vo::ToString(options.front_end.disparity_mode));
   RunPipeline(state, options, static_cast<int>(state.range(0)));
 }
 BENCHMARK(BM_OdometryAtSize)
@@ -251,7 +251,7 @@ BENCHMARK(BM_OdometryNoBundleAdjustment)->Unit(benchmark::kMillisecond)->Iterati
 // inlier test, which checks every point in both current images, catches most of what it removes.
 void BM_OdometryNoLeftRightCheck(benchmark::State& state) {
   vo::OdometryOptions options;
-  options.disparity.left_right_max_diff_px = -1.0;
+  options.front_end.disparity.left_right_max_diff_px = -1.0;
   RunPipeline(state, options);
 }
 BENCHMARK(BM_OdometryNoLeftRightCheck)->Unit(benchmark::kMillisecond)->Iterations(3);
@@ -266,8 +266,8 @@ BENCHMARK(BM_OdometryWindow10)->Unit(benchmark::kMillisecond)->Iterations(3);
 // Arg: the matcher (vo::MatcherType as int).
 void BM_OdometryMatcher(benchmark::State& state) {
   vo::OdometryOptions options;
-  options.matcher.type = static_cast<vo::MatcherType>(state.range(0));
-  state.SetLabel(vo::ToString(options.matcher.type));
+  options.tracker.matcher.type = static_cast<vo::MatcherType>(state.range(0));
+  state.SetLabel(vo::ToString(options.tracker.matcher.type));
   RunPipeline(state, options);
 }
 BENCHMARK(BM_OdometryMatcher)

@@ -71,7 +71,7 @@ TEST(OverridesTest, VoOverridesApplyOnTopOfTheGivenOptions) {
                                         &options, &error))
       << error;
   EXPECT_EQ(options.back_end.window_frames, 7);
-  EXPECT_EQ(options.matcher.type, vo::MatcherType::kNccMutual);
+  EXPECT_EQ(options.tracker.matcher.type, vo::MatcherType::kNccMutual);
   vo::OdometryOptions bad = options;
   EXPECT_FALSE(harness::ApplyVoOverrides(YAML::Load("{tracker.matcher.type: nonsense}"),
                                          "tune.yaml", &bad, &error));

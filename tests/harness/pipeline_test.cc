@@ -188,32 +188,32 @@ TEST(PipelineTest, PlatformAutoIsAGroundVehicleOnAKnownRig) {
   ASSERT_EQ(o.platform, vo::Platform::kAuto);
   const vo::OdometryOptions known = vo::ResolvePlatform(o, 0.15);
   EXPECT_EQ(known.platform, vo::Platform::kGroundVehicle);
-  EXPECT_TRUE(known.tracking.few_point_motion && known.tracking.ground_vehicle &&
+  EXPECT_TRUE(known.motion.few_point_motion && known.motion.ground_vehicle &&
               known.back_end.vehicle_planar.enabled && known.back_end.flat_floor.enabled);
-  EXPECT_EQ(known.tracking.few_point.axle_behind_camera_m, 0.15);
+  EXPECT_EQ(known.motion.few_point.axle_behind_camera_m, 0.15);
   const vo::OdometryOptions unknown = vo::ResolvePlatform(o, -1.0);
   EXPECT_EQ(unknown.platform, vo::Platform::kFree);
-  EXPECT_FALSE(unknown.tracking.few_point_motion || unknown.tracking.ground_vehicle ||
+  EXPECT_FALSE(unknown.motion.few_point_motion || unknown.motion.ground_vehicle ||
                unknown.back_end.vehicle_planar.enabled || unknown.back_end.flat_floor.enabled);
-  EXPECT_EQ(unknown.tracking.few_point.axle_behind_camera_m, 0.0);
+  EXPECT_EQ(unknown.motion.few_point.axle_behind_camera_m, 0.0);
 
   o.platform = vo::Platform::kFree;
   const vo::OdometryOptions free_on_rig = vo::ResolvePlatform(o, 0.15);
   EXPECT_EQ(free_on_rig.platform, vo::Platform::kFree);
-  EXPECT_FALSE(free_on_rig.tracking.ground_vehicle || free_on_rig.tracking.few_point_motion);
-  EXPECT_EQ(free_on_rig.tracking.few_point.axle_behind_camera_m, 0.0);
-  o.tracking.ground_vehicle = true;  // by hand, on the free platform
-  EXPECT_EQ(vo::ResolvePlatform(o, 0.15).tracking.few_point.axle_behind_camera_m, 0.15);
+  EXPECT_FALSE(free_on_rig.motion.ground_vehicle || free_on_rig.motion.few_point_motion);
+  EXPECT_EQ(free_on_rig.motion.few_point.axle_behind_camera_m, 0.0);
+  o.motion.ground_vehicle = true;  // by hand, on the free platform
+  EXPECT_EQ(vo::ResolvePlatform(o, 0.15).motion.few_point.axle_behind_camera_m, 0.15);
   EXPECT_FALSE(vo::ResolvePlatform(o, 0.15).back_end.flat_floor.enabled);
-  EXPECT_EQ(vo::ResolvePlatform(o, -1.0).tracking.few_point.axle_behind_camera_m, 0.0);
-  o.tracking.few_point.axle_behind_camera_m = 0.05;  // given: kept
-  EXPECT_EQ(vo::ResolvePlatform(o, 0.15).tracking.few_point.axle_behind_camera_m, 0.05);
+  EXPECT_EQ(vo::ResolvePlatform(o, -1.0).motion.few_point.axle_behind_camera_m, 0.0);
+  o.motion.few_point.axle_behind_camera_m = 0.05;  // given: kept
+  EXPECT_EQ(vo::ResolvePlatform(o, 0.15).motion.few_point.axle_behind_camera_m, 0.05);
 
   vo::OdometryOptions g;
   g.platform = vo::Platform::kGroundVehicle;  // without a rig: the options on, the axle as given
   const vo::OdometryOptions forced = vo::ResolvePlatform(g, -1.0);
-  EXPECT_TRUE(forced.back_end.flat_floor.enabled && forced.tracking.few_point_motion);
-  EXPECT_EQ(forced.tracking.few_point.axle_behind_camera_m, 0.0);
+  EXPECT_TRUE(forced.back_end.flat_floor.enabled && forced.motion.few_point_motion);
+  EXPECT_EQ(forced.motion.few_point.axle_behind_camera_m, 0.0);
 }
 
 // A ground vehicle whose rig's camera pitch is known takes its up from the mounting when the
@@ -223,25 +223,25 @@ TEST(PipelineTest, PlatformAutoIsAGroundVehicleOnAKnownRig) {
 TEST(PipelineTest, AGroundVehicleTakesItsUpFromTheRigsPitch) {
   vo::OdometryOptions o;
   const Eigen::Vector3d level(0.0, -1.0, 0.0);
-  ASSERT_FALSE(o.orientation_up_from_mounting);
-  ASSERT_EQ(o.orientation.expected_up_cam0, level);
+  ASSERT_FALSE(o.initial_orientation.up_from_mounting);
+  ASSERT_EQ(o.initial_orientation.planes.expected_up_cam0, level);
   const vo::OdometryOptions no_pitch = vo::ResolvePlatform(o, 0.15);
-  EXPECT_FALSE(no_pitch.orientation_up_from_mounting);
-  EXPECT_EQ(no_pitch.orientation.expected_up_cam0, level);
+  EXPECT_FALSE(no_pitch.initial_orientation.up_from_mounting);
+  EXPECT_EQ(no_pitch.initial_orientation.planes.expected_up_cam0, level);
   const vo::OdometryOptions flat = vo::ResolvePlatform(o, 0.15, 0.0);
-  EXPECT_TRUE(flat.orientation_up_from_mounting);
-  EXPECT_EQ(flat.orientation.expected_up_cam0, level);
+  EXPECT_TRUE(flat.initial_orientation.up_from_mounting);
+  EXPECT_EQ(flat.initial_orientation.planes.expected_up_cam0, level);
   const vo::OdometryOptions pitched = vo::ResolvePlatform(o, 0.15, 30.0);
-  EXPECT_TRUE(pitched.orientation_up_from_mounting);
-  EXPECT_NEAR(
-      (pitched.orientation.expected_up_cam0 - Eigen::Vector3d(0.0, -std::sqrt(3.0) / 2, -0.5))
-          .norm(),
-      0.0, 1e-12);
-  EXPECT_FALSE(vo::ResolvePlatform(o, -1.0, 30.0).orientation_up_from_mounting);  // free
+  EXPECT_TRUE(pitched.initial_orientation.up_from_mounting);
+  EXPECT_NEAR((pitched.initial_orientation.planes.expected_up_cam0 -
+               Eigen::Vector3d(0.0, -std::sqrt(3.0) / 2, -0.5))
+                  .norm(),
+              0.0, 1e-12);
+  EXPECT_FALSE(vo::ResolvePlatform(o, -1.0, 30.0).initial_orientation.up_from_mounting);  // free
   vo::OdometryOptions given = o;
-  given.orientation.expected_up_cam0 = Eigen::Vector3d(0.0, -1.0, -0.1);
-  EXPECT_EQ(vo::ResolvePlatform(given, 0.15, 30.0).orientation.expected_up_cam0,
-            given.orientation.expected_up_cam0);
+  given.initial_orientation.planes.expected_up_cam0 = Eigen::Vector3d(0.0, -1.0, -0.1);
+  EXPECT_EQ(vo::ResolvePlatform(given, 0.15, 30.0).initial_orientation.planes.expected_up_cam0,
+            given.initial_orientation.planes.expected_up_cam0);
 }
 
 }  // namespace

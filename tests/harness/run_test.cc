@@ -173,8 +173,8 @@ TEST(VoConfigTest, RoundTripAndErrors) {
       "back_end.bundle_adjustment: false\nback_end.window_frames: 7\n",
       "cfg.yaml", &o, &error))
       << error;
-  EXPECT_EQ(o.matcher.type, vo::MatcherType::kNccMutual);
-  EXPECT_DOUBLE_EQ(o.matcher.svd.sigma_px, 14);
+  EXPECT_EQ(o.tracker.matcher.type, vo::MatcherType::kNccMutual);
+  EXPECT_DOUBLE_EQ(o.tracker.matcher.svd.sigma_px, 14);
   EXPECT_FALSE(o.back_end.bundle_adjustment);
   EXPECT_EQ(o.back_end.window_frames, 7);
   // The effective file reads back to the same options, every key away from its default (a key
@@ -182,11 +182,12 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   o.back_end.ba.max_num_iterations = 7;
   o.back_end.ba.loss_scale_px = 2.5;
   o.back_end.max_points = 55;
-  o.disparity.algorithm = vo::DisparityAlgorithm::kSemiGlobal;
-  o.disparity_mode = vo::DisparityMode::kDense;  // at_features needs the one-volume matcher
-  o.disparity_range_margin_px = 4.0;
-  o.disparity.block_size = 7;
-  o.disparity_min_depth_m = 0.6;
+  o.front_end.disparity.algorithm = vo::DisparityAlgorithm::kSemiGlobal;
+  o.front_end.disparity_mode =
+      vo::DisparityMode::kDense;  // at_features needs the one-volume matcher
+  o.front_end.disparity_range_margin_px = 4.0;
+  o.front_end.disparity.block_size = 7;
+  o.front_end.disparity_min_depth_m = 0.6;
   const std::string effective = harness::VoConfigToYaml(o);
   for (const char* top :
        {"\n  ba:", "\n  disparity:", "\n  matcher:", "\n  detector:", "\n  ransac:", "\nfront_end:",
@@ -202,8 +203,8 @@ TEST(VoConfigTest, RoundTripAndErrors) {
   EXPECT_EQ(again.back_end.ba.max_num_iterations, 7);
   EXPECT_EQ(again.back_end.ba.loss_scale_px, 2.5);
   EXPECT_EQ(again.back_end.max_points, 55);
-  EXPECT_EQ(again.disparity.algorithm, vo::DisparityAlgorithm::kSemiGlobal);
-  EXPECT_EQ(again.disparity_min_depth_m, 0.6);
+  EXPECT_EQ(again.front_end.disparity.algorithm, vo::DisparityAlgorithm::kSemiGlobal);
+  EXPECT_EQ(again.front_end.disparity_min_depth_m, 0.6);
 
   vo::OdometryOptions bad;
   EXPECT_FALSE(
@@ -255,13 +256,13 @@ TEST(RunTest, GroundVehicleRunTakesTheSimulatedRigsAxle) {
   options.plots = false;
   options.max_frames = 3;
   vo::OdometryOptions vo_options;
-  vo_options.tracking.ground_vehicle = true;
+  vo_options.motion.ground_vehicle = true;
   harness::RunSummary s;
   ASSERT_TRUE(harness::RunScenario(scenario, vo_options, options, &s, &error)) << error;
   vo::OdometryOptions written;
   ASSERT_TRUE(harness::LoadVoConfig(options.out_dir + "/vo_options.yaml", &written, &error))
       << error;
-  EXPECT_EQ(written.tracking.few_point.axle_behind_camera_m, 0.2);
+  EXPECT_EQ(written.motion.few_point.axle_behind_camera_m, 0.2);
 }
 
 }  // namespace

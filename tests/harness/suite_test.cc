@@ -75,7 +75,7 @@ TEST(SuiteFileTest, ExpandsTheMatrixInAFixedOrderWithStableIds) {
   EXPECT_EQ(suite.scenarios[0].name, "l_hallway");  // default: the scenario's own name
   EXPECT_EQ(suite.scenarios[1].scenario.noise.pixel_sigma, 3.0);
   EXPECT_EQ(suite.scenarios[1].max_frames, 6);
-  EXPECT_EQ(suite.configs[1].options.matcher.type, vo::MatcherType::kNccMutual);
+  EXPECT_EQ(suite.configs[1].options.tracker.matcher.type, vo::MatcherType::kNccMutual);
 
   const std::vector<harness::SuiteRun> runs = harness::ExpandSuite(suite);
   ASSERT_EQ(runs.size(), 2u * 2u * 2u * 2u);
@@ -142,7 +142,7 @@ TEST(SuiteFileTest, ScenarioAndConfigFilesAreRelativeToTheSuite) {
   ASSERT_TRUE(harness::LoadSuite(dir / "suite.yaml", &suite, &error)) << error;
   EXPECT_EQ(suite.scenarios[0].name, "short");
   EXPECT_EQ(suite.configs[0].options.back_end.window_frames, 7);
-  EXPECT_EQ(suite.configs[0].options.matcher.type, vo::MatcherType::kLucasKanade);
+  EXPECT_EQ(suite.configs[0].options.tracker.matcher.type, vo::MatcherType::kLucasKanade);
 }
 
 TEST(SuiteFileTest, BadSuiteFilesNameTheFileLineAndKey) {

@@ -299,19 +299,22 @@ TEST(TuneSpecTest, ReadsAValidFile) {
   EXPECT_EQ(spec.parameters[1].step, 2);
   EXPECT_EQ(spec.parameters[2].type, ParameterType::kScale);
   const vo::OdometryOptions defaults;
-  EXPECT_EQ(spec.start_values, (std::vector<double>{defaults.matcher.svd.sigma_px, 11.0, 1.0,
-                                                    defaults.ransac.inlier_threshold_px, 5.0}));
+  EXPECT_EQ(spec.start_values,
+            (std::vector<double>{defaults.tracker.matcher.svd.sigma_px, 11.0, 1.0,
+                                 defaults.motion.ransac.inlier_threshold_px, 5.0}));
   EXPECT_EQ(spec.optimizer.algorithm, "random");
   EXPECT_EQ(spec.optimizer.max_evals, 4);
   // Applying values: scale multiplies the default wavelengths; the start gives the defaults.
   vo::OdometryOptions o;
   ASSERT_TRUE(harness::ApplyParameters(spec, {12.5, 9, 1.5, 3.0, 7}, &o, &error)) << error;
-  EXPECT_EQ(o.matcher.svd.sigma_px, 12.5);
-  EXPECT_EQ(o.matcher.ncc.window_px, 9);
-  ASSERT_EQ(o.matcher.gabor.wavelengths_px.size(), defaults.matcher.gabor.wavelengths_px.size());
-  for (size_t i = 0; i < o.matcher.gabor.wavelengths_px.size(); ++i)
-    EXPECT_EQ(o.matcher.gabor.wavelengths_px[i], 1.5 * defaults.matcher.gabor.wavelengths_px[i]);
-  EXPECT_EQ(o.ransac.inlier_threshold_px, 3.0);
+  EXPECT_EQ(o.tracker.matcher.svd.sigma_px, 12.5);
+  EXPECT_EQ(o.tracker.matcher.ncc.window_px, 9);
+  ASSERT_EQ(o.tracker.matcher.gabor.wavelengths_px.size(),
+            defaults.tracker.matcher.gabor.wavelengths_px.size());
+  for (size_t i = 0; i < o.tracker.matcher.gabor.wavelengths_px.size(); ++i)
+    EXPECT_EQ(o.tracker.matcher.gabor.wavelengths_px[i],
+              1.5 * defaults.tracker.matcher.gabor.wavelengths_px[i]);
+  EXPECT_EQ(o.motion.ransac.inlier_threshold_px, 3.0);
   EXPECT_EQ(o.back_end.window_frames, 7);
   ASSERT_TRUE(harness::ApplyParameters(spec, spec.start_values, &o, &error)) << error;
   EXPECT_EQ(harness::VoConfigToYaml(o), harness::VoConfigToYaml(defaults));
@@ -513,9 +516,9 @@ TEST(TuneCommandTest, TunesDeterministicallyAndWritesALoadableBestConfig) {
   ASSERT_TRUE(harness::ApplyParameters(spec, values, &expected, &error)) << error;
   ASSERT_TRUE(harness::LoadVoConfig(out1 + "/best_vo.yaml", &loaded, &error)) << error;
   EXPECT_EQ(harness::VoConfigToYaml(loaded), harness::VoConfigToYaml(expected));
-  EXPECT_EQ(loaded.matcher.svd.sigma_px, values[0]);
-  EXPECT_EQ(loaded.matcher.ncc.window_px, static_cast<int>(values[1]));
-  EXPECT_EQ(loaded.ransac.inlier_threshold_px, values[3]);
+  EXPECT_EQ(loaded.tracker.matcher.svd.sigma_px, values[0]);
+  EXPECT_EQ(loaded.tracker.matcher.ncc.window_px, static_cast<int>(values[1]));
+  EXPECT_EQ(loaded.motion.ransac.inlier_threshold_px, values[3]);
   std::istringstream row(lines[1 + best]);
   std::string cell;
   std::vector<std::string> cells;

@@ -46,8 +46,12 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
   std::map<std::string, int> counts;
   CountLeaves(yaml, "", &counts);
   const Recorded recorded[] = {
-      {"OdometryOptions", sizeof(vo::OdometryOptions), 1648},
-      {"RobustTrackingOptions", sizeof(vo::RobustTrackingOptions), 456},
+      {"OdometryOptions", sizeof(vo::OdometryOptions), 1656},
+      {"FrontEndOptions", sizeof(vo::FrontEndOptions), 304},
+      {"InitialOrientationOptions", sizeof(vo::InitialOrientationOptions), 192},
+      {"TrackerOptions", sizeof(vo::TrackerOptions), 544},
+      {"RecoveryOptions", sizeof(vo::RecoveryOptions), 208},
+      {"MotionOptions", sizeof(vo::MotionOptions), 224},
       {"DetectorOptions", sizeof(vo::DetectorOptions), 128},
       {"HarrisOptions", sizeof(vo::HarrisOptions), 64},
       {"SiftOptions", sizeof(vo::SiftOptions), 40},
@@ -78,7 +82,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
         << "vo::" << r.type << " changed size: register its new field in harness/vo_config.cc "
         << "(Registry), count it below and update the recorded size here";
   // The keys per group of vo_options.yaml, by stage (docs/DESIGN.md, "VO options by stage"):
-  // the groups' fields of OdometryOptions, RobustTrackingOptions (spread over the stages),
+  // the groups' fields of the stages' structs (FrontEndOptions, ..., BackEndOptions),
   // BackEndOptions (`back_end`, field for field) and the nested Options structs
   // (PriorMotionOptions' vehicle fields under `vehicle`).
   const std::map<std::string, int> expected = {
@@ -212,9 +216,9 @@ TEST(VoConfigTest, OldGroupsAreRefusedAtTheirLine) {
       "motion.few_point.enabled: true\n",
       "v.yaml", &o, &error))
       << error;
-  EXPECT_EQ(o.matcher.type, vo::MatcherType::kNccMutual);
+  EXPECT_EQ(o.tracker.matcher.type, vo::MatcherType::kNccMutual);
   EXPECT_EQ(o.back_end.window_frames, 3);
-  EXPECT_TRUE(o.tracking.few_point_motion);
+  EXPECT_TRUE(o.motion.few_point_motion);
   EXPECT_EQ(harness::RenamedVoKey("front_end.detector.type"), "");  // a new key is no old one
   EXPECT_EQ(harness::RenamedVoKey("disparity_mode"), "front_end.disparity_mode");
   EXPECT_EQ(harness::RenamedVoKey("disparity.block_size"), "front_end.disparity.block_size");

@@ -133,33 +133,21 @@ TEST(BackEndTest, ExactFramesStayAtTheTruthAndThePerturbedNewestIsPulledBack) {
 }
 
 TEST(BackEndTest, BadOptionsAreRefusedByName) {
-  BackEndOptions o;
-  std::string error;
-  EXPECT_TRUE(o.IsValid(&error)) << error;
-  o.window_frames = 11;
-  EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_EQ(error, "window_frames must be in [3, 10], got 11");
-  o = BackEndOptions();
-  o.window_frames = 3;
-  o.ba.num_fixed_poses = 3;
-  EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_EQ(error, "ba.num_fixed_poses (3) must be < window_frames (3)");
-  o = BackEndOptions();
-  o.prior_weight = 1.5;
-  EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_EQ(error, "prior_weight must be in [0, 1], got 1.5");
-  o = BackEndOptions();
-  o.vehicle_planar.slip_sigma_m = 0.0;
-  EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_NE(error.find("vehicle_planar"), std::string::npos) << error;
-  o = BackEndOptions();
-  o.flat_floor.height_sigma_m = NAN;
-  EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_NE(error.find("flat_floor"), std::string::npos) << error;
-  o = BackEndOptions();
-  o.max_points = -1;
-  EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_EQ(error, "max_points must be >= 0 (0 = no limit), got -1");
+  using O = BackEndOptions;
+  test::ExpectOptionsRefuseBadFields<O>({
+      {"ba: ", [](O* o) { o->ba.num_fixed_poses = 0; }},
+      {"window_frames must be in [3, 10], got 11", [](O* o) { o->window_frames = 11; }},
+      {"ba.num_fixed_poses (3) must be < window_frames (3)",
+       [](O* o) {
+         o->window_frames = 3;
+         o->ba.num_fixed_poses = 3;
+       }},
+      {"prior_weight must be in [0, 1], got 1.5", [](O* o) { o->prior_weight = 1.5; }},
+      {"max_correction_m", [](O* o) { o->max_correction_m = 0.0; }},
+      {"max_points must be >= 0 (0 = no limit), got -1", [](O* o) { o->max_points = -1; }},
+      {"vehicle_planar", [](O* o) { o->vehicle_planar.slip_sigma_m = 0.0; }},
+      {"flat_floor", [](O* o) { o->flat_floor.height_sigma_m = NAN; }},
+  });
 }
 
 }  // namespace

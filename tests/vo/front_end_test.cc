@@ -24,7 +24,7 @@ Feature WithDisparity(double u, double v, double d) {
 }
 
 TEST(FrontEndTest, SceneRangeCoversTheLargestDisparityWithItsMargins) {
-  OdometryOptions o;  // margin 25 % + 8 px
+  FrontEndOptions o;  // margin 25 % + 8 px
   o.disparity.num_disparities = 64;
   std::vector<Feature> f = {WithDisparity(10, 10, 4.0), WithDisparity(20, 10, 20.0)};
   EXPECT_EQ(SceneNumDisparities(f, o), 48);  // 20 · 1.25 + 8 = 33 → 48
@@ -78,7 +78,7 @@ TEST(FrontEndTest, FeaturesReadTheDisparityOfAShiftedPairInBothModes) {
   const cv::Mat left = texture(cv::Rect(0, 0, cam.width, cam.height)).clone();
   const cv::Mat right = texture(cv::Rect(d, 0, cam.width, cam.height)).clone();
   for (const DisparityMode mode : {DisparityMode::kDense, DisparityMode::kAtFeatures}) {
-    OdometryOptions o;
+    FrontEndOptions o;
     std::string error;
     const std::unique_ptr<FrontEnd> front = FrontEnd::Create(cam, o, &error);
     ASSERT_TRUE(front) << error;
@@ -108,7 +108,7 @@ TEST(FrontEndTest, FeaturesReadTheDisparityOfAShiftedPairInBothModes) {
 TEST(FrontEndTest, AFailedDisparitySaysSo) {
   const StereoCamera cam = test::TestCamera();
   std::string error;
-  const std::unique_ptr<FrontEnd> front = FrontEnd::Create(cam, OdometryOptions(), &error);
+  const std::unique_ptr<FrontEnd> front = FrontEnd::Create(cam, FrontEndOptions(), &error);
   ASSERT_TRUE(front) << error;
   OdometryResult result;
   const cv::Mat left(cam.height, cam.width, CV_8UC1, cv::Scalar(0));
@@ -120,11 +120,35 @@ TEST(FrontEndTest, AFailedDisparitySaysSo) {
 }
 
 TEST(FrontEndTest, ABadDetectorIsRefused) {
-  OdometryOptions o;
+  FrontEndOptions o;
   o.detector.max_features = -1;
   std::string error;
   EXPECT_FALSE(FrontEnd::Create(test::TestCamera(), o, &error));
   EXPECT_FALSE(error.empty());
+}
+
+TEST(FrontEndTest, OptionsRefuseABadFieldByName) {
+  using test::BadField;
+  test::ExpectOptionsRefuseBadFields<FrontEndOptions>({
+      {"detector: ", [](FrontEndOptions* o) { o->detector.max_features = -1; }},
+      {"disparity: ",
+       [](FrontEndOptions* o) {
+         o->derive_num_disparities = false;
+         o->disparity.num_disparities = 20;
+       }},
+      {"depth: ", [](FrontEndOptions* o) { o->depth.min_depth_m = -1.0; }},
+      {"disparity_min_depth_m", [](FrontEndOptions* o) { o->disparity_min_depth_m = 0.0; }},
+      {"max_num_disparities", [](FrontEndOptions* o) { o->max_num_disparities = 40; }},
+      {"disparity_mode: unknown",
+       [](FrontEndOptions* o) { o->disparity_mode = static_cast<DisparityMode>(7); }},
+      {"disparity_mode at_features needs disparity.algorithm",
+       [](FrontEndOptions* o) { o->disparity.algorithm = DisparityAlgorithm::kBlockMatching; }},
+      {"disparity_range_margin", [](FrontEndOptions* o) { o->disparity_range_margin = -0.1; }},
+      {"disparity_range_margin_px", [](FrontEndOptions* o) { o->disparity_range_margin_px = NAN; }},
+      {"adaptive_min_features", [](FrontEndOptions* o) { o->adaptive_min_features = -1; }},
+      {"adaptive_quality_level", [](FrontEndOptions* o) { o->adaptive_quality_level = 1.0; }},
+      {"min_features", [](FrontEndOptions* o) { o->min_features = 2; }},
+  });
 }
 
 }  // namespace

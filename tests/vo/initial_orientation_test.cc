@@ -55,9 +55,9 @@ std::vector<Eigen::Vector3d> Hallway(const Eigen::Matrix3d& R_hall_cam0, bool fl
   return points;
 }
 
-OdometryOptions NoRefinement() {
-  OdometryOptions o;
-  o.orientation_floor_refinement = false;
+InitialOrientationOptions NoRefinement() {
+  InitialOrientationOptions o;
+  o.refine_floor = false;
   return o;
 }
 
@@ -79,16 +79,16 @@ TEST(InitialOrientationTest, FloorAndWallsGiveTheHallwayFrameExactly) {
 TEST(InitialOrientationTest, WithoutAFloorTheUpComesFromTheMountingOnlyWhenAsked) {
   const Eigen::Matrix3d R_true = CameraOrientation(0.0, 12.0, 0.0);
   const std::vector<Eigen::Vector3d> walls = Hallway(R_true, false, true);
-  OdometryOptions o = NoRefinement();
+  InitialOrientationOptions o = NoRefinement();
   const InitialOrientation off =
       EstimateInitialOrientation(test::TestCamera(), o, walls, cv::Mat(), cv::Mat(), cv::Mat());
   EXPECT_FALSE(off.ok);
   EXPECT_EQ(off.planes.status, PlaneOrientationResult::Status::kNoFloor);
   EXPECT_TRUE(off.R_hall_cam0 == Eigen::Matrix3d::Identity());
 
-  o.orientation_up_from_mounting = true;
+  o.up_from_mounting = true;
   const double p = 12.0 * kDeg;
-  o.orientation.expected_up_cam0 = Eigen::Vector3d(0.0, -std::cos(p), -std::sin(p));
+  o.planes.expected_up_cam0 = Eigen::Vector3d(0.0, -std::cos(p), -std::sin(p));
   const InitialOrientation on =
       EstimateInitialOrientation(test::TestCamera(), o, walls, cv::Mat(), cv::Mat(), cv::Mat());
   ASSERT_TRUE(on.ok);
@@ -100,14 +100,14 @@ TEST(InitialOrientationTest, WithoutAFloorTheUpComesFromTheMountingOnlyWhenAsked
 TEST(InitialOrientationTest, AFloorWithoutWallsCountsOnlyWhenNoWallIsRequired) {
   const Eigen::Matrix3d R_true = CameraOrientation(0.0, 8.0, 2.0);
   const std::vector<Eigen::Vector3d> floor = Hallway(R_true, true, false);
-  OdometryOptions o = NoRefinement();
+  InitialOrientationOptions o = NoRefinement();
   const InitialOrientation r =
       EstimateInitialOrientation(test::TestCamera(), o, floor, cv::Mat(), cv::Mat(), cv::Mat());
   ASSERT_TRUE(r.ok);
   EXPECT_EQ(r.planes.status, PlaneOrientationResult::Status::kNoWall);
   // The up is exact: the third row of R_hall_cam0.
   EXPECT_LT((r.R_hall_cam0.row(2) - R_true.row(2)).norm(), kExactTolRad);
-  o.orientation_requires_wall = true;
+  o.requires_wall = true;
   EXPECT_FALSE(
       EstimateInitialOrientation(test::TestCamera(), o, floor, cv::Mat(), cv::Mat(), cv::Mat()).ok);
 }
@@ -122,6 +122,23 @@ TEST(InitialOrientationTest, SampleDisparityPointsReadsEveryStepWithinTheDepthRa
   for (const Eigen::Vector3d& p : points) EXPECT_NEAR(p.z(), z, 1e-12);
   EXPECT_TRUE(points[0].isApprox(cam.Backproject(4, 0, 10.0f)));
   EXPECT_TRUE(SampleDisparityPoints(cam, d, 4, z + 0.01, 100.0).empty());
+}
+
+TEST(InitialOrientationTest, OptionsRefuseABadFieldByName) {
+  using O = InitialOrientationOptions;
+  test::ExpectOptionsRefuseBadFields<O>({
+      {"planes: ", [](O* o) { o->planes.max_planes = 0; }},
+      {"floor_refinement: ", [](O* o) { o->floor_refinement.max_iterations = 0; }},
+      {"sample_step_px", [](O* o) { o->sample_step_px = 0; }},
+  });
+  // The plane extraction and the refinement are not checked when they are off.
+  O off;
+  off.refine_floor = false;
+  off.floor_refinement.max_iterations = 0;
+  EXPECT_TRUE(off.IsValid(nullptr));
+  off.enabled = false;
+  off.planes.max_planes = 0;
+  EXPECT_TRUE(off.IsValid(nullptr));
 }
 
 }  // namespace

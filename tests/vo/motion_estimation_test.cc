@@ -6,10 +6,12 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "tests/test_util.h"
 #include "tests/vo/vo_test_util.h"
+#include "vo/front_end.h"
 #include "vo/motion_model.h"
 
 namespace vo {
@@ -71,7 +73,7 @@ TEST(MotionEstimationTest, RansacOnExactMatchesIsTheMotion) {
 }
 
 TEST(MotionEstimationTest, PriorUpdateWeightIsTheSupportToItsExponent) {
-  RobustTrackingOptions o;  // reliable_min_inliers 30, exponent 2
+  MotionOptions o;  // reliable_min_inliers 30, exponent 2
   EXPECT_DOUBLE_EQ(PriorUpdateWeight(15, o), 0.25);
   EXPECT_DOUBLE_EQ(PriorUpdateWeight(30, o), 1.0);
   EXPECT_DOUBLE_EQ(PriorUpdateWeight(90, o), 1.0);
@@ -100,22 +102,23 @@ TEST(MotionEstimationTest, TooFewFeaturesTakeTheFewPointMotionOnlyAfterAMeasured
   const StereoCamera cam = test::TestCamera();
   const Eigen::Isometry3d truth = Motion(1.5, 0.0, Eigen::Vector3d(0.0, 0.0, 0.05));
   const Pair p = ExactPair(truth, 6);  // fewer than min_features (15) and min_inliers (12)
-  OdometryOptions o;
-  o.tracking.few_point_motion = true;
+  MotionOptions o;
+  o.few_point_motion = true;
   MotionAttempt a =
       EstimateMotion(cam, o.ransac, p.ref, p.curr, p.matches, PredictionSource::kMotionPrior);
   const Eigen::Vector2d no_shift = Eigen::Vector2d::Zero();
+  const bool few_features = 6 < FrontEndOptions().min_features;
   // After a loss (the prior is a bridge, not a measurement): no few-point motion.
   MotionAttempt after_loss = a;
-  const FrameMotion lost =
-      ResolveFrameMotion(cam, o, 6, p.ref, nullptr, &truth, false, false, no_shift, &after_loss);
+  const FrameMotion lost = ResolveFrameMotion(cam, o, few_features, p.ref, nullptr, &truth, false,
+                                              false, no_shift, &after_loss);
   EXPECT_TRUE(lost.few_features);
   EXPECT_FALSE(lost.ok());
   EXPECT_THAT(MotionFailureMessage(lost, after_loss, o.min_inliers),
               ::testing::StartsWith("motion failed: too few features for RANSAC"));
   // Tracking normally, with the true motion as the prior: the few-point motion is exact.
   const FrameMotion m =
-      ResolveFrameMotion(cam, o, 6, p.ref, nullptr, &truth, true, false, no_shift, &a);
+      ResolveFrameMotion(cam, o, few_features, p.ref, nullptr, &truth, true, false, no_shift, &a);
   ASSERT_TRUE(m.few_point);
   EXPECT_TRUE(m.ok());
   EXPECT_THAT(m.message, ::testing::HasSubstr("few-point motion with the prior"));
@@ -130,17 +133,17 @@ TEST(MotionEstimationTest, AWeakMotionThatTiltsTheGroundVehicleIsRefused) {
   // 20 inliers: above min_inliers (12), below reliable_min_inliers (30); 4° of pitch.
   const Eigen::Isometry3d tilting = Motion(0.0, 4.0, Eigen::Vector3d(0.0, 0.0, 0.05));
   const Pair p = ExactPair(tilting, 20);
-  OdometryOptions o;
+  MotionOptions o;
   MotionAttempt a =
       EstimateMotion(cam, o.ransac, p.ref, p.curr, p.matches, PredictionSource::kNone);
   ASSERT_EQ(a.inliers(), 20);
   const Eigen::Vector3d up(0.0, -1.0, 0.0);  // a level camera: the world's up is its −y
   MotionAttempt six_dof = a;
-  EXPECT_TRUE(ResolveFrameMotion(cam, o, 20, p.ref, nullptr, nullptr, true, false,
+  EXPECT_TRUE(ResolveFrameMotion(cam, o, false, p.ref, nullptr, nullptr, true, false,
                                  Eigen::Vector2d::Zero(), &six_dof)
                   .ok());
-  const FrameMotion vehicle =
-      ResolveFrameMotion(cam, o, 20, p.ref, &up, nullptr, true, false, Eigen::Vector2d::Zero(), &a);
+  const FrameMotion vehicle = ResolveFrameMotion(cam, o, false, p.ref, &up, nullptr, true, false,
+                                                 Eigen::Vector2d::Zero(), &a);
   EXPECT_TRUE(vehicle.not_vehicle_like);
   EXPECT_FALSE(vehicle.ok());
   EXPECT_THAT(MotionFailureMessage(vehicle, a, o.min_inliers),
@@ -149,9 +152,32 @@ TEST(MotionEstimationTest, AWeakMotionThatTiltsTheGroundVehicleIsRefused) {
   const Pair strong = ExactPair(tilting, 40);
   MotionAttempt b = EstimateMotion(cam, o.ransac, strong.ref, strong.curr, strong.matches,
                                    PredictionSource::kNone);
-  EXPECT_TRUE(ResolveFrameMotion(cam, o, 40, strong.ref, &up, nullptr, true, false,
+  EXPECT_TRUE(ResolveFrameMotion(cam, o, false, strong.ref, &up, nullptr, true, false,
                                  Eigen::Vector2d::Zero(), &b)
                   .ok());
+}
+
+TEST(MotionEstimationTest, OptionsRefuseABadFieldByName) {
+  test::ExpectOptionsRefuseBadFields<MotionOptions>({
+      {"ransac: ", [](MotionOptions* o) { o->ransac.confidence = 1.0; }},
+      {"few_point: ",
+       [](MotionOptions* o) {
+         o->few_point_motion = true;
+         o->few_point.min_inliers = 0;
+       }},
+      {"min_inliers", [](MotionOptions* o) { o->min_inliers = 2; }},
+      {"reliable_min_inliers", [](MotionOptions* o) { o->reliable_min_inliers = 2; }},
+      {"prior_update_exponent", [](MotionOptions* o) { o->prior_update_exponent = 0.5; }},
+      {"few_point_max_shift_disagreement_px",
+       [](MotionOptions* o) { o->few_point_max_shift_disagreement_px = -1.0; }},
+      {"vehicle_max_weak_tilt_deg", [](MotionOptions* o) { o->vehicle_max_weak_tilt_deg = 0.0; }},
+      {"vehicle_max_weak_lift_m",
+       [](MotionOptions* o) {
+         o->vehicle_max_weak_lift_m = std::numeric_limits<double>::infinity();
+       }},
+      {"few_point_min_features", [](MotionOptions* o) { o->few_point_min_features = 0; }},
+      {"few_point_prior_update", [](MotionOptions* o) { o->few_point_prior_update = 1.5; }},
+  });
 }
 
 }  // namespace

@@ -122,7 +122,7 @@ TEST(MotionModelTest, PredictedCentreShiftIsExact) {
   EXPECT_NEAR(PredictedCentreShift(cam, step, -1.0).x(), 0.0, 1e-12);
 }
 
-// The ground-vehicle gate (tracking.vehicle_max_weak_tilt_deg / _lift_m): a yaw about up and
+// The ground-vehicle gate (MotionOptions::vehicle_max_weak_tilt_deg / _lift_m): a yaw about up and
 // a step across it pass whatever their size; a tilt (rotation about an axis across up) or a
 // lift along up passes up to its limit and not beyond, also for a pitched camera.
 TEST(MotionModelTest, VehicleLikeMotionIsAYawAndAStepInThePlane) {

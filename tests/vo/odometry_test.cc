@@ -129,7 +129,7 @@ class OdometrySeamTest : public ::testing::TestWithParam<SeamCase> {};
 TEST_P(OdometrySeamTest, ExactMatchesReproduceTheTrajectory) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
-  options.estimate_initial_orientation = false;  // world = first camera = ground truth world
+  options.initial_orientation.enabled = false;  // world = first camera = ground truth world
   options.back_end.bundle_adjustment = GetParam().use_ba;
   options.back_end.prior_weight = GetParam().prior_weight;
   std::string error;
@@ -180,7 +180,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(OdometrySeamTest, FeaturesWithoutDepthAreDroppedAndMatchesReindexed) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
-  options.estimate_initial_orientation = false;
+  options.initial_orientation.enabled = false;
   StereoOdometry vo(cam, options);
   const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
   SeamFrame f0 = MakeSeamFrame(cam, points, 0);
@@ -209,8 +209,8 @@ TEST(OdometrySeamTest, FeaturesWithoutDepthAreDroppedAndMatchesReindexed) {
 TEST(OdometrySeamTest, FewMatchesAreTrackedWithThePrior) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
-  options.estimate_initial_orientation = false;
-  options.tracking.few_point_motion = true;  // off by default
+  options.initial_orientation.enabled = false;
+  options.motion.few_point_motion = true;  // off by default
   StereoOdometry vo(cam, options);
   const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
   std::vector<SeamFrame> frames;
@@ -245,7 +245,7 @@ TEST(OdometrySeamTest, FewMatchesAreTrackedWithThePrior) {
   EXPECT_EQ(r6.status, TrackingStatus::kTracking) << r6.message;
   EXPECT_FALSE(r6.few_point_motion);
   // Without the few-point solver the same frame is lost.
-  options.tracking.few_point_motion = false;
+  options.motion.few_point_motion = false;
   StereoOdometry plain(cam, options);
   plain.ProcessFeatures(frames[0].features, {}, 0.0);
   for (int i = 1; i < 5; ++i) {
@@ -259,8 +259,8 @@ TEST(OdometrySeamTest, FewMatchesAreTrackedWithThePrior) {
 TEST(OdometrySeamTest, MatchesWithoutAConsensusAreTrackedWithThePrior) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
-  options.estimate_initial_orientation = false;
-  options.tracking.few_point_motion = true;  // off by default
+  options.initial_orientation.enabled = false;
+  options.motion.few_point_motion = true;  // off by default
   const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
   std::vector<SeamFrame> frames;
   for (int i = 0; i < 6; ++i) frames.push_back(MakeSeamFrame(cam, points, i));
@@ -269,7 +269,7 @@ TEST(OdometrySeamTest, MatchesWithoutAConsensusAreTrackedWithThePrior) {
   std::swap(some[0].curr, some[1].curr);
   std::swap(some[2].curr, some[3].curr);
   auto run = [&](bool few_point_motion) {
-    options.tracking.few_point_motion = few_point_motion;
+    options.motion.few_point_motion = few_point_motion;
     StereoOdometry vo(cam, options);
     vo.ProcessFeatures(frames[0].features, {}, 0.0);
     for (int i = 1; i < 5; ++i) {
@@ -299,7 +299,7 @@ std::vector<Eigen::Vector3d> SeamWorldWithFloor() {
   return points;
 }
 
-// tracking.ground_vehicle refuses a weak motion that tilts the vehicle. The seam's world with a
+// motion.ground_vehicle refuses a weak motion that tilts the vehicle. The seam's world with a
 // floor 1 m below the first camera (so the first frame finds up); frame 5 is seen from its pose
 // pitched by 5° and matched by 20 exact matches only (weak: fewer than reliable_min_inliers).
 TEST(OdometrySeamTest, GroundVehicleRefusesAWeakMotionThatTilts) {
@@ -317,8 +317,8 @@ TEST(OdometrySeamTest, GroundVehicleRefusesAWeakMotionThatTilts) {
   const std::vector<Match> weak(all.begin(), all.begin() + 20);
   auto run = [&](bool ground_vehicle, const std::vector<Match>& matches_5) {
     OdometryOptions options;
-    options.tracking.ground_vehicle = ground_vehicle;
-    options.tracking.few_point_motion = false;
+    options.motion.ground_vehicle = ground_vehicle;
+    options.motion.few_point_motion = false;
     StereoOdometry vo(cam, options);
     const OdometryResult r0 = vo.ProcessFeatures(frames[0].features, {}, 0.0);
     EXPECT_TRUE(r0.initial_orientation_ok) << r0.message;
@@ -363,8 +363,8 @@ TEST(OdometrySeamTest, NoFloorTakesTheUpFromTheMounting) {
 
   const double p = 10.0 * kDeg;
   const Eigen::Vector3d up(0.0, -std::cos(p), -std::sin(p));
-  options.orientation_up_from_mounting = true;
-  options.orientation.expected_up_cam0 = up;
+  options.initial_orientation.up_from_mounting = true;
+  options.initial_orientation.planes.expected_up_cam0 = up;
   StereoOdometry vo(cam, options);
   const OdometryResult r = vo.ProcessFeatures(f0.features, {}, 0.0);
   EXPECT_TRUE(r.initial_orientation_ok) << r.message;
@@ -393,8 +393,8 @@ TEST(OdometrySeamTest, GroundVehicleMeasuresARefusedWeakMotionWithTheFewPointSol
     EXPECT_GE(weak.size(), 60u);
     weak.resize(20);
     OdometryOptions options;
-    options.tracking.ground_vehicle = true;
-    options.tracking.few_point_motion = true;
+    options.motion.ground_vehicle = true;
+    options.motion.few_point_motion = true;
     StereoOdometry vo(cam, options);
     EXPECT_TRUE(vo.ProcessFeatures(frames[0].features, {}, 0.0).initial_orientation_ok);
     for (int i = 1; i < 5; ++i) {
@@ -429,8 +429,8 @@ TEST(OdometrySeamTest, GroundVehicleMeasuresARefusedWeakMotionWithTheFewPointSol
 TEST(OdometrySeamTest, TooFewMatchesIsLostThenReinitialises) {
   const StereoCamera cam = HallwayCamera();
   OdometryOptions options;
-  options.estimate_initial_orientation = false;
-  options.tracking.few_point_motion = false;  // the loss itself is under test here
+  options.initial_orientation.enabled = false;
+  options.motion.few_point_motion = false;  // the loss itself is under test here
   StereoOdometry vo(cam, options);
   const std::vector<Eigen::Vector3d> points = SeamWorldPoints();
   std::vector<SeamFrame> frames;
@@ -708,7 +708,7 @@ TEST(OdometryRenderedTest, FloorRefinementPutsTheUpOnTheRenderedFloor) {
   double error_deg[2];
   for (bool refine : {false, true}) {
     OdometryOptions options;
-    options.orientation_floor_refinement = refine;
+    options.initial_orientation.refine_floor = refine;
     StereoOdometry vo(HallwayCamera(), options);
     const OdometryResult r =
         vo.Process(CorridorSequence()[0].left, CorridorSequence()[0].right, 0.0);
@@ -723,7 +723,7 @@ TEST(OdometryRenderedTest, FloorRefinementPutsTheUpOnTheRenderedFloor) {
 
 TEST(OdometryRenderedTest, WithoutOrientationTheWorldIsTheFirstCamera) {
   OdometryOptions options;
-  options.estimate_initial_orientation = false;
+  options.initial_orientation.enabled = false;
   StereoOdometry vo(HallwayCamera(), options);
   const OdometryResult r = vo.Process(CorridorSequence()[0].left, CorridorSequence()[0].right, 0.0);
   EXPECT_FALSE(r.initial_orientation_ok);
@@ -759,10 +759,10 @@ TEST(OdometryRenderedTest, StageTimesAreFilled) {
 // the dense map skips its speckle filter: the same trajectory, bit for bit.
 TEST(OdometryRenderedTest, DisparityAtFeaturesEqualsTheDenseMapWithoutSpeckleFilter) {
   OdometryOptions at_features;
-  at_features.disparity.speckle_window_size = 0;
-  ASSERT_EQ(at_features.disparity_mode, DisparityMode::kAtFeatures);
+  at_features.front_end.disparity.speckle_window_size = 0;
+  ASSERT_EQ(at_features.front_end.disparity_mode, DisparityMode::kAtFeatures);
   OdometryOptions dense = at_features;
-  dense.disparity_mode = DisparityMode::kDense;
+  dense.front_end.disparity_mode = DisparityMode::kDense;
   const std::vector<OdometryResult> a = RunCorridor(at_features);
   const std::vector<OdometryResult> b = RunCorridor(dense);
   ASSERT_EQ(a.size(), b.size());
@@ -783,10 +783,10 @@ TEST(OdometryRenderedTest, DisparityAtFeaturesEqualsTheDenseMapWithoutSpeckleFil
 // the largest disparity seen with its margin; the trajectory stays that of the full range.
 TEST(OdometryRenderedTest, DisparityRangeFollowsTheScene) {
   OdometryOptions wide;
-  wide.derive_num_disparities = false;
-  wide.disparity.num_disparities = 128;
+  wide.front_end.derive_num_disparities = false;
+  wide.front_end.disparity.num_disparities = 128;
   OdometryOptions fixed = wide;
-  fixed.disparity_range_from_scene = false;
+  fixed.front_end.disparity_range_from_scene = false;
   const std::vector<OdometryResult> r = RunCorridor(wide, {6});
   const std::vector<OdometryResult> full = RunCorridor(fixed, {6});
   EXPECT_EQ(r[0].num_disparities, 128);
@@ -854,7 +854,7 @@ TEST(OdometryLostTest, SeveralBlackFramesAreBridged) {
 // forward motion are the prior's. The end pose stays as close to the truth as without it.
 TEST(OdometryLostTest, GroundVehicleBridgesBlackFramesInThePlane) {
   OdometryOptions options;
-  options.tracking.ground_vehicle = true;
+  options.motion.ground_vehicle = true;
   const std::vector<OdometryResult> results = RunCorridor(options, {4, 5, 6});
   ASSERT_TRUE(results[0].initial_orientation_ok);
   for (int i : {4, 5, 6}) {
@@ -877,7 +877,7 @@ TEST(OdometryLostTest, GroundVehicleBridgesBlackFramesInThePlane) {
 // A ground vehicle turning at 1.5° a frame brakes in front of a plain end wall and turns
 // faster, and its frame 5 gets no matches: the constant velocity would bridge it with the
 // cruise step (4 cm, 1.5°); measured against frame 4's features
-// (tracking.vehicle_bridge_alignment) the bridged motion is the true one (1 cm, 2°). The world
+// (recovery.vehicle_bridge_alignment) the bridged motion is the true one (1 cm, 2°). The world
 // (hallway frame): a floor and an end wall 1.2 m ahead; frames 4 and 5 see the wall's features
 // only (the floor in front of it plain), as on texture seed 3. The camera 0.3 m above the
 // floor, 0.15 m ahead of the axle. Features dense at varying depths (a textured floor) are not
@@ -911,9 +911,9 @@ TEST(OdometryLostTest, GroundVehicleMeasuresALostFrameAgainstThePreviousFeatures
   }
   auto run = [&](bool alignment) {
     OdometryOptions options;
-    options.tracking.ground_vehicle = true;
-    options.tracking.few_point.axle_behind_camera_m = kAxleM;
-    options.tracking.vehicle_bridge_alignment = alignment;
+    options.motion.ground_vehicle = true;
+    options.motion.few_point.axle_behind_camera_m = kAxleM;
+    options.recovery.vehicle_bridge_alignment = alignment;
     StereoOdometry vo(cam, options);
     std::vector<OdometryResult> results = {vo.ProcessFeatures(frames[0].features, {}, 0.0)};
     for (int i = 1; i <= 5; ++i) {
@@ -947,7 +947,7 @@ TEST(OdometryLostTest, GroundVehicleMeasuresALostFrameAgainstThePreviousFeatures
 // 0.3 m above the floor and 0.15 m ahead of the axle), 1° a frame, then faster (2.5° a frame)
 // while frames 4-6 have no depth (their right images black: no feature has a disparity, so no
 // matcher can measure them). The previous frames' features lie on the wall: its plane, and the
-// left images, measure those frames directly (tracking.vehicle_direct_alignment): the true
+// left images, measure those frames directly (recovery.vehicle_direct_alignment): the true
 // motion, not the constant velocity's 1° a frame, and they are not lost frames. Without it they
 // are lost and bridged.
 TEST(OdometryLostTest, GroundVehicleMeasuresFramesWithoutDepthByDirectAlignment) {
@@ -968,11 +968,11 @@ TEST(OdometryLostTest, GroundVehicleMeasuresFramesWithoutDepthByDirectAlignment)
   }
   auto run = [&](bool direct) {
     OdometryOptions options;
-    options.tracking.ground_vehicle = true;
-    options.tracking.few_point.axle_behind_camera_m = kAxleM;
-    options.tracking.vehicle_direct_alignment = direct;
-    options.orientation_up_from_mounting = true;  // where the floor is not found
-    options.orientation.expected_up_cam0 = up_cam;
+    options.motion.ground_vehicle = true;
+    options.motion.few_point.axle_behind_camera_m = kAxleM;
+    options.recovery.vehicle_direct_alignment = direct;
+    options.initial_orientation.up_from_mounting = true;  // where the floor is not found
+    options.initial_orientation.planes.expected_up_cam0 = up_cam;
     StereoOdometry vo(cam, options);
     std::vector<OdometryResult> results;
     for (size_t i = 0; i < frames.size(); ++i)
@@ -1043,10 +1043,10 @@ std::vector<SeamFrame> NoisyVehicleDrive(const StereoCamera& cam, uint64_t seed,
 // The ground-vehicle configuration for that drive: planar BA, the axle, the flat floor or not.
 OdometryOptions DriveOptions(bool flat_floor) {
   OdometryOptions options;
-  options.tracking.ground_vehicle = true;
+  options.motion.ground_vehicle = true;
   options.back_end.vehicle_planar.enabled = true;
   options.back_end.flat_floor.enabled = flat_floor;
-  options.tracking.few_point.axle_behind_camera_m = kDriveAxleM;
+  options.motion.few_point.axle_behind_camera_m = kDriveAxleM;
   return options;
 }
 
@@ -1238,7 +1238,7 @@ TEST(OdometryPredictionTest, ThePapersUnpredictedFormLosesTheFastTurn) {
   // The same frames without prediction (matcher.prediction: none): 28 px per frame is beyond
   // the σ = 10 px proximity gate, so the turn is not measured (the failure the prediction fixes).
   OdometryOptions options;
-  options.matcher.prediction = PredictionMode::kNone;
+  options.tracker.matcher.prediction = PredictionMode::kNone;
   const std::vector<OdometryResult> r = RunTurn(options, {});
   int lost = 0;
   for (const OdometryResult& x : r) lost += IsLostFrame(x) ? 1 : 0;
@@ -1269,8 +1269,8 @@ TEST(OdometryPredictionTest, ATurnThatSpeedsUpIsMatchedAroundTheLastMeasuredMoti
     return SpeedingTurnPose(a).inverse() * SpeedingTurnPose(b);
   };
   OdometryOptions options;
-  options.tracking.reliable_min_inliers = 100000;
-  options.tracking.coarse_to_fine = false;
+  options.motion.reliable_min_inliers = 100000;
+  options.tracker.coarse_to_fine = false;
   const std::vector<OdometryResult> r = RunFrames(frames, options, {});
   for (int i = 1; i < 12; ++i) {
     EXPECT_TRUE(r[i].motion_measured) << i << ": " << r[i].message;
@@ -1278,7 +1278,7 @@ TEST(OdometryPredictionTest, ATurnThatSpeedsUpIsMatchedAroundTheLastMeasuredMoti
         << i;
   }
   // Without the pass, the turn is lost where the prior falls too far behind.
-  options.tracking.last_motion_pass = false;
+  options.tracker.last_motion_pass = false;
   const std::vector<OdometryResult> u = RunFrames(frames, options, {});
   int lost = 0;
   for (const OdometryResult& x : u) lost += IsLostFrame(x) ? 1 : 0;
@@ -1311,7 +1311,7 @@ TEST(OdometryPredictionTest, LostFramesAreChainedSoTheMotionThroughTheGapIsMeasu
   // times the measured motion (3°, 4 cm), where the constant velocity says "standing still".
   EXPECT_TRUE(IsLostFrame(r[5])) << r[5].message;
   EXPECT_EQ(r[5].chained_to_frame, 4) << r[5].message;
-  EXPECT_GE(r[5].chain_inliers, OdometryOptions().min_inliers);
+  EXPECT_GE(r[5].chain_inliers, OdometryOptions().motion.min_inliers);
   EXPECT_THAT(EstimatedMotion(r, 4, 5), IsNearPose(true_motion(4, 5), 0.3 * kDeg, 0.01));
   // After it, tracking goes on at the measured pace.
   for (int i = 6; i <= 11; ++i) {
@@ -1321,7 +1321,7 @@ TEST(OdometryPredictionTest, LostFramesAreChainedSoTheMotionThroughTheGapIsMeasu
 
   // Without the chain, frame 5 takes the prior (no translation): 4 cm short.
   OdometryOptions off;
-  off.tracking.chain_lost_frames = false;
+  off.recovery.chain_lost_frames = false;
   const std::vector<OdometryResult> u = RunFrames(frames, off, {});
   EXPECT_EQ(u[5].chained_to_frame, -1);
   EXPECT_THAT(EstimatedMotion(u, 4, 5),
@@ -1364,13 +1364,14 @@ TEST(OdometryPredictionTest, PredictionPutsFeaturesWhereTheSceneSaysTheyGo) {
   const CorridorRenderer renderer;
   const StereoFrame& f0 = CorridorSequence()[0];
   const OdometryOptions defaults;
-  DisparityOptions disparity_options = defaults.disparity;
+  DisparityOptions disparity_options = defaults.front_end.disparity;
   disparity_options.num_disparities = 32;
   DisparityEstimator disparity(disparity_options);
   const DisparityResult d = disparity.Compute(f0.left, f0.right);
   ASSERT_TRUE(d.ok) << d.message;
-  std::vector<Feature> features = CreateFeatureDetector(defaults.detector)->Detect(f0.left);
-  AttachDepth(d.disparity_px, cam, &features, defaults.depth);
+  std::vector<Feature> features =
+      CreateFeatureDetector(defaults.front_end.detector)->Detect(f0.left);
+  AttachDepth(d.disparity_px, cam, &features, defaults.front_end.depth);
   const Eigen::Isometry3d T_0_3 = TrueMotionFromFirst(3);
   const std::vector<Eigen::Vector2d> predicted =
       PredictFeaturePositions(cam, features, T_0_3, 1e-3);
@@ -1405,13 +1406,13 @@ TEST(OdometryPredictionTest, AdaptiveDetectionFindsCornersBesideOneStrongEdge) {
   cv::rectangle(right, cv::Rect(130, 100, 30, 30), cv::Scalar(255), cv::FILLED);
   OdometryOptions off;
   OdometryOptions on;
-  on.adaptive_min_features = 100;
+  on.front_end.adaptive_min_features = 100;
   const int n_off = StereoOdometry(HallwayCamera(), off).Process(left, right, 0.0).num_features;
   const int n_on = StereoOdometry(HallwayCamera(), on).Process(left, right, 0.0).num_features;
   EXPECT_LT(n_off, 100);
   EXPECT_GT(n_on, n_off + 50) << n_off;  // measured: 300 (the cap) vs 70
   OdometryOptions bad;
-  bad.adaptive_min_features = -1;
+  bad.front_end.adaptive_min_features = -1;
   std::string error;
   EXPECT_FALSE(bad.IsValid(&error));
   EXPECT_NE(error.find("adaptive_min_features"), std::string::npos);
@@ -1501,19 +1502,19 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
   rejects([](OdometryOptions* o) { o->back_end.window_frames = 2; }, "window_frames");
   rejects([](OdometryOptions* o) { o->back_end.window_frames = 11; }, "window_frames");
   rejects([](OdometryOptions* o) { o->back_end.prior_weight = -0.1; }, "prior_weight");
-  rejects([](OdometryOptions* o) { o->tracking.prior_update_exponent = 0.5; },
+  rejects([](OdometryOptions* o) { o->motion.prior_update_exponent = 0.5; },
           "prior_update_exponent");
-  rejects([](OdometryOptions* o) { o->tracking.vehicle_rotation_min_shift_score = 1.5; },
+  rejects([](OdometryOptions* o) { o->recovery.vehicle_rotation_min_shift_score = 1.5; },
           "vehicle_rotation_min_shift_score");
-  rejects([](OdometryOptions* o) { o->tracking.vehicle_rotation_min_peak_ratio = 0.9; },
+  rejects([](OdometryOptions* o) { o->recovery.vehicle_rotation_min_peak_ratio = 0.9; },
           "vehicle_rotation_min_peak_ratio");
-  rejects([](OdometryOptions* o) { o->tracking.vehicle_max_vertical_shift_ratio = -1.0; },
+  rejects([](OdometryOptions* o) { o->recovery.vehicle_max_vertical_shift_ratio = -1.0; },
           "vehicle_max_vertical_shift_ratio");
-  rejects([](OdometryOptions* o) { o->tracking.vehicle_max_weak_tilt_deg = 0.0; },
+  rejects([](OdometryOptions* o) { o->motion.vehicle_max_weak_tilt_deg = 0.0; },
           "vehicle_max_weak_tilt_deg");
   rejects(
       [](OdometryOptions* o) {
-        o->tracking.vehicle_max_weak_lift_m = std::numeric_limits<double>::infinity();
+        o->motion.vehicle_max_weak_lift_m = std::numeric_limits<double>::infinity();
       },
       "vehicle_max_weak_lift_m");
   rejects([](OdometryOptions* o) { o->back_end.vehicle_planar.tilt_sigma_deg = 0.0; },
@@ -1525,27 +1526,35 @@ TEST(OdometryOptionsTest, RejectsBadValues) {
   rejects([](OdometryOptions* o) { o->back_end.flat_floor.height_sigma_m = NAN; },
           "height_sigma_m");
   rejects([](OdometryOptions* o) { o->back_end.prior_weight = 1.5; }, "prior_weight");
-  rejects([](OdometryOptions* o) { o->min_inliers = 2; }, "min_inliers");
-  rejects([](OdometryOptions* o) { o->min_features = 0; }, "min_features");
-  rejects([](OdometryOptions* o) { o->disparity_min_depth_m = 0.0; }, "disparity_min_depth_m");
-  rejects([](OdometryOptions* o) { o->max_num_disparities = 40; }, "max_num_disparities");
-  rejects([](OdometryOptions* o) { o->reinit_after_lost_frames = 0; }, "reinit_after_lost");
+  rejects([](OdometryOptions* o) { o->motion.min_inliers = 2; }, "min_inliers");
+  rejects([](OdometryOptions* o) { o->front_end.min_features = 0; }, "min_features");
+  rejects([](OdometryOptions* o) { o->front_end.disparity_min_depth_m = 0.0; },
+          "disparity_min_depth_m");
+  rejects([](OdometryOptions* o) { o->front_end.max_num_disparities = 40; }, "max_num_disparities");
+  rejects([](OdometryOptions* o) { o->recovery.reinit_after_lost_frames = 0; },
+          "reinit_after_lost");
   rejects([](OdometryOptions* o) { o->back_end.max_points = -1; }, "max_points");
   rejects([](OdometryOptions* o) { o->back_end.max_correction_m = 0.0; }, "max_correction");
-  rejects([](OdometryOptions* o) { o->orientation_sample_step_px = 0; }, "orientation_sample");
-  rejects([](OdometryOptions* o) { o->matcher.type = MatcherType::kSiftRatio; }, "kSift");
-  rejects([](OdometryOptions* o) { o->detector.max_features = -1; }, "detector");
-  rejects([](OdometryOptions* o) { o->ransac.confidence = 1.0; }, "ransac");
+  rejects([](OdometryOptions* o) { o->initial_orientation.sample_step_px = 0; },
+          "initial_orientation: sample_step_px");
+  rejects([](OdometryOptions* o) { o->tracker.matcher.type = MatcherType::kSiftRatio; }, "kSift");
+  rejects([](OdometryOptions* o) { o->front_end.detector.max_features = -1; }, "detector");
+  rejects([](OdometryOptions* o) { o->motion.ransac.confidence = 1.0; }, "ransac");
   rejects([](OdometryOptions* o) { o->back_end.ba.num_fixed_poses = 0; }, "ba");
   rejects([](OdometryOptions* o) { o->back_end.ba.num_fixed_poses = 5; }, "num_fixed_poses");
-  rejects([](OdometryOptions* o) { o->disparity.algorithm = DisparityAlgorithm::kBlockMatching; },
-          "disparity_mode at_features needs disparity.algorithm block_matching_one_volume");
-  rejects([](OdometryOptions* o) { o->disparity_range_margin = -0.1; }, "disparity_range_margin");
-  rejects([](OdometryOptions* o) { o->disparity_range_margin_px = NAN; }, "disparity_range_margin");
   rejects(
       [](OdometryOptions* o) {
-        o->derive_num_disparities = false;
-        o->disparity.num_disparities = 20;
+        o->front_end.disparity.algorithm = DisparityAlgorithm::kBlockMatching;
+      },
+      "disparity_mode at_features needs disparity.algorithm block_matching_one_volume");
+  rejects([](OdometryOptions* o) { o->front_end.disparity_range_margin = -0.1; },
+          "disparity_range_margin");
+  rejects([](OdometryOptions* o) { o->front_end.disparity_range_margin_px = NAN; },
+          "disparity_range_margin");
+  rejects(
+      [](OdometryOptions* o) {
+        o->front_end.derive_num_disparities = false;
+        o->front_end.disparity.num_disparities = 20;
       },
       "disparity");
 }
@@ -1561,11 +1570,11 @@ TEST(OdometryOptionsTest, InvalidCameraIsRejectedByCreate) {
 TEST(OdometryOptionsTest, DisparityRangeIsDerivedFromTheCamera) {
   // Hallway rig: 230 · 0.09 / 0.7 = 29.6 px → 32; nearer cover 0.5 m: 41.4 px → 48.
   StereoOdometry hallway(HallwayCamera(), OdometryOptions());
-  EXPECT_EQ(hallway.options().disparity.num_disparities, 32);
+  EXPECT_EQ(hallway.options().front_end.disparity.num_disparities, 32);
   OdometryOptions near;
-  near.disparity_min_depth_m = 0.5;
+  near.front_end.disparity_min_depth_m = 0.5;
   StereoOdometry hallway_near(HallwayCamera(), near);
-  EXPECT_EQ(hallway_near.options().disparity.num_disparities, 48);
+  EXPECT_EQ(hallway_near.options().front_end.disparity.num_disparities, 48);
   // KITTI: 718 · 0.54 / 0.7 = 555 px → clamped to 256.
   StereoCamera kitti;
   kitti.width = 1241;
@@ -1575,14 +1584,14 @@ TEST(OdometryOptionsTest, DisparityRangeIsDerivedFromTheCamera) {
   kitti.cy_px = 185.22;
   kitti.baseline_m = 0.54;
   StereoOdometry kitti_vo(kitti, OdometryOptions());
-  EXPECT_EQ(kitti_vo.options().disparity.num_disparities, 256);
+  EXPECT_EQ(kitti_vo.options().front_end.disparity.num_disparities, 256);
   // Explicit value kept when not derived; RANSAC's min_inliers raised to the pipeline's.
   OdometryOptions options;
-  options.derive_num_disparities = false;
-  options.disparity.num_disparities = 32;
+  options.front_end.derive_num_disparities = false;
+  options.front_end.disparity.num_disparities = 32;
   StereoOdometry fixed(HallwayCamera(), options);
-  EXPECT_EQ(fixed.options().disparity.num_disparities, 32);
-  EXPECT_EQ(fixed.options().ransac.min_inliers, options.min_inliers);
+  EXPECT_EQ(fixed.options().front_end.disparity.num_disparities, 32);
+  EXPECT_EQ(fixed.options().motion.ransac.min_inliers, options.motion.min_inliers);
 }
 
 TEST(OdometryOptionsTest, StatusNames) {

@@ -42,7 +42,7 @@ struct Fixture {
 
 TEST(RecoveryTest, ALostFrameIsBridgedByThePriorExactly) {
   Fixture f;
-  Recovery recovery(f.camera, OdometryOptions());
+  Recovery recovery(f.camera, RecoveryOptions(), MotionOptions(), TrackerOptions());
   const Eigen::Isometry3d T_world_prev = Pose(30.0, 0.0, Eigen::Vector3d(1.0, 0.0, 2.0));
   const Eigen::Isometry3d v = Pose(2.0, 0.0, Eigen::Vector3d(0.0, 0.0, 0.05));
   f.velocity.Move(v, 1.0);
@@ -65,10 +65,11 @@ TEST(RecoveryTest, ALostFrameIsBridgedByThePriorExactly) {
 
 TEST(RecoveryTest, AGroundVehiclesBridgeIsPlanar) {
   Fixture f;
-  OdometryOptions o;
-  o.tracking.ground_vehicle = true;
-  o.tracking.vehicle_bridge_alignment = false;  // no features to align with here
-  Recovery recovery(f.camera, o);
+  MotionOptions motion;
+  motion.ground_vehicle = true;
+  RecoveryOptions o;
+  o.vehicle_bridge_alignment = false;  // no features to align with here
+  Recovery recovery(f.camera, o, motion, TrackerOptions());
   // The world's up is the camera's −y at the previous pose (a level camera).
   Eigen::Isometry3d T_world_prev = Eigen::Isometry3d::Identity();
   T_world_prev.linear().col(0) = -Eigen::Vector3d::UnitY();
@@ -90,7 +91,7 @@ TEST(RecoveryTest, AGroundVehiclesBridgeIsPlanar) {
 
 TEST(RecoveryTest, ALostFrameFollowsAPanByTheImageShift) {
   Fixture f;
-  Recovery recovery(f.camera, OdometryOptions());
+  Recovery recovery(f.camera, RecoveryOptions(), MotionOptions(), TrackerOptions());
   const int shift = 12;  // the view pans: the content moves 12 px to the left
   const cv::Mat texture = test::BlurredNoise(f.camera.width + shift, f.camera.height, 5, 5, 1.2);
   const cv::Mat previous = texture(cv::Rect(0, 0, f.camera.width, f.camera.height)).clone();
@@ -108,7 +109,7 @@ TEST(RecoveryTest, ALostFrameFollowsAPanByTheImageShift) {
   EXPECT_LT((PredictedCentreShift(f.camera, T, -1.0) - result.image_shift_px).norm(), 1e-9);
   EXPECT_LT(RotationAngleRad(f.velocity.per_frame().linear(), T.linear()), 1e-12);
   // A still view: no correction.
-  Recovery still(f.camera, OdometryOptions());
+  Recovery still(f.camera, RecoveryOptions(), MotionOptions(), TrackerOptions());
   still.EndFrame(f.features, Eigen::Isometry3d::Identity(), previous);
   OdometryResult r2;
   f.velocity.Reset();
@@ -118,11 +119,11 @@ TEST(RecoveryTest, ALostFrameFollowsAPanByTheImageShift) {
 
 TEST(RecoveryTest, WithoutAChainThereIsNothingToChainTo) {
   Fixture f;
-  const OdometryOptions o;
   std::string error;
-  const std::unique_ptr<Tracker> tracker = Tracker::Create(f.camera, o, &error);
+  const std::unique_ptr<Tracker> tracker =
+      Tracker::Create(f.camera, TrackerOptions(), MotionOptions(), &error);
   ASSERT_TRUE(tracker) << error;
-  Recovery recovery(f.camera, o);
+  Recovery recovery(f.camera, RecoveryOptions(), MotionOptions(), TrackerOptions());
   MatchFrame frame;
   frame.frame_id = 3;
   OdometryResult result;
@@ -135,6 +136,23 @@ TEST(RecoveryTest, WithoutAChainThereIsNothingToChainTo) {
   EXPECT_FALSE(recovery.ChainLostFrame(tracker.get(), frame,
                                        f.Context(Eigen::Isometry3d::Identity()), &result, &T));
   EXPECT_EQ(result.chained_to_frame, -1);
+}
+
+TEST(RecoveryTest, OptionsRefuseABadFieldByName) {
+  test::ExpectOptionsRefuseBadFields<RecoveryOptions>({
+      {"vehicle_bridge: ", [](RecoveryOptions* o) { o->vehicle_bridge.min_pairs = 0; }},
+      {"vehicle_direct: ", [](RecoveryOptions* o) { o->vehicle_direct.pyramid_levels = 0; }},
+      {"rotation_min_shift_score", [](RecoveryOptions* o) { o->rotation_min_shift_score = 1.5; }},
+      {"rotation_min_peak_ratio", [](RecoveryOptions* o) { o->rotation_min_peak_ratio = 0.5; }},
+      {"rotation_min_residual_px", [](RecoveryOptions* o) { o->rotation_min_residual_px = -1.0; }},
+      {"vehicle_rotation_min_shift_score",
+       [](RecoveryOptions* o) { o->vehicle_rotation_min_shift_score = -2.0; }},
+      {"vehicle_rotation_min_peak_ratio",
+       [](RecoveryOptions* o) { o->vehicle_rotation_min_peak_ratio = 0.9; }},
+      {"vehicle_max_vertical_shift_ratio",
+       [](RecoveryOptions* o) { o->vehicle_max_vertical_shift_ratio = NAN; }},
+      {"reinit_after_lost_frames", [](RecoveryOptions* o) { o->reinit_after_lost_frames = 0; }},
+  });
 }
 
 }  // namespace

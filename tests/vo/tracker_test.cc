@@ -54,7 +54,8 @@ void ExpectExact(const MotionAttempt& a, const Eigen::Isometry3d& T) {
 TEST(TrackerTest, ThePriorsPassAndTheGuidedPassFindEveryFeature) {
   const Scene s;
   std::string error;
-  const std::unique_ptr<Tracker> tracker = Tracker::Create(s.camera, OdometryOptions(), &error);
+  const std::unique_ptr<Tracker> tracker =
+      Tracker::Create(s.camera, TrackerOptions(), MotionOptions(), &error);
   ASSERT_TRUE(tracker) << error;
   TrackingContext context;
   context.T_ref_curr_prior = &s.T_ref_curr;
@@ -71,10 +72,10 @@ TEST(TrackerTest, ThePriorsPassAndTheGuidedPassFindEveryFeature) {
 
 TEST(TrackerTest, WithoutAPriorTheImageShiftCentresTheSearch) {
   const Scene s;
-  OdometryOptions o;
-  o.tracking.guided_rematch = false;
+  TrackerOptions o;
+  o.guided_rematch = false;
   std::string error;
-  const std::unique_ptr<Tracker> tracker = Tracker::Create(s.camera, o, &error);
+  const std::unique_ptr<Tracker> tracker = Tracker::Create(s.camera, o, MotionOptions(), &error);
   ASSERT_TRUE(tracker) << error;
   OdometryResult result;
   const MotionAttempt a =
@@ -89,10 +90,10 @@ TEST(TrackerTest, WithoutAPriorTheImageShiftCentresTheSearch) {
 
 TEST(TrackerTest, ThePapersFormRunsOnePassAroundThePreviousPositions) {
   const Scene s;
-  OdometryOptions o;
+  TrackerOptions o;
   o.matcher.prediction = PredictionMode::kNone;
   std::string error;
-  const std::unique_ptr<Tracker> tracker = Tracker::Create(s.camera, o, &error);
+  const std::unique_ptr<Tracker> tracker = Tracker::Create(s.camera, o, MotionOptions(), &error);
   ASSERT_TRUE(tracker) << error;
   TrackingContext context;
   context.T_ref_curr_prior = &s.T_ref_curr;  // ignored by the paper's form
@@ -108,7 +109,8 @@ TEST(TrackerTest, ThePapersFormRunsOnePassAroundThePreviousPositions) {
 TEST(TrackerTest, EstimateIsRansacOnGivenMatches) {
   const Scene s;
   std::string error;
-  const std::unique_ptr<Tracker> tracker = Tracker::Create(s.camera, OdometryOptions(), &error);
+  const std::unique_ptr<Tracker> tracker =
+      Tracker::Create(s.camera, TrackerOptions(), MotionOptions(), &error);
   ASSERT_TRUE(tracker) << error;
   std::vector<Match> matches;
   for (int i = 0; i < s.n(); ++i) matches.push_back(Match{i, i, 1.0});
@@ -120,11 +122,23 @@ TEST(TrackerTest, EstimateIsRansacOnGivenMatches) {
 }
 
 TEST(TrackerTest, ABadMatcherIsRefused) {
-  OdometryOptions o;
+  TrackerOptions o;
   o.matcher.type = static_cast<MatcherType>(99);
   std::string error;
-  EXPECT_FALSE(Tracker::Create(test::TestCamera(), o, &error));
+  EXPECT_FALSE(Tracker::Create(test::TestCamera(), o, MotionOptions(), &error));
   EXPECT_FALSE(error.empty());
+}
+
+TEST(TrackerTest, OptionsRefuseABadFieldByName) {
+  test::ExpectOptionsRefuseBadFields<TrackerOptions>({
+      {"matcher: ", [](TrackerOptions* o) { o->matcher.type = static_cast<MatcherType>(99); }},
+      {"image_shift: ", [](TrackerOptions* o) { o->image_shift.min_score = 2.0; }},
+      {"prior_radius_scale", [](TrackerOptions* o) { o->prior_radius_scale = 0.0; }},
+      {"shift_radius_scale", [](TrackerOptions* o) { o->shift_radius_scale = 21.0; }},
+      {"confident_min_inliers", [](TrackerOptions* o) { o->confident_min_inliers = -1; }},
+      {"confident_inlier_fraction", [](TrackerOptions* o) { o->confident_inlier_fraction = 1.5; }},
+      {"guided_radius_scale", [](TrackerOptions* o) { o->guided_radius_scale = NAN; }},
+  });
 }
 
 }  // namespace

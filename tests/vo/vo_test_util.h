@@ -1,10 +1,14 @@
-// Helpers shared by the vo/ tests: the synthetic stereo head and Gaussian noise.
+// Helpers shared by the vo/ tests: the synthetic stereo head, Gaussian noise and the check of a
+// stage's options (ExpectOptionsRefuseBadFields).
 #pragma once
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "vo/camera.h"
@@ -94,6 +98,31 @@ inline std::vector<Match> OneToOneMatches(size_t n) {
     matches.push_back(m);
   }
   return matches;
+}
+
+// One bad value of an options struct's field: `change` sets it, `field` is what the refusal's
+// message must name.
+template <typename Options>
+struct BadField {
+  std::string field;
+  std::function<void(Options*)> change;
+};
+
+// A stage's options (FrontEndOptions, TrackerOptions, ...): the defaults are valid, and each of
+// `bad` applied to the defaults is refused (IsValid false) with a message that names its field.
+template <typename Options>
+void ExpectOptionsRefuseBadFields(const std::vector<BadField<Options>>& bad) {
+  std::string error;
+  EXPECT_TRUE(Options().IsValid(&error)) << error;
+  EXPECT_TRUE(Options().IsValid(nullptr));
+  for (const BadField<Options>& b : bad) {
+    Options options;
+    b.change(&options);
+    error.clear();
+    EXPECT_FALSE(options.IsValid(&error)) << b.field;
+    EXPECT_FALSE(options.IsValid(nullptr)) << b.field;
+    EXPECT_THAT(error, ::testing::HasSubstr(b.field));
+  }
 }
 
 }  // namespace test
