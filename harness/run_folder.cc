@@ -313,7 +313,8 @@ bool WriteRunFolder(const RunRecords& records, const RunSummary& s,
     }
     // groundtruth_kitti.txt has no stamps: written only when it lines up with the estimate.
     const bool all_gt = t.gt_frames.size() == t.times.size();
-    if (!WriteTum((p / "groundtruth_world_tum.txt").string(), Stamped(times_at_gt, gt_at_gt), error) ||
+    if (!WriteTum((p / "groundtruth_world_tum.txt").string(), Stamped(times_at_gt, gt_at_gt),
+                  error) ||
         (all_gt && !WriteKittiPoses((p / "groundtruth_kitti.txt").string(),
                                     KittiRelativeToFirst(t.gt), error)) ||
         !WriteTum((p / "estimate_in_gt_world_tum.txt").string(),

@@ -49,7 +49,8 @@ TEST(ClosedLoopTest, TheRobotSteersOnTheVoAndRerunsAreBitIdentical) {
     ASSERT_TRUE(harness::RunScenario(scenario, vo::OdometryOptions(), options, &summary, &error))
         << error;
     int i = 0;
-    for (const char* f : {"trajectory_world_tum.txt", "groundtruth_world_tum.txt", "navigation.csv"})
+    for (const char* f :
+         {"trajectory_world_tum.txt", "groundtruth_world_tum.txt", "navigation.csv"})
       files[k][i++] = ReadText(options.out_dir + "/" + f);
     metrics[k] = nlohmann::json::parse(ReadText(options.out_dir + "/metrics.json"));
   }

@@ -54,8 +54,8 @@ TEST(RunTest, PapersConfigurationOnTheLHallwayMeetsThePapersFigure) {
   EXPECT_GT(s.match_stats.inlier_precision(), 0.99);
   // The run folder has what the issue names.
   for (const char* f :
-       {"trajectory_world_tum.txt", "trajectory_kitti.txt", "groundtruth_world_tum.txt", "per_frame.csv",
-        "vo_options.yaml", "scenario.yaml", "metrics.json", "report.md"})
+       {"trajectory_world_tum.txt", "trajectory_kitti.txt", "groundtruth_world_tum.txt",
+        "per_frame.csv", "vo_options.yaml", "scenario.yaml", "metrics.json", "report.md"})
     EXPECT_TRUE(fs::exists(fs::path(options.out_dir) / f)) << f;
   const nlohmann::json j = ReadJson(options.out_dir + "/metrics.json");
   for (const char* k : {"frames", "path_length_m", "end_pose_error_m", "end_pose_error_pct",

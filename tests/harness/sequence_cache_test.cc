@@ -252,8 +252,9 @@ TEST(SequenceCacheTest, ConcurrentRunsWaitOnOneSimulationAndEqualASimulatingRun)
                               stride + " --out " + plain);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const fs::path cached = dir / (std::string("cached_k") + stride);
-    for (const char* f : {"trajectory_world_tum.txt", "trajectory_kitti.txt", "groundtruth_world_tum.txt",
-                          "estimate_in_gt_world_tum.txt", "scenario.yaml", "vo_options.yaml"})
+    for (const char* f :
+         {"trajectory_world_tum.txt", "trajectory_kitti.txt", "groundtruth_world_tum.txt",
+          "estimate_in_gt_world_tum.txt", "scenario.yaml", "vo_options.yaml"})
       EXPECT_EQ(ReadAll((cached / f).string()), ReadAll(fs::path(plain) / f)) << stride << f;
     // metrics.json equal but for the timing figures.
     auto metrics = [](const fs::path& run) {

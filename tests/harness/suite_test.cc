@@ -390,8 +390,8 @@ TEST(SuiteRunTest, WritesEveryRunAndResumesOnlyUnfinishedRuns) {
   EXPECT_EQ(rows, 8);
   // Each run folder: the `vobench run` files, the suite's stamp, the stride and overrides honoured.
   const fs::path k2 = full / "runs" / "l_hallway__paper__s1__k2";
-  for (const char* f :
-       {"metrics.json", "suite_run.json", "trajectory_world_tum.txt", "vo_options.yaml", "scenario.yaml"})
+  for (const char* f : {"metrics.json", "suite_run.json", "trajectory_world_tum.txt",
+                        "vo_options.yaml", "scenario.yaml"})
     EXPECT_TRUE(fs::exists(k2 / f)) << f;
   const std::string metrics = ReadAll(k2 / "metrics.json");
   EXPECT_NE(metrics.find("\"frames\": 3,"), std::string::npos)
@@ -521,8 +521,9 @@ TEST(SuiteRunTest, EachSequenceIsSimulatedOnceAndTheRunsEqualSimulatingRuns) {
                    (full / "specs" / (id + ".vo.yaml")).string() + " --max-frames 6 --stride " +
                    stamp["stride"].dump() + " --no-plots -q --out " + plain);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    for (const char* f : {"trajectory_world_tum.txt", "groundtruth_world_tum.txt", "trajectory_kitti.txt",
-                          "estimate_in_gt_world_tum.txt", "vo_options.yaml", "scenario.yaml"})
+    for (const char* f :
+         {"trajectory_world_tum.txt", "groundtruth_world_tum.txt", "trajectory_kitti.txt",
+          "estimate_in_gt_world_tum.txt", "vo_options.yaml", "scenario.yaml"})
       EXPECT_EQ(ReadAll(e.path() / f), ReadAll(fs::path(plain) / f)) << id << " " << f;
     auto metrics = [](const fs::path& run) {
       nlohmann::json j = nlohmann::json::parse(ReadAll(run / "metrics.json"));
