@@ -113,9 +113,9 @@ TEST(ScoreTest, ARunFoldersFilesGiveTheRunsAccuracyFigures) {
   ASSERT_TRUE(run_metrics.at("has_ground_truth").get<bool>());
   for (const std::string format : {"kitti", "tum"}) {
     const std::string out = dir / ("score_" + format);
-    const auto s =
-        RunVobench("score --format " + format + " --gt " + run + "/groundtruth_" + format +
-                   ".txt --est " + run + "/trajectory_" + format + ".txt --out " + out);
+    const std::string suffix = format == "tum" ? "_world_tum.txt" : "_kitti.txt";
+    const auto s = RunVobench("score --format " + format + " --gt " + run + "/groundtruth" +
+                              suffix + " --est " + run + "/trajectory" + suffix + " --out " + out);
     ASSERT_EQ(s.exit_code, 0) << s.output;
     EXPECT_NE(s.output.find("ATE RMSE"), std::string::npos) << s.output;
     EXPECT_TRUE(harness::HasFolderMarker(out, "score"));
