@@ -1,7 +1,10 @@
 #include "harness/suite/folder.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -138,10 +141,41 @@ std::string ShardTag(const Shard& shard) {
   return "shard" + std::to_string(shard.index) + "of" + std::to_string(shard.count);
 }
 
+namespace {
+
+// Holds an flock on the output folder itself (Linux allows one on a directory) while tmp/ is made
+// or removed, so that making tmp/<tag> and another shard's removing an empty tmp/ never interleave.
+// Where the file system refuses the lock (some NFS mounts), it holds nothing and MakeWorkDir's
+// retries cover that rare race.
+class TmpLock {
+ public:
+  TmpLock(const fs::path& out, int operation)
+      : fd_(::open(out.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)) {
+    if (fd_ < 0) return;
+    int rc;
+    do rc = ::flock(fd_, operation);
+    while (rc != 0 && errno == EINTR);
+    if (rc != 0) {
+      ::close(fd_);
+      fd_ = -1;
+    }
+  }
+  ~TmpLock() {
+    if (fd_ >= 0) ::close(fd_);  // closing releases the lock
+  }
+  TmpLock(const TmpLock&) = delete;
+  TmpLock& operator=(const TmpLock&) = delete;
+
+ private:
+  int fd_;
+};
+
+}  // namespace
+
 bool MakeWorkDir(const fs::path& work, std::string* error) {
-  // Another shard's RemoveLeftovers removes tmp/ when it finds it empty, which may fall between
-  // create_directories making tmp/ and making tmp/<tag> in it: try again (tmp/<tag> is never
-  // removed by another process, so once it stands it stays).
+  // Shards making their folders share the lock; a shard removing an empty tmp/ (RemoveEmptyTmp)
+  // holds it alone. The retries are for file systems without flock.
+  const TmpLock lock(work.parent_path().parent_path(), LOCK_SH);
   std::error_code ec;
   for (int attempt = 0; attempt < 100; ++attempt) {
     fs::create_directories(work, ec);
@@ -151,10 +185,16 @@ bool MakeWorkDir(const fs::path& work, std::string* error) {
   return false;
 }
 
+void RemoveEmptyTmp(const fs::path& out) {
+  const TmpLock lock(out, LOCK_EX);
+  std::error_code ec;
+  fs::remove(out / "tmp", ec);  // only if empty
+}
+
 void RemoveLeftovers(const fs::path& out, const fs::path& work) {
   std::error_code ec;
   fs::remove_all(work, ec);
-  fs::remove(out / "tmp", ec);    // only if empty
+  RemoveEmptyTmp(out);
   std::vector<fs::path> partial;  // only work folders of killed vobench processes
   for (fs::directory_iterator it(out / "runs", ec), end; !ec && it != end; it.increment(ec))
     if (IsStaleWorkFolder(it->path().string())) partial.push_back(it->path());

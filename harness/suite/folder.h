@@ -71,6 +71,8 @@ std::filesystem::path WorkDir(const std::filesystem::path& out, const std::strin
 std::string ShardTag(const Shard& shard);
 // Creates `work` (and tmp/), also while a shard sharing the folder removes an empty tmp/.
 bool MakeWorkDir(const std::filesystem::path& work, std::string* error);
+// Removes out/tmp/ when it is empty, never while another process is inside MakeWorkDir.
+void RemoveEmptyTmp(const std::filesystem::path& out);
 // Removes `work` (this process's folder under tmp/, and tmp/ when it is then empty) and every
 // *.partial* entry in runs/: leftovers of interrupted runs.
 void RemoveLeftovers(const std::filesystem::path& out, const std::filesystem::path& work);

@@ -43,29 +43,44 @@ for d in "${datasets[@]}"; do
   for f in "$WORK/ds_$d"/*; do [ "$(basename "$f")" = rig.yaml ] || ln -s "$f" "$v/"; done
 done
 
-# VO configurations (partial VO YAMLs over the defaults).
-printf 'matcher:\n  type: svd_ncc_gabor\n' > "$WORK/default.yaml"
-printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\n' > "$WORK/free.yaml"
-printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\n  prediction: none\nreinit_after_lost_frames: 1\n' > "$WORK/paper.yaml"
-printf 'matcher:\n  type: lucas_kanade\n' > "$WORK/lucas_kanade.yaml"
-printf 'matcher:\n  type: ncc_mutual\n' > "$WORK/ncc_mutual.yaml"
+# VO configurations (partial VO YAMLs over the defaults; keys grouped by the pipeline's stages).
+# cfg NAME KEY=VALUE...: writes $WORK/NAME.yaml, one nested YAML map from the dotted keys.
+cfg() {
+  local name=$1; shift
+  /usr/bin/python3 -c 'import sys
+tree = {}
+for kv in sys.argv[2:]:
+    key, value = kv.split("=", 1)
+    node = tree
+    *path, leaf = key.split(".")
+    for p in path: node = node.setdefault(p, {})
+    node[leaf] = value
+def dump(node, indent):
+    for k, v in node.items():
+        if isinstance(v, dict): print(" " * indent + k + ":"); dump(v, indent + 2)
+        else: print(" " * indent + k + ": " + v)
+sys.stdout = open(sys.argv[1], "w"); dump(tree, 0)' "$WORK/$name.yaml" "$@"
+}
+M=tracker.matcher.type
+cfg default $M=svd_ncc_gabor
+cfg free platform=free $M=svd_ncc_gabor
+cfg paper platform=free $M=svd_ncc_gabor tracker.matcher.prediction=none recovery.reinit_after_lost_frames=1
+cfg lucas_kanade $M=lucas_kanade
+cfg ncc_mutual $M=ncc_mutual
 # The ground vehicle's options one by one on the free platform (README, "Robust tracking"):
 # few-point motion, alone and with the ground-vehicle (planar) constraint; the last one is what
 # platform ground_vehicle switches on.
-printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n' > "$WORK/few_point.yaml"
-printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n' \
-  > "$WORK/few_point_ground.yaml"
-printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  ground_vehicle: true\n' > "$WORK/ground.yaml"
+cfg few_point platform=free $M=svd_ncc_gabor motion.few_point.enabled=true
+cfg few_point_ground platform=free $M=svd_ncc_gabor motion.few_point.enabled=true vehicle.enabled=true
+cfg ground platform=free $M=svd_ncc_gabor vehicle.enabled=true
 # Both, with the rig's calibration: the camera 0.15 m ahead of the wheel axle (camera.forward_m, set in
 # scenes/l_hallway.yaml, the default for plain_corridor; given here as on the free platform).
-printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
-  > "$WORK/few_point_ground_rig.yaml"
+RIG="platform=free $M=svd_ncc_gabor motion.few_point.enabled=true vehicle.enabled=true vehicle.axle_behind_camera_m=0.15"
+cfg few_point_ground_rig $RIG
 # The same with the planar motion prior in the window's bundle adjustment (it needs the axle).
-printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  vehicle_planar_ba: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
-  > "$WORK/few_point_ground_rig_planar.yaml"
+cfg few_point_ground_rig_planar $RIG back_end.vehicle_planar.enabled=true
 # And with the flat floor (every pose held to the first pose's floor tilt and camera height).
-printf 'platform: free\nmatcher:\n  type: svd_ncc_gabor\ntracking:\n  few_point_motion: true\n  ground_vehicle: true\n  vehicle_planar_ba: true\n  vehicle_flat_floor: true\n  few_point:\n    axle_behind_camera_m: 0.15\n' \
-  > "$WORK/few_point_ground_rig_planar_floor.yaml"
+cfg few_point_ground_rig_planar_floor $RIG back_end.vehicle_planar.enabled=true back_end.flat_floor.enabled=true
 runs=()
 for c in ${CONFIGS:-default free paper lucas_kanade ncc_mutual few_point few_point_ground ground few_point_ground_rig few_point_ground_rig_planar few_point_ground_rig_planar_floor}; do
   for s in 1 2 3 4 5 6 7 8 9 10; do for k in 1 2 3 5; do runs+=("seed$s $k $c"); done; done

@@ -338,8 +338,7 @@ TEST(ShardTest, AWorkFolderIsMadeWhileAnotherShardRemovesAnEmptyTmp) {
   const fs::path work = harness::suite_internal::WorkDir(out, "shard2of2");
   std::atomic<bool> stop{false};
   std::thread remover([&] {
-    std::error_code ec;
-    while (!stop) fs::remove(out / "tmp", ec);  // only if empty, as RemoveLeftovers does
+    while (!stop) harness::suite_internal::RemoveEmptyTmp(out);  // as RemoveLeftovers does
   });
   int failed = 0;
   std::string error;
