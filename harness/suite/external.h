@@ -79,8 +79,8 @@ bool WriteSequence(const ExternalRunSpec& spec, const std::string& dir, std::str
 // truth at the IMU rate), read back and written into `dir`. Images, depth, stamps, rig.yaml, the
 // sensor.yaml files and imu0/data.csv are the bytes WriteSequence writes at that stride; the
 // ground truth (poses.txt, groundtruth_tum.txt, T_world_cam0first.txt, the IMU-rate
-// state_groundtruth_estimate0/data.csv) equal to ~1e-15 (a rotation read back from its
-// quaternion gives that quaternion to the last bit only about half of the time).
+// state_groundtruth_estimate0/data.csv) equal to ~1e-15 (a quaternion turned into a rotation
+// and back differs in its last bit about half of the time).
 bool WriteStridedCopy(const ExternalRunSpec& spec, const std::string& full_dir,
                       const std::string& dir, std::string* error);
 
