@@ -153,6 +153,53 @@ bool ReadEurocImu(const std::string& path, std::vector<int64_t>* t_ns,
   return true;
 }
 
+bool ReadEurocImuGroundTruth(const std::string& path, const std::vector<int64_t>& t_ns,
+                             std::vector<sim::ImuSample>* samples, std::string* error) {
+  if (samples->size() != t_ns.size())
+    return Fail(error, path + ": ReadEurocImuGroundTruth: " + std::to_string(t_ns.size()) +
+                           " stamps for " + std::to_string(samples->size()) + " samples");
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, error)) return false;
+  size_t next = 0;  // the sample the next line is for
+  std::vector<double> v;
+  std::string what;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (IsBlankOrComment(lines[i])) continue;
+    const int line_no = static_cast<int>(i) + 1;
+    const std::string_view line(lines[i]);
+    const size_t comma = line.find(',');
+    int64_t stamp = 0;
+    if (comma == std::string_view::npos || !ParseStamp(line.substr(0, comma), &stamp))
+      return Fail(error, Where(path, line_no) +
+                             "expected '<timestamp ns>,p xyz,q wxyz,v xyz,b_w xyz,b_a xyz' "
+                             "(17 fields)");
+    if (next >= t_ns.size() || stamp != t_ns[next])
+      return Fail(error,
+                  Where(path, line_no) + "time stamp " + std::to_string(stamp) +
+                      (next < t_ns.size() ? " is not the IMU sample's " + std::to_string(t_ns[next])
+                                          : " is past the last IMU sample's") +
+                      " (expected one line per imu0 sample, at its stamp)");
+    if (!ParseNumbers(line.substr(comma + 1), 16, &v, &what))
+      return Fail(error, Where(path, line_no) + what +
+                             " after the time stamp (p xyz, q wxyz, v xyz, b_w xyz, b_a xyz)");
+    Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+    if (!(q.norm() > 0.5 && q.norm() < 2.0))
+      return Fail(error, Where(path, line_no) + "the quaternion (fields 5-8) is not a rotation");
+    sim::ImuSample& s = (*samples)[next++];
+    s.has_gt = true;
+    s.T_world_imu.linear() = q.normalized().toRotationMatrix();
+    s.T_world_imu.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    s.v_world_mps = Eigen::Vector3d(v[7], v[8], v[9]);
+    s.gyro_bias_radps = Eigen::Vector3d(v[10], v[11], v[12]);
+    s.accel_bias_mps2 = Eigen::Vector3d(v[13], v[14], v[15]);
+  }
+  if (next != t_ns.size())
+    return Fail(error, path + ": " + std::to_string(next) + " lines for " +
+                           std::to_string(t_ns.size()) +
+                           " IMU samples (expected one line per imu0 sample)");
+  return true;
+}
+
 bool ReadEurocImuSensorYaml(const std::string& path, sim::ImuOptions* imu, std::string* error) {
   std::vector<std::string> lines;
   if (!ReadTextLines(path, &lines, error)) return false;

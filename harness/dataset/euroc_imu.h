@@ -40,6 +40,17 @@ bool WriteEurocImu(const std::string& mav0, const std::vector<sim::ImuSample>& s
 bool ReadEurocImu(const std::string& path, std::vector<int64_t>* t_ns,
                   std::vector<sim::ImuSample>* samples, std::string* error);
 
+// Reads the ground truth at the IMU rate (a state_groundtruth_estimate0/data.csv as WriteEurocImu
+// writes it: a header, then 17 numbers a line: stamp in ns, p, q (w x y z), v, b_w, b_a) into the
+// samples ReadEurocImu read (t_ns, *samples): one line per sample, with the sample's stamp, in
+// order. Sets has_gt, T_world_imu (the quaternion normalized), v_world_mps, gyro_bias_radps and
+// accel_bias_mps2; gyro_true_radps and accel_true_mps2 (not in the file) stay as they are. The
+// numbers read back as written (FormatDouble); the rotation matrix of a quaternion gives that
+// quaternion back only to ~1e-16 (its last bit differs for about half of them). Errors name
+// file:line.
+bool ReadEurocImuGroundTruth(const std::string& path, const std::vector<int64_t>& t_ns,
+                             std::vector<sim::ImuSample>* samples, std::string* error);
+
 // Reads an imu0/sensor.yaml (a leading "%YAML:1.0" accepted): rate_hz (> 0) and
 // gyroscope_noise_density, gyroscope_random_walk, accelerometer_noise_density,
 // accelerometer_random_walk (finite, >= 0) into *imu, its pose fields untouched; the other keys

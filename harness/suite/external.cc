@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "harness/dataset/euroc.h"
+#include "harness/dataset/euroc_imu.h"
 #include "harness/dataset/kitti.h"
 #include "harness/dataset/writer.h"
 #include "harness/interrupt.h"
@@ -55,13 +56,30 @@ std::vector<std::string> Expand(const std::vector<std::string>& argv,
   return out;
 }
 
-// The writer's options for the sequence of `scenario` seen at `stride`.
+// What a shared sequence folder holds, in its name's hash: a folder written by a vobench that
+// wrote other files (1: no IMU) is never taken for one of this version.
+//   2: the IMU (mav0/imu0/, body.yaml, the ground truth at the IMU rate with the IMU as body)
+constexpr int kSharedSequenceFormat = 2;
+
+// The writer's options for the sequence of `scenario` seen at `stride`; EuRoC's body is the
+// IMU (its pose on the robot's body T_body_imu), so the cameras' T_BS are relative to it.
 DatasetWriter::Options SequenceWriterOptions(const sim::Scenario& scenario, int stride,
-                                             const Eigen::Isometry3d& T_body_cam0) {
+                                             const Eigen::Isometry3d& T_body_cam0,
+                                             const Eigen::Isometry3d& T_body_imu) {
   DatasetWriter::Options options = ScenarioWriterOptions(scenario, T_body_cam0);
   options.format = DatasetFormat::kEuroc;
   options.rate_hz = scenario.rate_hz / stride;
+  options.T_body_imu = T_body_imu;
   return options;
+}
+
+// The capture index (sim::StereoFrame::index) of each of the first `frames` frames the
+// simulator gives: with frames.drop_rate the dropped ones are skipped (sim::Simulator::Next).
+std::vector<int> CaptureIndices(const sim::Scenario& scenario, size_t frames) {
+  std::vector<int> indices;
+  for (int index = 0; indices.size() < frames; ++index)
+    if (!sim::FrameFateOf(scenario.frames, scenario.seed, index).dropped) indices.push_back(index);
+  return indices;
 }
 
 // The sequences of `spec` in the shared folder `datasets_dir`: the whole one (stride 1, one per
@@ -73,8 +91,10 @@ bool SharedSequence(const ExternalRunSpec& spec, const fs::path& datasets_dir, f
   sim::Scenario scenario;
   if (!sim::LoadScenario(spec.scenario_path, &scenario, error)) return false;
   scenario.name.clear();  // the run's id: the configuration is not part of the sequence
-  const fs::path full = datasets_dir / Fnv1aHex(sim::ScenarioToYaml(scenario) + "max_frames: " +
-                                                std::to_string(spec.max_frames) + "\n");
+  const fs::path full =
+      datasets_dir /
+      Fnv1aHex(sim::ScenarioToYaml(scenario) + "max_frames: " + std::to_string(spec.max_frames) +
+               "\nshared_sequence_format: " + std::to_string(kSharedSequenceFormat) + "\n");
   std::error_code ec;
   fs::create_directories(datasets_dir, ec);
   {
@@ -110,18 +130,25 @@ bool WriteSequence(const ExternalRunSpec& spec, const std::string& dir, std::str
   if (!sim::LoadScenario(spec.scenario_path, &scenario, error)) return false;
   std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
-  DatasetWriter writer(
-      SequenceWriterOptions(scenario, spec.stride, simulator->calibration().T_body_cam0));
+  DatasetWriter writer(SequenceWriterOptions(scenario, spec.stride,
+                                             simulator->calibration().T_body_cam0,
+                                             simulator->calibration().T_body_imu));
   if (!writer.Open(dir, ExportedStereoCamera(scenario, simulator->calibration()), error))
     return false;
   sim::StereoFrame frame;
+  // The IMU samples of the frames skipped since the last frame kept: they go with the next one
+  // kept (as the simulator's dropped frames' do), so imu0/ holds every sample up to the last
+  // frame at any stride; the samples of frames after the last one kept are not written.
+  std::vector<sim::ImuSample> carried;
   for (int index = 0; spec.max_frames == 0 || index < spec.max_frames; ++index) {
     if (!simulator->Next(&frame, error)) break;
-    // The sequence for an external estimator carries no IMU samples yet: its strided copies are
-    // made from the KITTI layout, which has none, and must equal a simulation at that stride.
-    DatasetFrame dataset_frame = ToDatasetFrame(frame);
-    dataset_frame.imu.clear();
-    if (index % spec.stride == 0 && !writer.Add(dataset_frame, error)) return false;
+    carried.insert(carried.end(), frame.imu.begin(), frame.imu.end());
+    if (index % spec.stride == 0) {
+      DatasetFrame dataset_frame = ToDatasetFrame(frame);
+      dataset_frame.imu = std::move(carried);
+      carried.clear();
+      if (!writer.Add(dataset_frame, error)) return false;
+    }
     if (InterruptSignal() != 0) {
       *error = InterruptedMessage(index, simulator->EstimatedFrames(), "frames", dir);
       return false;
@@ -135,14 +162,35 @@ bool WriteStridedCopy(const ExternalRunSpec& spec, const std::string& full_dir,
   sim::Scenario scenario;
   KittiReader reader;
   EurocCameraCalibration cam0;
+  std::vector<int64_t> imu_ns;
+  std::vector<sim::ImuSample> imu;
+  const fs::path mav0 = fs::path(full_dir) / "mav0";
   if (!sim::LoadScenario(spec.scenario_path, &scenario, error) || !reader.Open(full_dir, error) ||
-      !ReadEurocSensorYaml((fs::path(full_dir) / "mav0/cam0/sensor.yaml").string(), &cam0, error))
+      !ReadEurocSensorYaml((mav0 / "cam0/sensor.yaml").string(), &cam0, error) ||
+      !ReadEurocImu((mav0 / "imu0/data.csv").string(), &imu_ns, &imu, error) ||
+      !ReadEurocImuGroundTruth((mav0 / "state_groundtruth_estimate0/data.csv").string(), imu_ns,
+                               &imu, error))
     return false;
-  DatasetWriter writer(SequenceWriterOptions(scenario, spec.stride, cam0.T_body_cam));
+  // cam0's T_BS is relative to the IMU already (EuRoC's body): the IMU is the body here.
+  const DatasetWriter::Options options =
+      SequenceWriterOptions(scenario, spec.stride, cam0.T_body_cam, Eigen::Isometry3d::Identity());
+  DatasetWriter writer(options);
   if (!writer.Open(dir, reader.camera(), error)) return false;
+  // The samples on the simulator's clock (their stamps less the writer's offset), each with the
+  // frame the simulator gave it: frame k (captured k-th) takes those up to k / rate_hz + half a
+  // physics step (sim::Simulator); a frame kept takes those of the frames skipped before it.
+  for (size_t i = 0; i < imu.size(); ++i)
+    imu[i].time_s = static_cast<double>(imu_ns[i] - options.stamp_offset_ns) / 1e9;
+  const std::vector<int> captured = CaptureIndices(scenario, reader.size());
+  size_t next_sample = 0;
   DatasetFrame frame;
   for (size_t index = 0; index < reader.size(); index += static_cast<size_t>(spec.stride)) {
-    if (!reader.ReadFrame(index, &frame, error) || !writer.Add(frame, error)) return false;
+    if (!reader.ReadFrame(index, &frame, error)) return false;
+    const double up_to_s = captured[index] / scenario.rate_hz + 0.5 * scenario.physics_dt_s;
+    frame.imu.clear();
+    while (next_sample < imu.size() && imu[next_sample].time_s <= up_to_s)
+      frame.imu.push_back(imu[next_sample++]);
+    if (!writer.Add(frame, error)) return false;
     if (InterruptSignal() != 0) {
       *error = InterruptedMessage(static_cast<int>(index), static_cast<int>(reader.size()),
                                   "frames", dir);

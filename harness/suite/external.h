@@ -10,9 +10,11 @@
 //
 // Placeholders in the command's arguments: {dataset} the run's sequence in the KITTI layout
 // (image_0/, image_1/, calib.txt, times.txt, poses.txt, groundtruth_tum.txt, rig.yaml), {euroc}
-// the same folder read as EuRoC (its mav0/), {calib} its calib.txt, {out} an empty folder for
-// the command's output. A first argument with a '/' that is relative is a path relative to the
-// suite file; one without is looked up on PATH.
+// the same folder read as EuRoC (its mav0/: cam0/, cam1/, the IMU's imu0/ and body.yaml, the
+// ground truth at the IMU rate, as `vobench render --format euroc` writes them), {calib} its
+// calib.txt, {out} an empty folder for the command's output. At a stride the IMU stream stays
+// whole: a frame kept carries the samples of the frames skipped before it. A first argument with a
+// '/' that is relative is a path relative to the suite file; one without is looked up on PATH.
 //
 // A suite runs an external run as a child `vobench suite external SPEC --out DIR --datasets D`
 // (the same child-process path as a built-in run: log, failure record, resume, shards). The
@@ -66,12 +68,19 @@ nlohmann::ordered_json ExternalRunSpecJson(const ExternalRunSpec& spec);
 bool ReadExternalRunSpec(const std::string& path, ExternalRunSpec* spec, std::string* error);
 
 // The sequence a run of `spec` sees, every stride-th of the first max_frames source frames of
-// its scenario, simulated and written as a dataset in `dir` (KITTI layout, EuRoC's mav0/ and
-// rig.yaml beside it; DatasetWriter: nothing at dir on failure).
+// its scenario, simulated and written as a dataset in `dir` (KITTI layout, EuRoC's mav0/ with
+// the IMU and rig.yaml beside it; DatasetWriter: nothing at dir on failure). Every IMU sample up
+// to the last frame written is in imu0/: a frame written carries the samples of the frames
+// skipped since the one before it (as the simulator's dropped frames' go with the next frame
+// kept); those of the frames after the last one written are left out.
 bool WriteSequence(const ExternalRunSpec& spec, const std::string& dir, std::string* error);
 // The same from `full_dir`, the sequence written by WriteSequence at stride 1: every
-// spec.stride-th of its frames, read back and written into `dir`. Images, depth, stamps and
-// rig.yaml are those WriteSequence writes at that stride, the ground truth equal to ~1e-15 m.
+// spec.stride-th of its frames and the IMU samples up to the last of them (imu0/ and the ground
+// truth at the IMU rate), read back and written into `dir`. Images, depth, stamps, rig.yaml, the
+// sensor.yaml files and imu0/data.csv are the bytes WriteSequence writes at that stride; the
+// ground truth (poses.txt, groundtruth_tum.txt, T_world_cam0first.txt, the IMU-rate
+// state_groundtruth_estimate0/data.csv) equal to ~1e-15 (a quaternion turned into a rotation
+// and back differs in its last bit about half of the time).
 bool WriteStridedCopy(const ExternalRunSpec& spec, const std::string& full_dir,
                       const std::string& dir, std::string* error);
 
@@ -108,7 +117,8 @@ class CommandLauncher {
 
 // The external run of `spec` into the run folder `out_dir` (kind "run", written as a work
 // folder and published at the end). The sequence is written into `datasets_dir`: the whole one
-// (named by the hash of the scenario without its name and max_frames), simulated once, and a
+// (named by the hash of the scenario without its name, max_frames and the format of the folder,
+// so one an older vobench wrote, without the IMU, is never taken), simulated once, and a
 // strided copy of it per stride ("<hash>_k<stride>", WriteStridedCopy), where the runs of other
 // configurations and strides find them (the suite gives its work folder, removed when the call
 // ends); with datasets_dir empty, simulated at the run's stride into the run's work folder and

@@ -247,6 +247,70 @@ TEST_F(EurocImuTest, WrittenAndReadBackWithTheDatasetWriterAndReader) {
   }
 }
 
+// The ground truth at the IMU rate read back into imu0's samples (as the strided copies of a
+// suite's external sequences do, harness/suite/external.h): positions, velocities and biases
+// exactly, the rotation to 1e-15; a file that does not match imu0 line for line is refused,
+// naming file:line.
+TEST_F(EurocImuTest, TheGroundTruthAtTheImuRateIsReadBackIntoTheSamples) {
+  std::vector<sim::ImuSample> written;
+  for (int k = 0; k < 4; ++k) {
+    sim::ImuSample s;
+    s.time_s = 0.005 * k;
+    s.gyro_radps = Eigen::Vector3d(0.1 * k, -0.2, 1.0 / 3.0);
+    s.accel_mps2 = Eigen::Vector3d(0.1, 0.2, 9.81 + 1e-3 * k);
+    s.has_gt = true;
+    s.T_world_imu.linear() =
+        Eigen::AngleAxisd(0.3 + 0.1 * k, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    s.T_world_imu.translation() = Eigen::Vector3d(0.1 * k, 1.0 / 7.0, 0.19);
+    s.v_world_mps = Eigen::Vector3d(1.0 / 3.0, 0, k);
+    s.gyro_bias_radps = Eigen::Vector3d(1e-5 * k, 0, 2.5e-6);
+    s.accel_bias_mps2 = Eigen::Vector3d(0, -1e-4, -2e-4 * k);
+    written.push_back(s);
+  }
+  const std::string mav0 = (root_ / "mav0").string();
+  bool wrote_gt = false;
+  std::string error;
+  ASSERT_TRUE(WriteEurocImu(mav0, written, sim::ImuOptions(), 1000000000, &wrote_gt, &error))
+      << error;
+  ASSERT_TRUE(wrote_gt);
+  std::vector<int64_t> t_ns;
+  std::vector<sim::ImuSample> read;
+  ASSERT_TRUE(ReadEurocImu(mav0 + "/imu0/data.csv", &t_ns, &read, &error)) << error;
+  const std::string gt_path = mav0 + "/state_groundtruth_estimate0/data.csv";
+  ASSERT_TRUE(ReadEurocImuGroundTruth(gt_path, t_ns, &read, &error)) << error;
+  ASSERT_EQ(read.size(), written.size());
+  for (size_t i = 0; i < read.size(); ++i) {
+    EXPECT_TRUE(read[i].has_gt) << i;
+    EXPECT_EQ(read[i].T_world_imu.translation(), written[i].T_world_imu.translation()) << i;
+    EXPECT_TRUE(read[i].T_world_imu.linear().isApprox(written[i].T_world_imu.linear(), 1e-15)) << i;
+    EXPECT_EQ(read[i].v_world_mps, written[i].v_world_mps) << i;
+    EXPECT_EQ(read[i].gyro_bias_radps, written[i].gyro_bias_radps) << i;
+    EXPECT_EQ(read[i].accel_bias_mps2, written[i].accel_bias_mps2) << i;
+    EXPECT_EQ(read[i].gyro_radps, written[i].gyro_radps) << i;  // imu0's, untouched
+  }
+
+  const std::string gt = ReadAll(gt_path);
+  const auto refused = [&](const std::string& text) {
+    std::ofstream(gt_path) << text;
+    std::vector<sim::ImuSample> samples = read;
+    std::string why;
+    EXPECT_FALSE(ReadEurocImuGroundTruth(gt_path, t_ns, &samples, &why));
+    return why;
+  };
+  const std::string short_file = refused(gt.substr(0, gt.rfind('\n', gt.size() - 2) + 1));
+  EXPECT_THAT(short_file, HasSubstr(gt_path + ": 3 lines for 4 IMU samples")) << short_file;
+  std::string other_stamp = gt;
+  other_stamp.replace(other_stamp.find("\n1005000000,"), 12, "\n1005000001,");
+  const std::string stamp = refused(other_stamp);
+  EXPECT_THAT(stamp, HasSubstr(gt_path + ":3: time stamp 1005000001 is not the IMU sample's "
+                                         "1005000000"))
+      << stamp;
+  std::string fewer = gt;
+  fewer.erase(fewer.find(",", fewer.find("\n1000000000,") + 1), 2);  // ",0" of x
+  const std::string fields = refused(fewer);
+  EXPECT_THAT(fields, HasSubstr(gt_path + ":2: expected 16 numbers, got 15")) << fields;
+}
+
 // Frames whose IMU samples carry no ground truth (a dataset's, re-written) keep the frames'
 // ground truth at the frame rate; imu0/ is written all the same.
 TEST_F(EurocImuTest, SamplesWithoutGroundTruthLeaveTheFramesGroundTruth) {

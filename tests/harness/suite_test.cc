@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include <sstream>
 #include <thread>
 
+#include "harness/dataset/writer.h"
 #include "harness/output_folder.h"
 #include "harness/suite/folder.h"
 #include "tests/harness/cli_test_util.h"
@@ -737,46 +739,158 @@ TEST(SuiteExternalTest, ShardsAndMergeHoldExternalRuns) {
   EXPECT_NE(again.output.find("2 ok (0 run now, 2 kept)"), std::string::npos) << again.output;
 }
 
-// The strided sequence an external run sees, written from the whole sequence simulated once,
-// equals the one simulated at that stride: the same images, depth, stamps, calibration and rig
-// byte for byte, the ground truth to 1e-12.
-TEST(SuiteExternalTest, AStridedCopyEqualsTheSequenceSimulatedAtThatStride) {
-  TempDir dir("suite_ext_stride");
+// The lines of a text file.
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// The IMU samples of a simulated sequence without dropped frames up to its frame `frame`: one
+// every 1 / imu.rate_hz from time 0, a frame's up to half a physics step past its time.
+size_t ImuSamplesUpToFrame(const sim::Scenario& s, int frame) {
+  return static_cast<size_t>(
+      std::floor((frame / s.rate_hz + 0.5 * s.physics_dt_s) * s.imu.rate_hz + 1e-9) + 1);
+}
+
+// The sequence of `scenario_path` (its first max_frames frames) written at stride 1 into
+// dir/full, simulated at `stride` into dir/direct and copied from dir/full at that stride into
+// dir/copy: the copy must hold the same files as the simulation, the same bytes (the images,
+// depth, stamps, calibration, rig, imu0/data.csv and every sensor.yaml), the ground truth
+// (KITTI, TUM and EuRoC's at the IMU rate) to 1e-12. *full_imu, *direct_imu: the lines of
+// imu0/data.csv of dir/full and dir/direct.
+void ExpectStridedCopyEqualsSimulation(const TempDir& dir, const std::string& scenario_path,
+                                       int max_frames, int stride,
+                                       std::vector<std::string>* full_imu,
+                                       std::vector<std::string>* direct_imu) {
   harness::ExternalRunSpec spec;
-  spec.scenario_path = sim::BuiltinScenarioPath("l_hallway");
-  spec.max_frames = 5;
+  spec.scenario_path = scenario_path;
+  spec.max_frames = max_frames;
   spec.stride = 1;
   std::string error;
   ASSERT_TRUE(harness::WriteSequence(spec, dir / "full", &error)) << error;
-  spec.stride = 2;
+  spec.stride = stride;
   ASSERT_TRUE(harness::WriteSequence(spec, dir / "direct", &error)) << error;
   ASSERT_TRUE(harness::WriteStridedCopy(spec, dir / "full", dir / "copy", &error)) << error;
-  int files = 0, numbers = 0;
-  for (const auto& e : fs::recursive_directory_iterator(dir / "direct")) {
-    if (!e.is_regular_file() || e.path().filename() == harness::kFolderMarkerFile) continue;
-    const std::string rel = fs::relative(e.path(), dir / "direct").string();
-    const std::string a = ReadAll(e.path().string()), b = ReadAll(dir / ("copy/" + rel));
-    ++files;
+  const auto files_of = [](const fs::path& root) {
+    std::set<std::string> files;
+    for (const auto& e : fs::recursive_directory_iterator(root))
+      if (e.is_regular_file() && e.path().filename() != harness::kFolderMarkerFile)
+        files.insert(fs::relative(e.path(), root).string());
+    return files;
+  };
+  const std::set<std::string> files = files_of(dir / "direct");
+  EXPECT_EQ(files, files_of(dir / "copy"));
+  // The IMU as `vobench render --format euroc` writes it.
+  for (const char* f : {"mav0/imu0/data.csv", "mav0/imu0/sensor.yaml", "mav0/body.yaml",
+                        "mav0/state_groundtruth_estimate0/data.csv",
+                        "mav0/state_groundtruth_estimate0/sensor.yaml"})
+    EXPECT_EQ(files.count(f), 1u) << f;
+  int numbers = 0;
+  for (const std::string& rel : files) {
+    const std::string a = ReadAll(dir / ("direct/" + rel)), b = ReadAll(dir / ("copy/" + rel));
     if (rel != "poses.txt" && rel != "groundtruth_tum.txt" && rel != "T_world_cam0first.txt" &&
         rel != "mav0/state_groundtruth_estimate0/data.csv") {
-      EXPECT_EQ(a, b) << rel;
+      EXPECT_TRUE(a == b) << rel << " differs: " << a.size() << " vs " << b.size() << " bytes";
       continue;
     }
     std::istringstream sa(a), sb(b);
     std::string ta, tb;
-    while (sa >> ta) {
+    bool same = true;  // up to the first difference beyond 1e-12 (one message per file)
+    while (same && sa >> ta) {
       ASSERT_TRUE(static_cast<bool>(sb >> tb)) << rel;
       ++numbers;
       if (ta == tb) continue;
       std::replace(ta.begin(), ta.end(), ',', ' ');
       std::replace(tb.begin(), tb.end(), ',', ' ');
       std::istringstream na(ta), nb(tb);
-      for (double x, y; na >> x && nb >> y;) EXPECT_NEAR(x, y, 1e-12) << rel;
+      std::vector<double> xa, xb;
+      for (double x; na >> x;) xa.push_back(x);
+      for (double x; nb >> x;) xb.push_back(x);
+      same = xa.size() == xb.size();
+      for (size_t i = 0; same && i < xa.size(); ++i) same = std::abs(xa[i] - xb[i]) <= 1e-12;
+      EXPECT_TRUE(same) << rel << ": '" << ta << "' vs '" << tb << "'";
     }
-    EXPECT_FALSE(static_cast<bool>(sb >> tb)) << rel;
+    EXPECT_FALSE(same && static_cast<bool>(sb >> tb)) << rel;
   }
-  EXPECT_GE(files, 3 * 3 + 6);  // 3 frames: left, right, depth (+ EuRoC images), text files
-  EXPECT_GE(numbers, 3 * 12);   // poses.txt at least
+  const int kept = (max_frames - 1) / stride + 1;
+  EXPECT_GE(files.size(), 3u * kept + 6);  // left, right, depth (+ EuRoC images), text files
+  EXPECT_GE(numbers, kept * 12);           // poses.txt at least
+  *full_imu = Lines(ReadAll(dir / "full/mav0/imu0/data.csv"));
+  *direct_imu = Lines(ReadAll(dir / "direct/mav0/imu0/data.csv"));
+  // The strided IMU stream is the whole one up to its last frame (no sample lost between
+  // frames); one ground-truth line per sample.
+  ASSERT_LE(direct_imu->size(), full_imu->size());
+  EXPECT_TRUE(std::equal(direct_imu->begin(), direct_imu->end(), full_imu->begin()));
+  EXPECT_EQ(Lines(ReadAll(dir / "direct/mav0/state_groundtruth_estimate0/data.csv")).size(),
+            direct_imu->size());
+}
+
+// The strided sequence an external run sees, written from the whole sequence simulated once,
+// equals the one simulated at that stride: the same images, depth, stamps, calibration, rig and
+// IMU samples byte for byte, the ground truth to 1e-12. Stride 3 of 5 frames: frames 0 and 3,
+// frame 3 with the IMU samples of frames 1 and 2; frame 4's samples are left out.
+TEST(SuiteExternalTest, AStridedCopyEqualsTheSequenceSimulatedAtThatStride) {
+  TempDir dir("suite_ext_stride");
+  const std::string path = sim::BuiltinScenarioPath("l_hallway");
+  std::vector<std::string> full, direct;
+  ExpectStridedCopyEqualsSimulation(dir, path, 5, 3, &full, &direct);
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(path, &s, &error)) << error;
+  EXPECT_EQ(full.size(), 1 + ImuSamplesUpToFrame(s, 4));  // the header line, the samples
+  EXPECT_EQ(direct.size(), 1 + ImuSamplesUpToFrame(s, 3));
+  EXPECT_LT(direct.size(), full.size());
+}
+
+// The same with dropped frames and jittered stamps (frames.*): a frame kept by the simulator
+// carries the samples of the frames it dropped, and the copy finds each frame's samples by the
+// frame it was captured as.
+TEST(SuiteExternalTest, AStridedCopyOfASequenceWithDroppedFramesEqualsItsSimulation) {
+  TempDir dir("suite_ext_stride_drops");
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  s.frames.drop_rate = 0.3;
+  s.frames.time_jitter_s = 0.2 / s.rate_hz;
+  WriteText(dir / "drops.yaml", sim::ScenarioToYaml(s));
+  std::vector<std::string> full, direct;
+  ExpectStridedCopyEqualsSimulation(dir, dir / "drops.yaml", 6, 2, &full, &direct);
+  EXPECT_LT(direct.size(), full.size());  // frame 5's samples
+}
+
+// Issues #33/#36: an external command finds the IMU in {euroc} as `render --format euroc` writes
+// it, every sample up to the sequence's last frame at every stride. 4 source frames: stride 1
+// sees frames 0-3, stride 2 frames 0 and 2 (frame 2 with frame 1's samples). The stand-in
+// estimator keeps imu0/data.csv in its {out} (the run's estimate/).
+TEST(SuiteExternalTest, AnExternalCommandSeesTheImu) {
+  TempDir dir("suite_ext_imu");
+  WriteText(dir / "imu.sh",
+            "#!/bin/sh\ntest -f \"$1/mav0/imu0/sensor.yaml\" && test -f \"$1/mav0/body.yaml\" && "
+            "test -f \"$1/mav0/state_groundtruth_estimate0/data.csv\" && "
+            "cp \"$1/mav0/imu0/data.csv\" \"$2/imu.csv\" && cp \"$1/poses.txt\" \"$2/t.txt\"\n");
+  fs::permissions(dir / "imu.sh", fs::perms::owner_all);
+  WriteText(dir / "suite.yaml",
+            "name: extimu\nmax_frames: 4\nstrides: [1, 2]\nscenarios:\n  - scenario: l_hallway\n"
+            "configs:\n  - name: imu\n    external: {command: [./imu.sh, \"{euroc}\", \"{out}\"], "
+            "trajectory: t.txt, format: kitti}\n");
+  const std::string out = dir / "out";
+  const auto r = RunVobench("suite " + (dir / "suite.yaml") + " -q -j 1 --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 ok (2 run now"), std::string::npos) << r.output;
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  const std::vector<std::string> k1 =
+      Lines(ReadAll(out + "/runs/l_hallway__imu__s1__k1/estimate/imu.csv"));
+  const std::vector<std::string> k2 =
+      Lines(ReadAll(out + "/runs/l_hallway__imu__s1__k2/estimate/imu.csv"));
+  ASSERT_EQ(k1.size(), 1 + ImuSamplesUpToFrame(s, 3));  // the header line, the samples
+  ASSERT_EQ(k2.size(), 1 + ImuSamplesUpToFrame(s, 2));
+  EXPECT_EQ(k1[0].rfind("#timestamp [ns],w_RS_S_x [rad s^-1]", 0), 0u) << k1[0];
+  EXPECT_EQ(k1[1].rfind(std::to_string(harness::kSimulationEpochNs) + ",", 0), 0u) << k1[1];
+  EXPECT_TRUE(std::equal(k2.begin(), k2.end(), k1.begin()));  // stride 2: no sample lost
 }
 
 }  // namespace
