@@ -4,20 +4,17 @@
 #include <cmath>
 #include <filesystem>
 
+#include "harness/dataset/rectification.h"
 #include "harness/interrupt.h"
 #include "harness/progress.h"
 #include "harness/render.h"
+#include "harness/sim_adapter.h"
 #include "sim/simulator.h"
 
 namespace harness {
 
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
                           std::string* error) {
-  if (std::string problem = CalibrationErrorProblem(scenario, false, "the VO's camera in memory");
-      !problem.empty()) {
-    *error = problem;
-    return false;
-  }
   std::shared_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
   DescribeScenarioSequence(scenario, simulator->calibration(), simulator->EstimatedFrames(),
@@ -40,6 +37,31 @@ bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequenc
       simulator->FixAtLastFrame(fixes.Fix(result.T_world_cam0, simulator->BeliefAtLastFrame()));
     };
   }
+  return RectifyScenarioSequence(scenario, simulator->calibration(), sequence, error);
+}
+
+bool RectifyScenarioSequence(const sim::Scenario& scenario,
+                             const sim::StereoCalibration& calibration, StereoSequence* sequence,
+                             std::string* error) {
+  auto rectification = std::make_shared<StereoRectification>();
+  if (!ExportedRectification(scenario, calibration, rectification.get(), error)) return false;
+  if (rectification->IsIdentity()) return true;
+  Eigen::Isometry3d T_cam0_rect0 = Eigen::Isometry3d::Identity();
+  T_cam0_rect0.linear() = rectification->R_cam0_rect0;
+  sequence->camera = rectification->camera;
+  sequence->T_imu_cam0 = sequence->T_imu_cam0 * T_cam0_rect0;
+  sequence->next = [next = sequence->next, rectification](DatasetFrame* frame, std::string* err) {
+    if (!next(frame, err)) return false;
+    RectifyFrame(*rectification, frame);
+    return true;
+  };
+  if (sequence->feedback)  // the follower's fixes are of the raw left camera
+    sequence->feedback = [feedback = sequence->feedback,
+                          T_rect0_cam0 = T_cam0_rect0.inverse()](const vo::OdometryResult& r) {
+      vo::OdometryResult raw = r;
+      raw.T_world_cam0 = r.T_world_cam0 * T_rect0_cam0;
+      feedback(raw);
+    };
   return true;
 }
 

@@ -77,6 +77,16 @@ struct StereoSequence {
 // each frame's result (RunFrames does), and its frames cannot be simulated ahead of the VO.
 bool OpenScenarioSequence(const sim::Scenario& scenario, StereoSequence* sequence,
                           std::string* error);
+// A simulated sequence (`next`, `feedback` and T_imu_cam0 set) onto the frames the VO takes:
+// with a lens or a rotated cam1 in the exported calibration (camera.distortion,
+// calibration_error.rotation_deg), its frames rectified by ExportedRectification
+// (harness/sim_adapter.h) as `vobench eval --format euroc` rectifies the EuRoC render of it: the
+// rectified camera, the ground truth of the rectified left camera, no depth (it belongs to the
+// raw view), the closed loop's estimates turned back to the raw camera. Nothing changes for a
+// pinhole pair. OpenScenarioSequence and OpenCachedSequence (sequence_cache.h) call it.
+bool RectifyScenarioSequence(const sim::Scenario& scenario,
+                             const sim::StereoCalibration& calibration, StereoSequence* sequence,
+                             std::string* error);
 // What such a sequence says of itself, from the scenario and its simulator's calibration:
 // every field but `next` (shared with the cached sequences of sequence_cache.h).
 void DescribeScenarioSequence(const sim::Scenario& scenario,

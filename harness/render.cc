@@ -36,17 +36,16 @@ DatasetWriter::Options ScenarioWriterOptions(const sim::Scenario& scenario,
 bool RenderScenario(const sim::Scenario& scenario, const std::string& out_dir,
                     const RenderOptions& options, RenderSummary* summary, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
-  if (const std::string problem =
-          CalibrationErrorProblem(scenario, options.format == DatasetFormat::kEuroc,
-                                  std::string("--format ") + DatasetFormatName(options.format));
-      !problem.empty()) {
-    *error = problem;
-    return false;
-  }
   std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
   DatasetWriter::Options wopt =
       ScenarioWriterOptions(scenario, simulator->calibration().T_body_cam0);
+  // A lens or a rotated cam1: EuRoC's side gets the raw frames, the KITTI/TUM/bag side them
+  // rectified by the exported calibration (DatasetWriter::Options::rectification).
+  auto rectification = std::make_shared<StereoRectification>();
+  if (!ExportedRectification(scenario, simulator->calibration(), rectification.get(), error))
+    return false;
+  if (!rectification->IsIdentity()) wopt.rectification = rectification;
   wopt.format = options.format;
   wopt.overwrite = options.overwrite;
   // EuRoC's body with the IMU: the cameras' T_BS relative to it, imu0/ from the frames' samples.

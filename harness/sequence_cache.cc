@@ -424,7 +424,7 @@ bool OpenCachedSequence(const sim::Scenario& scenario, int max_frames, const std
     ++next;
     return true;
   };
-  return true;
+  return RectifyScenarioSequence(scenario, index->calibration, sequence, error);
 }
 
 bool LockSharedFolder(const std::string& dir, FolderLock* lock, std::string* error) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 
+#include "harness/dataset/euroc_imu.h"
+
 namespace harness {
 
 namespace fs = std::filesystem;
@@ -53,17 +55,40 @@ Eigen::Matrix3d ExportedRotationCam0Cam1(const sim::Scenario& scenario) {
   return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()).toRotationMatrix();
 }
 
-std::string CalibrationErrorProblem(const sim::Scenario& scenario, bool euroc,
-                                    const std::string& where) {
-  if (!euroc && scenario.camera.distortion.any())
-    return scenario.source_path + ": camera.distortion: raw images of a lens cannot be " +
-           "exported to " + where + " (rectified images only); render it with --format euroc, " +
-           "whose sensor.yaml holds the lens for `eval --format euroc` to rectify";
-  if (euroc || scenario.calibration_error.rotation_deg == 0.0) return "";
-  return scenario.source_path + ": calibration_error.rotation_deg: a rotation between the " +
-         "cameras cannot be exported to " + where +
-         " (a rectified calibration: same orientation for both cameras); render it with " +
-         "--format euroc, whose cam1 sensor.yaml T_BS holds it";
+bool ExportedRectification(const sim::Scenario& scenario, const sim::StereoCalibration& calibration,
+                           StereoRectification* rectification, std::string* error) {
+  const vo::StereoCamera camera = ExportedStereoCamera(scenario, calibration);
+  const sim::LensDistortion& lens = scenario.camera.distortion;
+  const Eigen::Matrix3d R_cam0_cam1 = ExportedRotationCam0Cam1(scenario);
+  if (!lens.any() && R_cam0_cam1 == Eigen::Matrix3d::Identity()) {
+    *rectification = StereoRectification();
+    rectification->camera = camera;
+    return true;
+  }
+  Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
+  T_cam0_cam1.linear() = R_cam0_cam1;
+  T_cam0_cam1.translation() = Eigen::Vector3d(camera.baseline_m, 0.0, 0.0);
+  // cam0 in EuRoC's body, the IMU's (DatasetWriter::EurocBodyCam0), and cam1 beside it: the
+  // numbers render --format euroc writes (exactly, FormatDouble), so `eval` makes the same maps.
+  const Eigen::Isometry3d T_body_cam0 =
+      CameraInImuFrame(calibration.T_body_cam0, calibration.T_body_imu);
+  EurocCameraCalibration cam[2];
+  for (int i = 0; i < 2; ++i) {
+    EurocCameraCalibration& c = cam[i];
+    c.T_body_cam = i == 0 ? T_body_cam0 : T_body_cam0 * T_cam0_cam1;
+    c.fu_px = camera.fx_px;
+    c.fv_px = camera.fy_px;
+    c.cu_px = camera.cx_px;
+    c.cv_px = camera.cy_px;
+    c.camera_model = "pinhole";
+    c.distortion_model = lens.any() ? lens.model : sim::kRadTan;
+    c.distortion_coefficients = lens.any() ? lens.coeffs : std::vector<double>{0, 0, 0, 0};
+    c.width = camera.width;
+    c.height = camera.height;
+    c.rate_hz = scenario.rate_hz;
+    c.path = scenario.source_path + " (cam" + std::to_string(i) + " as exported)";
+  }
+  return ComputeStereoRectification(cam[0], cam[1], RectificationOptions(), rectification, error);
 }
 
 DatasetFrame ToDatasetFrame(const sim::StereoFrame& f) {

@@ -6,6 +6,8 @@
 //   ToStereoCamera(calib)     sim::StereoCalibration -> vo::StereoCamera (pinhole, rectified)
 //   ExportedStereoCamera(...)  the camera vobench exports: with the scenario's calibration_error
 //   ExportedRotationCam0Cam1   cam1's orientation in cam0 as exported (EuRoC's T_BS)
+//   ExportedRectification      what rectifies the raw frames of a lens or a rotated cam1 by
+//                              the exported calibration (as `eval --format euroc` does)
 //   ToDatasetFrame(frame)     sim::StereoFrame -> DatasetFrame (images, depth, ground truth,
 //                             the IMU samples since the previous frame)
 //
@@ -17,6 +19,7 @@
 #include <string>
 
 #include "harness/dataset.h"
+#include "harness/dataset/rectification.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 #include "vo/camera.h"
@@ -41,12 +44,16 @@ vo::StereoCamera ExportedStereoCamera(const sim::Scenario& scenario,
 // (the identity without it). Only EuRoC's sensor.yaml (cam1's T_BS) can hold it.
 Eigen::Matrix3d ExportedRotationCam0Cam1(const sim::Scenario& scenario);
 
-// "" when the scenario's calibration error can be exported where it goes, else why not:
-// calibration_error.rotation_deg needs EuRoC's T_BS, camera.distortion's raw images EuRoC's
-// sensor.yaml (`where` names the destination, e.g.
-// "--format kitti", "vobench run"; euroc = true: it goes to a EuRoC sequence).
-std::string CalibrationErrorProblem(const sim::Scenario& scenario, bool euroc,
-                                    const std::string& where);
+// The rectification of the scenario's raw frames by its exported calibration: the two cameras'
+// sensor.yaml as render --format euroc writes them (ExportedStereoCamera's intrinsics,
+// camera.distortion, cam1 at the exported baseline turned by ExportedRotationCam0Cam1) through
+// ComputeStereoRectification with the default RectificationOptions, the rectification that
+// `vobench eval --format euroc` computes from that export. The identity (the exported camera,
+// no maps) for a pinhole pair without a rotation: the frames are rectified already. The frames
+// the simulator renders are of the true rig, so a calibration error shows in the rectified
+// images as it would on a real rig calibrated that wrongly.
+bool ExportedRectification(const sim::Scenario& scenario, const sim::StereoCalibration& calibration,
+                           StereoRectification* rectification, std::string* error);
 
 // A simulated frame as a dataset frame (with ground truth and depth).
 DatasetFrame ToDatasetFrame(const sim::StereoFrame& frame);

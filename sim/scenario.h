@@ -131,8 +131,8 @@ struct ImuOptions {
 // focal lengths by (1 + focal_pct / 100) (the principal point stays); rotation_deg turns the
 // right camera about its own y axis (image down: a toe-in/out "yaw" between the cameras, the
 // error that biases disparity most) in EuRoC's cam1 T_BS. A rotation between the cameras has no
-// place in a rectified calibration (KITTI's calib.txt, the VO's vo::StereoCamera): it is written
-// to EuRoC only and refused elsewhere (CalibrationErrorProblem in harness/sim_adapter.h).
+// place in a rectified calibration (KITTI's calib.txt, the VO's vo::StereoCamera): there the
+// frames are rectified by the wrong calibration (ExportedRectification, harness/sim_adapter.h).
 // All 0 = the true calibration, byte for byte.
 struct CalibrationErrorOptions {
   double baseline_pct = 0.0;  // baseline error (% of the true baseline), > -100

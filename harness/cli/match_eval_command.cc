@@ -63,6 +63,16 @@ int RunMatchEval(const MatchEvalArgs& args) {
     std::fprintf(stderr, "vobench match-eval: %s\n", closed.c_str());
     return 2;
   }
+  if (scenario.camera.distortion.any() || scenario.calibration_error.rotation_deg != 0.0) {
+    // The frames would be rectified (RectifyScenarioSequence), and the depth that scores the
+    // matches is the raw view's, dropped with it.
+    std::fprintf(stderr,
+                 "vobench match-eval: %s: camera.distortion / calibration_error.rotation_deg: "
+                 "match-eval scores matches by the simulator's depth, which belongs to the raw "
+                 "view and is not rectified with the frames; evaluate the matchers without them\n",
+                 scenario.source_path.c_str());
+    return 2;
+  }
   MatchEvalOptions options;
   if (!args.config.empty()) {  // the matcher's options and its gate scale; the rest stays as it is
     vo::OdometryOptions vo_options;

@@ -193,6 +193,11 @@ bool DatasetWriter::Open(const std::string& dir, const vo::StereoCamera& camera,
   if (dir.empty()) return Fail(error, "DatasetWriter: empty output folder name");
   dir_ = NormalizeDir(dir);
   camera_ = camera;
+  rectify_ = options_.rectification && !options_.rectification->IsIdentity();
+  rectified_camera_ = rectify_ ? options_.rectification->camera : camera;
+  if (rectify_ && (options_.rectification->map0_x.cols != camera.width ||
+                   options_.rectification->map0_x.rows != camera.height))
+    return Fail(error, "DatasetWriter: the rectification's maps are not of the camera's size");
 
   // The partial folder: a marked, locked, unique sibling (output_folder.h); an existing DIR is
   // replaced only with overwrite, and only when it is a vobench dataset.
@@ -220,7 +225,7 @@ bool DatasetWriter::Open(const std::string& dir, const vo::StereoCamera& camera,
   if (options_.format == DatasetFormat::kRosbag) {
     bag_ = std::make_unique<RosbagWriter>();
     const std::string name = fs::path(RosbagPathInDataset(dir_)).filename().string();
-    if (!bag_->Open(Join(partial_dir_, name), camera_, options_.imu, error)) {
+    if (!bag_->Open(Join(partial_dir_, name), rectified_camera_, options_.imu, error)) {
       RemovePartial();
       return false;
     }
@@ -273,7 +278,8 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
     return Fail(error, what + "right image must be CV_8UC1 " + std::to_string(size.width) + "x" +
                            std::to_string(size.height) + ", got type " +
                            std::to_string(frame.right.type()) + " " + SizeText(frame.right));
-  const bool frame_depth = options_.write_depth && !frame.depth_m.empty();
+  // The depth belongs to the raw view: with a rectification no side writes it.
+  const bool frame_depth = options_.write_depth && !frame.depth_m.empty() && !rectify_;
   if (frame_depth && (frame.depth_m.type() != CV_32FC1 || frame.depth_m.size() != size))
     return Fail(error, what + "depth must be CV_32FC1 of the image size, got type " +
                            std::to_string(frame.depth_m.type()) + " " + SizeText(frame.depth_m));
@@ -292,18 +298,28 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
   if (has_gt_ && !frame.T_world_cam0.matrix().allFinite())
     return Fail(error, what + "ground-truth pose is not finite");
 
-  // Images: encode once, write the same bytes to every layout.
+  // Images: encode once, write the same bytes to every layout; with a rectification the EuRoC
+  // side gets the raw images, the others the rectified ones.
+  DatasetFrame rectified;
+  if (rectify_) {
+    rectified = frame;
+    RectifyFrame(*options_.rectification, &rectified);
+  }
+  const DatasetFrame& out = rectify_ ? rectified : frame;
   const std::string png_ns = std::to_string(stamp_ns) + ".png";
   for (int cam = 0; cam < 2; ++cam) {
-    std::vector<uchar> png;
-    if (!cv::imencode(".png", cam == 0 ? frame.left : frame.right, png, compression_params_))
+    std::vector<uchar> png, raw_png;
+    if (!cv::imencode(".png", cam == 0 ? out.left : out.right, png, compression_params_) ||
+        (rectify_ && options_.format == DatasetFormat::kEuroc &&
+         !cv::imencode(".png", cam == 0 ? frame.left : frame.right, raw_png, compression_params_)))
       return Fail(error, what + "PNG encoding failed");
     const std::string cam_name = std::to_string(cam);
     if (!WriteBytes(Join(partial_dir_, "image_" + cam_name + "/" + FrameName(index, ".png")), png,
                     error))
       return false;
     if (options_.format == DatasetFormat::kEuroc &&
-        !WriteBytes(Join(partial_dir_, "mav0/cam" + cam_name + "/data/" + png_ns), png, error))
+        !WriteBytes(Join(partial_dir_, "mav0/cam" + cam_name + "/data/" + png_ns),
+                    rectify_ ? raw_png : png, error))
       return false;
     if (options_.format == DatasetFormat::kTum &&
         !WriteBytes(
@@ -320,7 +336,7 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
     if (!WriteBytes(Join(partial_dir_, "depth/" + FrameName(index, ".png")), png, error))
       return false;
   }
-  if (bag_ && !bag_->Add(frame, depth_mm, stamp_ns, options_.stamp_offset_ns, error)) return false;
+  if (bag_ && !bag_->Add(out, depth_mm, stamp_ns, options_.stamp_offset_ns, error)) return false;
   times_s_.push_back(frame.time_s);
   stamps_ns_.push_back(stamp_ns);
   if (has_gt_) T_world_cam0_.push_back(frame.T_world_cam0);
@@ -398,6 +414,13 @@ bool DatasetWriter::WriteEurocGroundTruth(std::string* error) const {
          WriteTextFile(Join(gt_dir, "sensor.yaml"), EurocGroundTruthYaml(), error);
 }
 
+Eigen::Isometry3d DatasetWriter::LeftCameraPose(size_t i) const {
+  if (!rectify_) return T_world_cam0_[i];
+  Eigen::Isometry3d T_cam0_rect0 = Eigen::Isometry3d::Identity();
+  T_cam0_rect0.linear() = options_.rectification->R_cam0_rect0;
+  return T_world_cam0_[i] * T_cam0_rect0;
+}
+
 bool DatasetWriter::WriteTumText(std::string* error) const {
   const char* names[2] = {"left", "right"};
   for (int cam = 0; cam < 2; ++cam) {
@@ -415,8 +438,9 @@ bool DatasetWriter::WriteTumText(std::string* error) const {
   std::string gt = "# ground truth: left camera in the world (vobench TUM-style stereo layout)\n";
   gt += "# timestamp tx ty tz qx qy qz qw\n";
   for (size_t i = 0; i < stamps_ns_.size(); ++i) {
-    const Eigen::Vector3d t = T_world_cam0_[i].translation();
-    const Eigen::Quaterniond q = CanonicalQuaternion(T_world_cam0_[i].linear());
+    const Eigen::Isometry3d T = LeftCameraPose(i);
+    const Eigen::Vector3d t = T.translation();
+    const Eigen::Quaterniond q = CanonicalQuaternion(T.linear());
     gt += TumStampText(stamps_ns_[i]);
     for (double x : {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}) gt += ' ' + FormatDouble(x);
     gt += '\n';
@@ -431,11 +455,12 @@ bool DatasetWriter::Finish(std::string* error) {
   // calib.txt as KITTI odometry's: rectified projection matrices, P1 = K [I | (-fx baseline_m, 0,
   // 0)]; P2/P3 (KITTI's colour pair) repeat P0/P1, Tr (velodyne to cam0) is the identity: the
   // tools read all five (pykitti: P_rect_20, T_cam0_velo; cv::datasets::SLAM_kitti).
-  const double P0[12] = {
-      camera_.fx_px, 0, camera_.cx_px, 0, 0, camera_.fy_px, camera_.cy_px, 0, 0, 0, 1, 0};
+  // With a rectification: the rectified camera (the KITTI side holds the rectified images).
+  const vo::StereoCamera& c = rectified_camera_;
+  const double P0[12] = {c.fx_px, 0, c.cx_px, 0, 0, c.fy_px, c.cy_px, 0, 0, 0, 1, 0};
   double P1[12];
   std::copy(P0, P0 + 12, P1);
-  P1[3] = -(camera_.fx_px * camera_.baseline_m);
+  P1[3] = -(c.fx_px * c.baseline_m);
   const double Tr[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
   if (!WriteTextFile(Join(partial_dir_, "calib.txt"),
                      CalibRow("P0:", P0) + CalibRow("P1:", P1) + CalibRow("P2:", P0) +
@@ -448,18 +473,21 @@ bool DatasetWriter::Finish(std::string* error) {
     return false;
 
   if (has_gt_) {
-    // Ground truth relative to the first left camera, as KITTI's poses.txt.
-    const Eigen::Isometry3d T_cam0first_world = T_world_cam0_.front().inverse();
+    // Ground truth relative to the first left camera, as KITTI's poses.txt (with a
+    // rectification: of the rectified left camera, whose images the KITTI side holds).
+    std::vector<Eigen::Isometry3d> T_world_left;
+    for (size_t i = 0; i < T_world_cam0_.size(); ++i) T_world_left.push_back(LeftCameraPose(i));
+    const Eigen::Isometry3d T_cam0first_world = T_world_left.front().inverse();
     std::vector<Eigen::Isometry3d> poses;
     std::vector<StampedPose> tum;
     for (size_t i = 0; i < times_s_.size(); ++i) {
       poses.push_back(i == 0 ? Eigen::Isometry3d::Identity()
-                             : T_cam0first_world * T_world_cam0_[i]);
+                             : T_cam0first_world * T_world_left[i]);
       tum.push_back({times_s_[i], poses.back()});
     }
     if (!WriteKittiPoses(Join(partial_dir_, "poses.txt"), poses, error) ||
         !WriteTum(Join(partial_dir_, "groundtruth_tum.txt"), tum, error) ||
-        !WriteKittiPoses(Join(partial_dir_, "T_world_cam0first.txt"), {T_world_cam0_.front()},
+        !WriteKittiPoses(Join(partial_dir_, "T_world_cam0first.txt"), {T_world_left.front()},
                          error))
       return false;
   }

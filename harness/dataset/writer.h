@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "harness/dataset/common.h"
+#include "harness/dataset/rectification.h"
 #include "harness/dataset/rig.h"
 #include "harness/dataset/rosbag.h"
 #include "harness/output_folder.h"
@@ -80,6 +81,14 @@ class DatasetWriter {
     // EuRoC: both cameras' lens in sensor.yaml (distortion_model, distortion_coefficients); the
     // images are then the raw ones of that lens. None: radial-tangential [0, 0, 0, 0].
     sim::LensDistortion lens;
+    // Raw frames of a lens or of a pair whose calibration holds a rotation (null or identity:
+    // the frames are rectified already). The EuRoC side writes the frames as they are with the
+    // raw calibration (Open's camera, `lens`, R_cam0_cam1); every other side (the KITTI layout,
+    // TUM, the bag) writes them rectified by this (RectifyFrame: the images remapped, the ground
+    // truth of the rectified left camera, no depth), with its rectified camera in calib.txt, as
+    // `vobench eval --format euroc` rectifies that EuRoC side (the same maps: the exported
+    // numbers read back exactly). Made by ExportedRectification (harness/sim_adapter.h).
+    std::shared_ptr<const StereoRectification> rectification;
 
     bool IsValid(std::string* error) const;
   };
@@ -118,9 +127,14 @@ class DatasetWriter {
   bool WriteEurocCamera(int cam, double rate_hz, std::string* error) const;
   bool WriteEurocGroundTruth(std::string* error) const;
   bool WriteTumText(std::string* error) const;
+  // Frame i's ground truth as the KITTI/TUM/bag side holds it: the rectified left camera's pose
+  // with a rectification (RectifyFrame's), the frame's own otherwise.
+  Eigen::Isometry3d LeftCameraPose(size_t i) const;
 
   Options options_;
-  vo::StereoCamera camera_;
+  vo::StereoCamera camera_;            // the frames' camera (raw with a rectification)
+  vo::StereoCamera rectified_camera_;  // the KITTI/TUM/bag side's: camera_ or the rectified one
+  bool rectify_ = false;               // options_.rectification is not the identity
   std::string dir_;
   OutputFolder folder_;      // the marked, locked work folder and its publishing
   std::string partial_dir_;  // folder_.path() while open
@@ -129,7 +143,7 @@ class DatasetWriter {
   bool has_depth_ = false;
   std::vector<double> times_s_;
   std::vector<int64_t> stamps_ns_;               // the EuRoC/TUM stamps: stamp_offset_ns + t_ns
-  std::vector<Eigen::Isometry3d> T_world_cam0_;  // one per frame when has_gt_
+  std::vector<Eigen::Isometry3d> T_world_cam0_;  // one per frame when has_gt_ (raw camera's)
   std::vector<sim::ImuSample> imu_;              // the frames' IMU samples (kEuroc)
   std::vector<int> compression_params_;
   std::unique_ptr<RosbagWriter> bag_;  // kRosbag: the bag in the partial folder

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +14,7 @@
 #include <utility>
 
 #include "harness/dataset.h"
+#include "harness/dataset/rectification.h"
 #include "harness/dataset/rig.h"
 #include "harness/pipeline.h"
 #include "tests/harness/cli_test_util.h"
@@ -117,6 +120,41 @@ TEST(RenderTest, DatasetOnDiskEqualsTheSimulationAndIsDeterministic) {
 // configured (baseline and focal scaled, cam1's T_BS turned about its y axis); the images are
 // the same bytes; the in-memory sequence's camera has the same error; the rotation, which a
 // rectified calibration cannot hold, is refused for KITTI and `run`, nothing written.
+// The KITTI side of a render with a lens or a rotated cam1 (`dir`, rendered --format euroc)
+// holds the EuRoC side's raw frames rectified exactly as `eval --format euroc` rectifies them:
+// the same camera in calib.txt, the same images bit for bit, the rectified left camera's ground
+// truth, no depth. Returns the rectified camera.
+vo::StereoCamera ExpectKittiSideIsEvalsRectification(const std::string& dir) {
+  std::string error;
+  harness::EurocReader euroc;
+  harness::KittiReader kitti;
+  EXPECT_TRUE(euroc.Open(dir, &error)) << error;
+  EXPECT_TRUE(kitti.Open(dir, &error)) << error;
+  harness::StereoRectification rectification;
+  EXPECT_TRUE(euroc.Rectification(&rectification, &error)) << error;
+  EXPECT_FALSE(rectification.IsIdentity());
+  const vo::StereoCamera& c = rectification.camera;
+  EXPECT_EQ(kitti.camera().fx_px, c.fx_px);
+  EXPECT_EQ(kitti.camera().cx_px, c.cx_px);
+  EXPECT_EQ(kitti.camera().cy_px, c.cy_px);
+  EXPECT_NEAR(kitti.camera().baseline_m, c.baseline_m, 1e-15);  // calib.txt holds -fx b
+  EXPECT_FALSE(fs::exists(fs::path(dir) / "depth"));
+  EXPECT_EQ(kitti.size(), euroc.size());
+  harness::DatasetFrame raw, rectified;
+  for (size_t i = 0; i < euroc.size(); i += 7) {
+    EXPECT_TRUE(euroc.ReadFrame(i, &raw, &error)) << error;
+    EXPECT_TRUE(kitti.ReadFrame(i, &rectified, &error)) << error;
+    harness::RectifyFrame(rectification, &raw);
+    EXPECT_EQ(cv::norm(raw.left, rectified.left, cv::NORM_INF), 0.0) << "frame " << i;
+    EXPECT_EQ(cv::norm(raw.right, rectified.right, cv::NORM_INF), 0.0) << "frame " << i;
+    // The ground truth of the rectified left camera, as eval's rectification turns it.
+    EXPECT_LT((rectified.T_world_cam0.matrix() - raw.T_world_cam0.matrix()).cwiseAbs().maxCoeff(),
+              1e-9)
+        << "frame " << i;
+  }
+  return c;
+}
+
 TEST(RenderTest, CalibrationErrorChangesOnlyTheExportedCalibration) {
   TempDir dir("render");
   const std::string truth = ShortScenario(dir);
@@ -124,27 +162,35 @@ TEST(RenderTest, CalibrationErrorChangesOnlyTheExportedCalibration) {
   WriteText(wrong, ReadAll(truth) +
                        "calibration_error:\n  baseline_pct: 2\n  focal_pct: -1.5\n"
                        "  rotation_deg: 0.7\n");
-  for (const auto& [yaml, out] : {std::pair{truth, dir / "a"}, std::pair{wrong, dir / "b"}}) {
+  const std::string scaled = dir / "scaled.yaml";
+  WriteText(scaled, ReadAll(truth) + "calibration_error:\n  baseline_pct: 2\n  focal_pct: -1.5\n");
+  for (const auto& [yaml, out] : {std::pair{truth, dir / "a"}, std::pair{wrong, dir / "b"},
+                                  std::pair{scaled, dir / "s"}}) {
     const auto r = RunVobench("render " + yaml + " --out " + out + " -q --format euroc");
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
+  // The images are the true rig's: every PNG of the scaled render, and the raw (EuRoC) ones of
+  // the rotated render, equal the true calibration's.
   size_t images = 0;
   for (const auto& e : fs::recursive_directory_iterator(dir / "a"))
     if (e.is_regular_file() && e.path().extension() == ".png") {
       const std::string f = fs::relative(e.path(), dir / "a").string();
-      EXPECT_EQ(ReadAll(fs::path(dir / "b") / f), ReadAll(e.path().string())) << f;
+      EXPECT_EQ(ReadAll(fs::path(dir / "s") / f), ReadAll(e.path().string())) << f;
+      if (f.rfind("mav0/", 0) == 0) {
+        EXPECT_EQ(ReadAll(fs::path(dir / "b") / f), ReadAll(e.path().string())) << f;
+      }
       ++images;
     }
   EXPECT_GT(images, 20u);
   std::string error;
-  harness::KittiReader a, b;
+  harness::KittiReader a, s;
   ASSERT_TRUE(a.Open(dir / "a", &error)) << error;
-  ASSERT_TRUE(b.Open(dir / "b", &error)) << error;
-  EXPECT_NEAR(b.camera().baseline_m, a.camera().baseline_m * 1.02, 1e-12);
-  EXPECT_NEAR(b.camera().fx_px, a.camera().fx_px * 0.985, 1e-9);
-  EXPECT_NEAR(b.camera().fy_px, a.camera().fy_px * 0.985, 1e-9);
-  EXPECT_EQ(b.camera().cx_px, a.camera().cx_px);
-  EXPECT_EQ(b.camera().cy_px, a.camera().cy_px);
+  ASSERT_TRUE(s.Open(dir / "s", &error)) << error;
+  EXPECT_NEAR(s.camera().baseline_m, a.camera().baseline_m * 1.02, 1e-12);
+  EXPECT_NEAR(s.camera().fx_px, a.camera().fx_px * 0.985, 1e-9);
+  EXPECT_NEAR(s.camera().fy_px, a.camera().fy_px * 0.985, 1e-9);
+  EXPECT_EQ(s.camera().cx_px, a.camera().cx_px);
+  EXPECT_EQ(s.camera().cy_px, a.camera().cy_px);
   harness::EurocCameraCalibration a0, a1, b0, b1;
   for (const auto& [folder, cam, calib] :
        {std::tuple{dir / "a", "cam0", &a0}, std::tuple{dir / "a", "cam1", &a1},
@@ -162,23 +208,58 @@ TEST(RenderTest, CalibrationErrorChangesOnlyTheExportedCalibration) {
   EXPECT_NEAR(turn.angle(), 0.7 * M_PI / 180.0, 1e-12);
   EXPECT_NEAR(std::abs(turn.axis().y()), 1.0, 1e-12);  // about the camera's y axis
 
-  // `run`'s sequence in memory: the same scaled camera; the rotation refused.
+  // The rotation has no place in a rectified calibration: the KITTI side holds the raw frames
+  // rectified by the wrong calibration, as a real rig calibrated that wrongly would give them.
+  const vo::StereoCamera rectified = ExpectKittiSideIsEvalsRectification(dir / "b");
+
+  // `run`'s sequence in memory: the same rectified camera; without the rotation the scaled
+  // camera itself, and the frames as rendered.
   sim::Scenario scenario;
   ASSERT_TRUE(sim::LoadScenario(wrong, &scenario, &error)) << error;
   harness::StereoSequence sequence;
-  EXPECT_FALSE(harness::OpenScenarioSequence(scenario, &sequence, &error));
-  EXPECT_NE(error.find("calibration_error.rotation_deg"), std::string::npos) << error;
-  scenario.calibration_error.rotation_deg = 0.0;
-  error.clear();
   ASSERT_TRUE(harness::OpenScenarioSequence(scenario, &sequence, &error)) << error;
-  EXPECT_EQ(sequence.camera.baseline_m, b.camera().baseline_m);
-  EXPECT_EQ(sequence.camera.fx_px, b.camera().fx_px);
+  EXPECT_EQ(sequence.camera.fx_px, rectified.fx_px);
+  EXPECT_EQ(sequence.camera.baseline_m, rectified.baseline_m);
+  scenario.calibration_error.rotation_deg = 0.0;
+  ASSERT_TRUE(harness::OpenScenarioSequence(scenario, &sequence, &error)) << error;
+  EXPECT_EQ(sequence.camera.baseline_m, s.camera().baseline_m);
+  EXPECT_EQ(sequence.camera.fx_px, s.camera().fx_px);
+
+  // --format kitti writes the same rectified frames as the EuRoC render's KITTI side.
   const auto k = RunVobench("render " + wrong + " --out " + (dir / "k") + " -q --format kitti");
-  EXPECT_NE(k.exit_code, 0);
-  EXPECT_NE(k.output.find("rotation_deg: a rotation between the cameras cannot be exported"),
-            std::string::npos)
-      << k.output;
-  EXPECT_FALSE(fs::exists(dir / "k"));
+  ASSERT_EQ(k.exit_code, 0) << k.output;
+  const fs::path k_dir = dir / "k", b_dir = dir / "b";
+  EXPECT_EQ(ReadAll(k_dir / "calib.txt"), ReadAll(b_dir / "calib.txt"));
+  for (const char* f : {"image_0/000000.png", "image_1/000000.png", "image_0/000020.png"})
+    EXPECT_EQ(ReadAll(k_dir / f), ReadAll(b_dir / f)) << f;
+  EXPECT_FALSE(fs::exists(k_dir / "mav0"));
+}
+
+TEST(RenderTest, ALensIsRawInEurocAndRectifiedElsewhereAsEvalRectifiesIt) {
+  TempDir dir("render_lens");
+  for (const char* lens : {"{model: radtan, coeffs: [-0.28, 0.07, 0.0002, 0.00002]}",
+                           "{model: equidistant, coeffs: [0.05, -0.01, 0.002, -0.0005]}"}) {
+    const std::string yaml = ShortScenario(dir, std::string("camera:\n  distortion: ") + lens +
+                                                    "\n");
+    const std::string euroc = dir / "euroc";
+    fs::remove_all(euroc);
+    const auto r = RunVobench("render " + yaml + " --out " + euroc + " -q --format euroc");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    ExpectKittiSideIsEvalsRectification(euroc);
+    // `vobench run` gives the VO those frames: its trajectory is eval's on the EuRoC side, bit for
+    // bit (the same images and camera; the stamps differ, which the VO only records).
+    WriteText(dir / "free.yaml", "platform: free\n");
+    const std::string config = " --config " + (dir / "free.yaml") + " -q --no-plots --out ";
+    fs::remove_all(dir / "run");
+    fs::remove_all(dir / "eval");
+    const auto run = RunVobench("run " + yaml + config + (dir / "run"));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const auto eval = RunVobench("eval --format euroc --dataset " + euroc + config + (dir / "eval"));
+    ASSERT_EQ(eval.exit_code, 0) << eval.output;
+    const std::string trajectory = ReadAll(fs::path(dir / "run") / "trajectory_kitti.txt");
+    EXPECT_GT(trajectory.size(), 100u);
+    EXPECT_EQ(trajectory, ReadAll(fs::path(dir / "eval") / "trajectory_kitti.txt")) << lens;
+  }
 }
 
 class RenderBadInputTest : public ::testing::Test {
