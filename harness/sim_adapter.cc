@@ -55,12 +55,16 @@ Eigen::Matrix3d ExportedRotationCam0Cam1(const sim::Scenario& scenario) {
   return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()).toRotationMatrix();
 }
 
+bool ExportsRawFrames(const sim::Scenario& scenario) {
+  return scenario.camera.distortion.any() || scenario.calibration_error.rotation_deg != 0.0;
+}
+
 bool ExportedRectification(const sim::Scenario& scenario, const sim::StereoCalibration& calibration,
                            StereoRectification* rectification, std::string* error) {
   const vo::StereoCamera camera = ExportedStereoCamera(scenario, calibration);
   const sim::LensDistortion& lens = scenario.camera.distortion;
   const Eigen::Matrix3d R_cam0_cam1 = ExportedRotationCam0Cam1(scenario);
-  if (!lens.any() && R_cam0_cam1 == Eigen::Matrix3d::Identity()) {
+  if (!ExportsRawFrames(scenario)) {
     *rectification = StereoRectification();
     rectification->camera = camera;
     return true;

@@ -54,6 +54,9 @@ Eigen::Matrix3d ExportedRotationCam0Cam1(const sim::Scenario& scenario);
 // images as it would on a real rig calibrated that wrongly.
 bool ExportedRectification(const sim::Scenario& scenario, const sim::StereoCalibration& calibration,
                            StereoRectification* rectification, std::string* error);
+// Whether the scenario's exported calibration needs that rectification: a lens
+// (camera.distortion) or a rotated cam1 (calibration_error.rotation_deg).
+bool ExportsRawFrames(const sim::Scenario& scenario);
 
 // A simulated frame as a dataset frame (with ground truth and depth).
 DatasetFrame ToDatasetFrame(const sim::StereoFrame& frame);

@@ -63,7 +63,7 @@ int RunMatchEval(const MatchEvalArgs& args) {
     std::fprintf(stderr, "vobench match-eval: %s\n", closed.c_str());
     return 2;
   }
-  if (scenario.camera.distortion.any() || scenario.calibration_error.rotation_deg != 0.0) {
+  if (ExportsRawFrames(scenario)) {
     // The frames would be rectified (RectifyScenarioSequence), and the depth that scores the
     // matches is the raw view's, dropped with it.
     std::fprintf(stderr,

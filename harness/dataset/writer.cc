@@ -481,8 +481,7 @@ bool DatasetWriter::Finish(std::string* error) {
     std::vector<Eigen::Isometry3d> poses;
     std::vector<StampedPose> tum;
     for (size_t i = 0; i < times_s_.size(); ++i) {
-      poses.push_back(i == 0 ? Eigen::Isometry3d::Identity()
-                             : T_cam0first_world * T_world_left[i]);
+      poses.push_back(i == 0 ? Eigen::Isometry3d::Identity() : T_cam0first_world * T_world_left[i]);
       tum.push_back({times_s_[i], poses.back()});
     }
     if (!WriteKittiPoses(Join(partial_dir_, "poses.txt"), poses, error) ||

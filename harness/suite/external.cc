@@ -112,8 +112,11 @@ bool SharedSequence(const ExternalRunSpec& spec, const fs::path& datasets_dir, f
   *dir = full.string() + "_k" + std::to_string(spec.stride);
   FolderLock lock;
   if (!LockSharedFolder(dir->string(), &lock, error)) return false;
+  // The copy reads the KITTI side back: with raw frames (a lens, a rotated cam1) that side is
+  // rectified, so such a sequence is simulated at its stride instead.
   return HasFolderMarker(dir->string(), "dataset") ||
-         WriteStridedCopy(spec, full.string(), dir->string(), error);
+         (ExportsRawFrames(scenario) ? WriteSequence(spec, dir->string(), error)
+                                     : WriteStridedCopy(spec, full.string(), dir->string(), error));
 }
 
 bool CopyFile(const fs::path& from, const fs::path& to, std::string* error) {
@@ -130,9 +133,15 @@ bool WriteSequence(const ExternalRunSpec& spec, const std::string& dir, std::str
   if (!sim::LoadScenario(spec.scenario_path, &scenario, error)) return false;
   std::unique_ptr<sim::Simulator> simulator = sim::Simulator::Create(scenario, error);
   if (!simulator) return false;
-  DatasetWriter writer(SequenceWriterOptions(scenario, spec.stride,
-                                             simulator->calibration().T_body_cam0,
-                                             simulator->calibration().T_body_imu));
+  DatasetWriter::Options options =
+      SequenceWriterOptions(scenario, spec.stride, simulator->calibration().T_body_cam0,
+                            simulator->calibration().T_body_imu);
+  // A lens or a rotated cam1: {euroc} gets the raw frames, {dataset} them rectified (render's).
+  auto rectification = std::make_shared<StereoRectification>();
+  if (!ExportedRectification(scenario, simulator->calibration(), rectification.get(), error))
+    return false;
+  if (!rectification->IsIdentity()) options.rectification = rectification;
+  DatasetWriter writer(options);
   if (!writer.Open(dir, ExportedStereoCamera(scenario, simulator->calibration()), error))
     return false;
   sim::StereoFrame frame;

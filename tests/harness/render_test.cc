@@ -4,11 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/core.hpp>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core.hpp>
 #include <sstream>
 #include <tuple>
 #include <utility>
@@ -164,8 +163,8 @@ TEST(RenderTest, CalibrationErrorChangesOnlyTheExportedCalibration) {
                        "  rotation_deg: 0.7\n");
   const std::string scaled = dir / "scaled.yaml";
   WriteText(scaled, ReadAll(truth) + "calibration_error:\n  baseline_pct: 2\n  focal_pct: -1.5\n");
-  for (const auto& [yaml, out] : {std::pair{truth, dir / "a"}, std::pair{wrong, dir / "b"},
-                                  std::pair{scaled, dir / "s"}}) {
+  for (const auto& [yaml, out] :
+       {std::pair{truth, dir / "a"}, std::pair{wrong, dir / "b"}, std::pair{scaled, dir / "s"}}) {
     const auto r = RunVobench("render " + yaml + " --out " + out + " -q --format euroc");
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
@@ -239,8 +238,8 @@ TEST(RenderTest, ALensIsRawInEurocAndRectifiedElsewhereAsEvalRectifiesIt) {
   TempDir dir("render_lens");
   for (const char* lens : {"{model: radtan, coeffs: [-0.28, 0.07, 0.0002, 0.00002]}",
                            "{model: equidistant, coeffs: [0.05, -0.01, 0.002, -0.0005]}"}) {
-    const std::string yaml = ShortScenario(dir, std::string("camera:\n  distortion: ") + lens +
-                                                    "\n");
+    const std::string yaml =
+        ShortScenario(dir, std::string("camera:\n  distortion: ") + lens + "\n");
     const std::string euroc = dir / "euroc";
     fs::remove_all(euroc);
     const auto r = RunVobench("render " + yaml + " --out " + euroc + " -q --format euroc");
@@ -254,7 +253,8 @@ TEST(RenderTest, ALensIsRawInEurocAndRectifiedElsewhereAsEvalRectifiesIt) {
     fs::remove_all(dir / "eval");
     const auto run = RunVobench("run " + yaml + config + (dir / "run"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
-    const auto eval = RunVobench("eval --format euroc --dataset " + euroc + config + (dir / "eval"));
+    const auto eval =
+        RunVobench("eval --format euroc --dataset " + euroc + config + (dir / "eval"));
     ASSERT_EQ(eval.exit_code, 0) << eval.output;
     const std::string trajectory = ReadAll(fs::path(dir / "run") / "trajectory_kitti.txt");
     EXPECT_GT(trajectory.size(), 100u);

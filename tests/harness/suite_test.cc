@@ -21,7 +21,9 @@
 
 #include "harness/dataset/writer.h"
 #include "harness/output_folder.h"
+#include "harness/sim_adapter.h"
 #include "harness/suite/folder.h"
+#include "harness/trajectory_io.h"
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
 
@@ -858,6 +860,52 @@ TEST(SuiteExternalTest, AStridedCopyOfASequenceWithDroppedFramesEqualsItsSimulat
   std::vector<std::string> full, direct;
   ExpectStridedCopyEqualsSimulation(dir, dir / "drops.yaml", 6, 2, &full, &direct);
   EXPECT_LT(direct.size(), full.size());  // frame 5's samples
+}
+
+// Issue #34: a lens goes to {euroc} raw, with its calibration, and to {dataset} rectified by
+// that calibration (render's KITTI side); a strided sequence of such a scenario is simulated at
+// its stride (the copy would read the rectified side back) and holds the same frames.
+TEST(SuiteExternalTest, ALensIsRawInEurocAndRectifiedInTheDataset) {
+  TempDir dir("suite_ext_lens");
+  WriteText(dir / "lens.sh",
+            "#!/bin/sh\ncp \"$1/calib.txt\" \"$3/calib.txt\" && "
+            "cp \"$2/mav0/cam0/sensor.yaml\" \"$3/cam0.yaml\" && "
+            "cp \"$1/image_0/000001.png\" \"$3/f1.png\" && "
+            "{ cp \"$1/image_0/000002.png\" \"$3/f2.png\" || true; } && "
+            "test ! -d \"$1/depth\" && cp \"$1/poses.txt\" \"$3/t.txt\"\n");
+  fs::permissions(dir / "lens.sh", fs::perms::owner_all);
+  const std::string lens = "{model: radtan, coeffs: [-0.28, 0.07, 0.0002, 0.00002]}";
+  WriteText(dir / "suite.yaml",
+            "name: extlens\nmax_frames: 5\nstrides: [1, 2]\nscenarios:\n  - scenario: l_hallway\n"
+            "    set: {camera.distortion: " +
+                lens +
+                "}\n"
+                "configs:\n  - name: lens\n    external: {command: [./lens.sh, \"{dataset}\", "
+                "\"{euroc}\", \"{out}\"], trajectory: t.txt, format: kitti}\n");
+  const std::string out = dir / "out";
+  const auto r = RunVobench("suite " + (dir / "suite.yaml") + " -q -j 1 --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 ok (2 run now"), std::string::npos) << r.output;
+  const std::string k1 = out + "/runs/l_hallway__lens__s1__k1/estimate/";
+  const std::string k2 = out + "/runs/l_hallway__lens__s1__k2/estimate/";
+  EXPECT_NE(ReadAll(k1 + "cam0.yaml").find("distortion_coefficients: [-0.28, 0.07"),
+            std::string::npos);
+  // calib.txt: the rectified camera of the exported calibration.
+  sim::Scenario s;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(sim::BuiltinScenarioPath("l_hallway"), &s, &error)) << error;
+  s.camera.distortion = {sim::kRadTan, {-0.28, 0.07, 0.0002, 0.00002}};
+  auto simulator = sim::Simulator::Create(s, &error);
+  ASSERT_TRUE(simulator) << error;
+  harness::StereoRectification rectification;
+  ASSERT_TRUE(harness::ExportedRectification(s, simulator->calibration(), &rectification, &error))
+      << error;
+  ASSERT_FALSE(rectification.IsIdentity());
+  const std::string calib = ReadAll(k1 + "calib.txt");
+  EXPECT_EQ(calib.rfind("P0: " + harness::FormatDouble(rectification.camera.fx_px) + " ", 0), 0u)
+      << calib;
+  EXPECT_EQ(ReadAll(k2 + "calib.txt"), calib);
+  EXPECT_EQ(ReadAll(k2 + "f1.png"), ReadAll(k1 + "f2.png"));  // source frame 2 in both
 }
 
 // Issues #33/#36: an external command finds the IMU in {euroc} as `render --format euroc` writes
