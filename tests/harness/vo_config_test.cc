@@ -46,7 +46,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
   std::map<std::string, int> counts;
   CountLeaves(yaml, "", &counts);
   const Recorded recorded[] = {
-      {"OdometryOptions", sizeof(vo::OdometryOptions), 1656},
+      {"OdometryOptions", sizeof(vo::OdometryOptions), 1704},
       {"FrontEndOptions", sizeof(vo::FrontEndOptions), 304},
       {"InitialOrientationOptions", sizeof(vo::InitialOrientationOptions), 192},
       {"TrackerOptions", sizeof(vo::TrackerOptions), 544},
@@ -76,6 +76,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
       {"ImageShiftOptions", sizeof(vo::ImageShiftOptions), 56},
       {"BridgeAlignmentOptions", sizeof(vo::BridgeAlignmentOptions), 32},
       {"DirectAlignmentOptions", sizeof(vo::DirectAlignmentOptions), 96},
+      {"ImuOptions", sizeof(vo::ImuOptions), 48},
   };
   for (const Recorded& r : recorded)
     EXPECT_EQ(r.size, r.recorded_size)
@@ -117,6 +118,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
       {"back_end.ba", 12},
       {"back_end.vehicle_planar", 4},
       {"back_end.flat_floor", 3},
+      {"imu", 7},
   };
   EXPECT_EQ(counts, expected);
 }
