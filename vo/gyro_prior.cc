@@ -30,10 +30,11 @@ constexpr double kMaxSampleGapS = 1.0;
 
 bool ImuOptions::IsValid(std::string* error) const {
   std::ostringstream msg;
-  if (!(min_rotation_sigma_deg > 0.0) ||
-      !std::isfinite(min_rotation_sigma_deg)) {
-    msg << "min_rotation_sigma_deg must be finite and > 0, got "
-        << min_rotation_sigma_deg;
+  if (!(min_rotation_sigma_deg > 0.0) || !std::isfinite(min_rotation_sigma_deg)) {
+    msg << "min_rotation_sigma_deg must be finite and > 0, got " << min_rotation_sigma_deg;
+  } else if (!(max_weak_rotation_error_deg > 0.0) || !std::isfinite(max_weak_rotation_error_deg)) {
+    msg << "max_weak_rotation_error_deg must be finite and > 0, got "
+        << max_weak_rotation_error_deg;
   } else if (!(initial_bias_sigma_radps >= 0.0) || !std::isfinite(initial_bias_sigma_radps)) {
     msg << "initial_bias_sigma_radps must be finite and >= 0, got " << initial_bias_sigma_radps;
   } else if (!(bias_gain >= 0.0 && bias_gain <= 1.0)) {

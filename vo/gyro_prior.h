@@ -50,15 +50,25 @@ struct ImuOptions {
                                  // any platform: its rotation is the gyro's (σ below), the
                                  // few matches measure the translation; off: as
                                  // motion.few_point_motion says
-  double min_rotation_sigma_deg = 0.05;     // σ of the gyro's rotation as a prior term (the
-                                            // few-point motion's rotation prior, the direct
-                                            // alignment's yaw prior): the gyro's own σ, at least
-                                            // this (degrees; the IMU's mounting and time stamps
-                                            // are not exact), > 0
-  double initial_bias_sigma_radps = 0.005;  // σ of the bias before any estimate (rad/s), >= 0
-  double bias_gain = 0.2;                   // each stretch's bias observation moves the
-                                            // estimate this part of the way, in [0, 1]
-                                            // (0: the bias stays 0)
+  bool few_point_after_loss = true;  // ... also after lost frames (the motion stage's own
+                                     // few-point motion waits for a measured frame): the
+                                     // rotation since the reference is the gyro's, the few
+                                     // matches measure the translation the constant velocity
+                                     // extrapolated
+  double max_weak_rotation_error_deg = 0.5;  // a weak RANSAC motion (fewer than
+                                             // motion.reliable_min_inliers inliers) whose
+                                             // rotation is farther than this from the gyro's
+                                             // (degrees) is no consensus (the few-point motion
+                                             // instead), > 0
+  double min_rotation_sigma_deg = 0.05;      // σ of the gyro's rotation as a prior term (the
+                                             // few-point motion's rotation prior, the direct
+                                             // alignment's yaw prior): the gyro's own σ, at least
+                                             // this (degrees; the IMU's mounting and time stamps
+                                             // are not exact), > 0
+  double initial_bias_sigma_radps = 0.005;   // σ of the bias before any estimate (rad/s), >= 0
+  double bias_gain = 0.2;                    // each stretch's bias observation moves the
+                                             // estimate this part of the way, in [0, 1]
+                                             // (0: the bias stays 0)
   double bias_window_s = 2.0;    // a stretch of well-tracked frames this long (seconds) is
                                  // one observation of the bias, > 0
   double max_bias_radps = 0.02;  // an observation larger than this (rad/s) is dropped

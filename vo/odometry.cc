@@ -274,12 +274,32 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     frame_motion_options.few_point.prior_rotation_sigma_deg =
         std::max(options_.imu.min_rotation_sigma_deg, gyro_rotation_.sigma_rad() * 180.0 / M_PI);
   }
-  const FrameMotion motion =
-      ResolveFrameMotion(camera_, frame_motion_options,
-                         static_cast<int>(frame.features.size()) < options_.front_end.min_features,
-                         ref_features, VehicleUpAtReference(&up_storage), T_ref_curr_prior,
-                         previous_measured_ && consecutive_lost_ == 0 && Predicted(),
-                         result.image_shift_ok, result.image_shift_px, &attempt);
+  // A weak RANSAC motion (fewer than reliable_min_inliers inliers) whose rotation the gyro
+  // contradicts is a wrong consensus: it goes on as one without a consensus (the few-point
+  // motion, with the gyro's rotation as its prior).
+  const double gyro_gate_rad = options_.imu.max_weak_rotation_error_deg * M_PI / 180.0;
+  if (gyro_rotation_.ok && T_ref_curr_prior != nullptr && attempt.ransac.ok() &&
+      attempt.ransac.num_inliers < options_.motion.reliable_min_inliers &&
+      IsFinitePose(attempt.ransac.T_prev_curr)) {
+    const double error_rad = Eigen::AngleAxisd(T_ref_curr_prior->linear().transpose() *
+                                               attempt.ransac.T_prev_curr.linear())
+                                 .angle();
+    if (error_rad > gyro_gate_rad) {
+      std::ostringstream msg;
+      msg << "a weak motion (" << attempt.ransac.num_inliers << " inliers) turns "
+          << error_rad * 180.0 / M_PI << " deg from the gyro's rotation";
+      attempt.ransac.status = RansacResult::Status::kNoConsensus;
+      attempt.ransac.message = msg.str();
+      attempt.ransac.num_inliers = 0;
+      attempt.ransac.inlier_mask.assign(attempt.ransac.inlier_mask.size(), false);
+    }
+  }
+  const FrameMotion motion = ResolveFrameMotion(
+      camera_, frame_motion_options,
+      static_cast<int>(frame.features.size()) < options_.front_end.min_features, ref_features,
+      VehicleUpAtReference(&up_storage), T_ref_curr_prior,
+      ((previous_measured_ && consecutive_lost_ == 0) || GyroFewPointAfterLoss()) && Predicted(),
+      result.image_shift_ok, result.image_shift_px, &attempt);
   if (motion.few_point) {
     result.few_point_motion = true;
     result.message = motion.message;
@@ -462,7 +482,7 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   const bool few_point_possible =
       (options_.motion.few_point_motion || (gyro_rotation_.ok && options_.imu.few_point_motion)) &&
       Predicted() && reference_.valid && (prior != nullptr || velocity_.known()) &&
-      previous_measured_ && consecutive_lost_ == 0 &&
+      ((previous_measured_ && consecutive_lost_ == 0) || GyroFewPointAfterLoss()) &&
       result.num_features_with_depth >= options_.motion.few_point_min_features;
   if (result.num_features_with_depth < options_.front_end.min_features && !few_point_possible) {
     std::ostringstream msg;

@@ -180,6 +180,11 @@ class StereoOdometry {
   // The world's up in the reference camera frame for a ground vehicle whose up is known (the
   // few-point motion and the weak-motion check are planar about it); null otherwise.
   const Eigen::Vector3d* VehicleUpAtReference(Eigen::Vector3d* storage) const;
+  // With the gyro's rotation for this frame, the few-point motion is used after lost frames too
+  // (imu.few_point_motion and imu.few_point_after_loss).
+  bool GyroFewPointAfterLoss() const {
+    return gyro_rotation_.ok && options_.imu.few_point_motion && options_.imu.few_point_after_loss;
+  }
   // The tracker predicts its matches (matcher.prediction is not kNone).
   bool Predicted() const { return options_.tracker.matcher.prediction != PredictionMode::kNone; }
   // A lost frame: pose bridged (or `chained`, see Recovery::BridgedPose), reference and

@@ -212,6 +212,7 @@ TEST(GyroPriorTest, AStretchThatDisagreesGrosslyIsNotABias) {
 TEST(GyroPriorTest, OptionsRefuseBadFields) {
   test::ExpectOptionsRefuseBadFields<ImuOptions>({
       {"min_rotation_sigma_deg", [](ImuOptions* o) { o->min_rotation_sigma_deg = 0.0; }},
+      {"max_weak_rotation_error_deg", [](ImuOptions* o) { o->max_weak_rotation_error_deg = 0.0; }},
       {"initial_bias_sigma_radps", [](ImuOptions* o) { o->initial_bias_sigma_radps = -1.0; }},
       {"bias_gain", [](ImuOptions* o) { o->bias_gain = 1.5; }},
       {"bias_window_s", [](ImuOptions* o) { o->bias_window_s = 0.0; }},
