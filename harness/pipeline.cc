@@ -85,6 +85,7 @@ void DescribeScenarioSequence(const sim::Scenario& scenario,
   sequence->has_imu = true;
   sequence->imu = scenario.imu;
   sequence->T_imu_cam0 = CameraInImuFrame(calibration.T_body_cam0, calibration.T_body_imu);
+  sequence->imu_extrinsics_known = true;
 }
 
 bool ReadAllFrames(const FrameSource& source, int max_frames, int expected_frames,
@@ -144,7 +145,20 @@ bool RunFrames(const std::string& name, const FrameSource& source, vo::StereoOdo
   DatasetFrame frame;
   int source_frames = 0;
   error->clear();
+  std::vector<vo::GyroSample> gyro;
   while ((options.max_frames <= 0 || source_frames < options.max_frames) && source(&frame, error)) {
+    // The gyro's samples of every source frame, the skipped ones' too (ignored by a VO without
+    // the gyro: StereoOdometry::SetGyro).
+    if (!frame.imu.empty()) {
+      gyro.clear();
+      for (const sim::ImuSample& s : frame.imu) {
+        vo::GyroSample g;
+        g.time_s = s.time_s;
+        g.rate_radps = s.gyro_radps;
+        gyro.push_back(g);
+      }
+      odometry.AddGyroSamples(gyro);
+    }
     if (source_frames++ % stride != 0) continue;  // frame stride: skip to every k-th frame
     FrameRecord record;
     record.source_index = source_frames - 1;

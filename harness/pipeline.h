@@ -62,10 +62,12 @@ struct StereoSequence {
   // simulated scenario always has one (its imu keys, the IMU's pose on the rig); a EuRoC folder
   // when mav0/imu0/data.csv is there (imu: its sensor.yaml's rate and noise numbers;
   // T_imu_cam0 is not set there: EuRoC's cam0 T_BS is the raw camera's, not the rectified one's).
-  // The VO does not use it yet.
+  // The VO uses its gyro (vo_options.yaml imu.gyro_prior, vo/gyro_prior.h) when T_imu_cam0 is
+  // known (imu_extrinsics_known: a simulated scenario; not yet EuRoC or a bag).
   bool has_imu = false;
   sim::ImuOptions imu;                                           // rate and noise numbers
   Eigen::Isometry3d T_imu_cam0 = Eigen::Isometry3d::Identity();  // cam0 in the IMU frame
+  bool imu_extrinsics_known = false;                             // T_imu_cam0 is the rig's
   // A simulated scenario: what the robot did (its navigation report); with navigation: vo also
   // the feedback that steers it on the VO's estimates. Empty otherwise.
   NavigationSource navigation;

@@ -24,6 +24,7 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
     *error = "invalid VO options or camera: " + *error;
     return false;
   }
+  if (options.has_gyro) odometry->SetGyro(options.gyro);
   OutputFolder folder;  // written as a marked DIR.partial-<pid>-<random>, moved into place
   if (!OpenRunFolder(options.out_dir, &folder, error)) return false;
   RunRecords records;
@@ -55,6 +56,12 @@ bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_o
   o.ground_truth_not_gravity_aligned = sequence.ground_truth_not_gravity_aligned;
   o.feedback = sequence.feedback;
   o.navigation = sequence.navigation;
+  if (sequence.has_imu && sequence.imu_extrinsics_known) {
+    o.has_gyro = true;
+    o.gyro.R_imu_cam = sequence.T_imu_cam0.linear();
+    o.gyro.noise_density = sequence.imu.gyro_noise_density;
+    o.gyro.random_walk = sequence.imu.gyro_random_walk;
+  }
   return RunOdometry(
       sequence.name, sequence.camera, sequence.next, sequence.expected_frames,
       vo::ResolvePlatform(vo_options, sequence.axle_behind_camera_m, sequence.camera_pitch_deg), o,

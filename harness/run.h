@@ -40,6 +40,10 @@ struct RunOptions {
   // (StereoSequence::navigation); empty for none.
   EstimateFeedback feedback;
   NavigationSource navigation;
+  // The sequence's gyro for the VO (StereoOdometry::SetGyro; used with imu.gyro_prior on), when
+  // has_gyro: a sequence with an IMU whose mounting is known (StereoSequence).
+  bool has_gyro = false;
+  vo::GyroCalibration gyro;
   std::string ground_truth_not_gravity_aligned;  // why the ground truth's world is not
                                                  // gravity-aligned ("" = it is): no
                                                  // initial-orientation error then

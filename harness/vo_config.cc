@@ -422,6 +422,15 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
        Number(&o->back_end.flat_floor.tilt_sigma_deg, 1e-9, 180.0)},
       {"back_end.flat_floor.height_sigma_m",
        Number(&o->back_end.flat_floor.height_sigma_m, 1e-9, 100.0)},
+      {"imu.gyro_prior", Bool(&o->imu.gyro_prior)},
+      {"imu.few_point_motion", Bool(&o->imu.few_point_motion)},
+      {"imu.few_point_after_loss", Bool(&o->imu.few_point_after_loss)},
+      {"imu.max_weak_rotation_error_deg", Number(&o->imu.max_weak_rotation_error_deg, 1e-9, 180.0)},
+      {"imu.min_rotation_sigma_deg", Number(&o->imu.min_rotation_sigma_deg, 1e-9, 180.0)},
+      {"imu.initial_bias_sigma_radps", Number(&o->imu.initial_bias_sigma_radps, 0.0, 100.0)},
+      {"imu.bias_gain", Number(&o->imu.bias_gain, 0.0, 1.0)},
+      {"imu.bias_window_s", Number(&o->imu.bias_window_s, 1e-9, 1e6)},
+      {"imu.max_bias_radps", Number(&o->imu.max_bias_radps, 1e-9, 100.0)},
   };
 }
 

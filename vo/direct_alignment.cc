@@ -229,7 +229,8 @@ DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::M
                                          const cv::Mat& curr, const std::vector<ScenePlane>& planes,
                                          const Eigen::Vector3d& up_prev,
                                          double axle_behind_camera_m, double yaw0_rad,
-                                         double forward0_m, const DirectAlignmentOptions& options) {
+                                         double forward0_m, const DirectAlignmentOptions& options,
+                                         double yaw_prior_sigma_rad) {
   DirectAlignmentResult result;
   result.yaw_rad = yaw0_rad;
   result.forward_m = forward0_m;
@@ -267,6 +268,16 @@ DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::M
   const Eigen::Vector3d up = up_prev.normalized();
 
   Eigen::Vector2d theta(yaw0_rad, forward0_m);
+  // The yaw prior (yaw_prior_sigma_rad > 0): ½ w (yaw − yaw0)² in the cost, w in the units of
+  // the grey levels' squares (the level's robust residual variance over σ²).
+  const bool yaw_prior = yaw_prior_sigma_rad > 0.0 && std::isfinite(yaw_prior_sigma_rad);
+  double prior_weight = 0.0;
+  auto AddYawPrior = [&](const Eigen::Vector2d& at, Linearisation* lin) {
+    const double d = at.x() - yaw0_rad;
+    lin->cost += 0.5 * prior_weight * d * d;
+    lin->H(0, 0) += prior_weight;
+    lin->g(0) += prior_weight * d;
+  };
   for (int l = levels - 1; l >= 0; --l) {
     const std::vector<PlanePixel> pixels =
         InView(C[l], SelectPixels(P[l], unit, options), up, axle_behind_camera_m, theta);
@@ -282,18 +293,21 @@ DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::M
           RobustSigma(Linearise(C[l], pixels, up, axle_behind_camera_m, theta, 1e300, false, false)
                           .abs_residuals);
       threshold = (tukey ? options.tukey_k : options.huber_k) * sigma;
+      prior_weight = yaw_prior ? sigma * sigma / (yaw_prior_sigma_rad * yaw_prior_sigma_rad) : 0.0;
       bool converged = false;
       for (int it = 0; it < options.max_iterations && !converged; ++it) {
         ++result.iterations;
-        const Linearisation lin =
+        Linearisation lin =
             Linearise(C[l], pixels, up, axle_behind_camera_m, theta, threshold, tukey, true);
+        if (yaw_prior) AddYawPrior(theta, &lin);
         if (lin.n < 3 || !(lin.H.determinant() > 0.0)) break;
         Eigen::Vector2d step = -lin.H.ldlt().solve(lin.g);
         if (!step.allFinite()) break;
         bool improved = false;
         for (int halving = 0; halving < 6 && !improved; ++halving, step *= 0.5) {
-          const Linearisation trial = Linearise(C[l], pixels, up, axle_behind_camera_m,
-                                                theta + step, threshold, tukey, false);
+          Linearisation trial = Linearise(C[l], pixels, up, axle_behind_camera_m, theta + step,
+                                          threshold, tukey, false);
+          if (yaw_prior) AddYawPrior(theta + step, &trial);
           if (trial.cost < lin.cost) {
             theta += step;
             improved = true;
@@ -304,8 +318,9 @@ DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::M
     }
     if (l > 0) continue;
     // The finest level: the measurement's support and uncertainty.
-    const Linearisation final_lin =
+    Linearisation final_lin =
         Linearise(C[0], pixels, up, axle_behind_camera_m, theta, threshold, tukey, true);
+    if (yaw_prior) AddYawPrior(theta, &final_lin);
     result.pixels = final_lin.n;
     result.residual_sigma = RobustSigma(final_lin.abs_residuals);
     if (final_lin.n >= 3 && final_lin.H.determinant() > 0.0) {

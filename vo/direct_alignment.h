@@ -87,12 +87,15 @@ struct DirectAlignmentResult {
 // (yaw, forward) of the vehicle motion T_prev_curr = VehicleMotion(up_prev, axle_behind_camera_m,
 // yaw, forward) that aligns `curr` with `prev` (8-bit grey left images of the same size as the
 // camera's), the previous image's pixels on `planes` (previous camera frame), starting at
-// (yaw0_rad, forward0_m).
+// (yaw0_rad, forward0_m). yaw_prior_sigma_rad > 0: yaw0_rad is a measurement of the yaw with
+// this σ (a gyro's, gyro_prior.h), a prior term (yaw − yaw0)² / σ² beside the grey levels (in
+// their units: times the level's robust residual variance), in the fit and its covariance.
 DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::Mat& prev,
                                          const cv::Mat& curr, const std::vector<ScenePlane>& planes,
                                          const Eigen::Vector3d& up_prev,
                                          double axle_behind_camera_m, double yaw0_rad,
-                                         double forward0_m, const DirectAlignmentOptions& options);
+                                         double forward0_m, const DirectAlignmentOptions& options,
+                                         double yaw_prior_sigma_rad = 0.0);
 
 // The plane that most features with depth lie on (camera frame): a feature is on it when its
 // disparity is within tolerance_px of the plane's at its pixel. Deterministic RANSAC over

@@ -126,6 +126,11 @@ std::vector<Eigen::Vector2d> PredictFeaturePositions(const StereoCamera& camera,
 
 Eigen::Isometry3d ConstantVelocity::Prior(const MotionPrior* prior) const {
   if (prior != nullptr && IsFinitePose(prior->T_prev_curr)) return prior->T_prev_curr;
+  if (has_measured_rotation_) {
+    Eigen::Isometry3d T = known_ ? velocity_ : Eigen::Isometry3d::Identity();
+    T.linear() = measured_rotation_;
+    return T;
+  }
   return known_ ? velocity_ : Eigen::Isometry3d::Identity();
 }
 

@@ -92,7 +92,8 @@ class ConstantVelocity {
   // The per-frame motion (identity while unknown).
   const Eigen::Isometry3d& per_frame() const { return velocity_; }
   // The prior's motion since the previous output: the caller's prior (when finite), else the
-  // constant velocity, else none (identity).
+  // constant velocity (its rotation the measured one when set), else none (identity; the
+  // measured rotation when set).
   Eigen::Isometry3d Prior(const MotionPrior* prior) const;
   // Moved `weight` of the way (slerp) to a measured per-frame motion (the first one is taken as
   // it is; a non-finite one is ignored, and so is a weight of 0 once known).
@@ -105,6 +106,15 @@ class ConstantVelocity {
   void ReplaceRotationIfKnown(const Eigen::Matrix3d& R) {
     if (known_) velocity_.linear() = R;
   }
+  // The coming frame's rotation as another sensor measured it (the gyro's, gyro_prior.h):
+  // Prior(nullptr) takes it in place of the constant velocity's rotation (the translation stays
+  // the constant velocity's; none while unknown), until ClearMeasuredRotation.
+  void SetMeasuredRotation(const Eigen::Matrix3d& R_prev_curr) {
+    measured_rotation_ = R_prev_curr;
+    has_measured_rotation_ = true;
+  }
+  void ClearMeasuredRotation() { has_measured_rotation_ = false; }
+  bool has_measured_rotation() const { return has_measured_rotation_; }
 
   // The last measured motion (per frame) and its frame index; -1: none.
   void SetLastMeasured(const Eigen::Isometry3d& per_frame, int64_t frame_index) {
@@ -118,6 +128,7 @@ class ConstantVelocity {
     velocity_ = Eigen::Isometry3d::Identity();
     known_ = false;
     last_motion_frame_ = -1;
+    has_measured_rotation_ = false;
   }
 
  private:
@@ -125,6 +136,8 @@ class ConstantVelocity {
   bool known_ = false;
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
   int64_t last_motion_frame_ = -1;
+  Eigen::Matrix3d measured_rotation_ = Eigen::Matrix3d::Identity();
+  bool has_measured_rotation_ = false;
 };
 
 }  // namespace vo

@@ -66,6 +66,18 @@ StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions
 
 StereoOdometry::~StereoOdometry() = default;
 
+void StereoOdometry::SetGyro(const GyroCalibration& calibration) {
+  if (!options_.imu.gyro_prior || !calibration.IsValid(nullptr)) {
+    gyro_.reset();
+    return;
+  }
+  gyro_ = std::make_unique<GyroPrior>(options_.imu, calibration);
+}
+
+void StereoOdometry::AddGyroSamples(const std::vector<GyroSample>& samples) {
+  if (gyro_) gyro_->AddSamples(samples);
+}
+
 void StereoOdometry::Reset() {
   back_end_.Reset();
   tracker_->Reset();
@@ -88,6 +100,8 @@ void StereoOdometry::Reset() {
   last_reference_features_.clear();
   prev_call_index_map_.clear();
   current_left_ = cv::Mat();
+  if (gyro_) gyro_->Reset();
+  gyro_rotation_ = GyroRotation();
 }
 
 OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isometry3d& T_world_cam0,
@@ -102,6 +116,16 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
                                                : Eigen::Isometry3d(T_world_prev_.inverse() * T);
   T_world_prev_ = T;
   previous_measured_ = result.motion_measured;
+  if (gyro_) {
+    // The gyro's rotation was this frame's only; a well-tracked frame's measured rotation is an
+    // observation of the gyro's bias (gyro_prior.h).
+    velocity_.ClearMeasuredRotation();
+    const bool well_tracked = gyro_rotation_.ok && result.status == TrackingStatus::kTracking &&
+                              result.motion_measured && !result.few_point_motion &&
+                              !result.direct_motion &&
+                              result.num_inliers >= options_.motion.reliable_min_inliers;
+    gyro_->Observe(well_tracked, result.T_prev_curr.linear());
+  }
   recovery_.EndFrame(last_features_, result.T_prev_curr, current_left_);
   // Next frame's disparity search range from the depths of this one (full after a loss).
   scene_num_disparities_ = result.status != TrackingStatus::kLost
@@ -121,6 +145,10 @@ BridgeContext StereoOdometry::Bridge(const MotionPrior* prior) {
   c.features = &last_features_;
   c.after_loss = consecutive_lost_ > 0;
   c.velocity = &velocity_;
+  if (gyro_rotation_.ok) {
+    c.measured_rotation_sigma_rad =
+        std::max(options_.imu.min_rotation_sigma_deg * M_PI / 180.0, gyro_rotation_.sigma_rad());
+  }
   return c;
 }
 
@@ -237,12 +265,41 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
   const MotionOptions& motion_options = options_.motion;
   const Eigen::Isometry3d* T_world_ref = back_end_.Pose(reference_.frame_index);
   Eigen::Vector3d up_storage;
-  const FrameMotion motion =
-      ResolveFrameMotion(camera_, options_.motion,
-                         static_cast<int>(frame.features.size()) < options_.front_end.min_features,
-                         ref_features, VehicleUpAtReference(&up_storage), T_ref_curr_prior,
-                         previous_measured_ && consecutive_lost_ == 0 && Predicted(),
-                         result.image_shift_ok, result.image_shift_px, &attempt);
+  // With the gyro's rotation in the prior, the few-point motion's rotation prior is the gyro's
+  // (gyro_prior.h), not the constant velocity's.
+  MotionOptions frame_motion_options = options_.motion;
+  if (gyro_rotation_.ok) {
+    frame_motion_options.few_point_motion =
+        frame_motion_options.few_point_motion || options_.imu.few_point_motion;
+    frame_motion_options.few_point.prior_rotation_sigma_deg =
+        std::max(options_.imu.min_rotation_sigma_deg, gyro_rotation_.sigma_rad() * 180.0 / M_PI);
+  }
+  // A weak RANSAC motion (fewer than reliable_min_inliers inliers) whose rotation the gyro
+  // contradicts is a wrong consensus: it goes on as one without a consensus (the few-point
+  // motion, with the gyro's rotation as its prior).
+  const double gyro_gate_rad = options_.imu.max_weak_rotation_error_deg * M_PI / 180.0;
+  if (gyro_rotation_.ok && T_ref_curr_prior != nullptr && attempt.ransac.ok() &&
+      attempt.ransac.num_inliers < options_.motion.reliable_min_inliers &&
+      IsFinitePose(attempt.ransac.T_prev_curr)) {
+    const double error_rad = Eigen::AngleAxisd(T_ref_curr_prior->linear().transpose() *
+                                               attempt.ransac.T_prev_curr.linear())
+                                 .angle();
+    if (error_rad > gyro_gate_rad) {
+      std::ostringstream msg;
+      msg << "a weak motion (" << attempt.ransac.num_inliers << " inliers) turns "
+          << error_rad * 180.0 / M_PI << " deg from the gyro's rotation";
+      attempt.ransac.status = RansacResult::Status::kNoConsensus;
+      attempt.ransac.message = msg.str();
+      attempt.ransac.num_inliers = 0;
+      attempt.ransac.inlier_mask.assign(attempt.ransac.inlier_mask.size(), false);
+    }
+  }
+  const FrameMotion motion = ResolveFrameMotion(
+      camera_, frame_motion_options,
+      static_cast<int>(frame.features.size()) < options_.front_end.min_features, ref_features,
+      VehicleUpAtReference(&up_storage), T_ref_curr_prior,
+      ((previous_measured_ && consecutive_lost_ == 0) || GyroFewPointAfterLoss()) && Predicted(),
+      result.image_shift_ok, result.image_shift_px, &attempt);
   if (motion.few_point) {
     result.few_point_motion = true;
     result.message = motion.message;
@@ -380,6 +437,12 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   last_inlier_mask_.clear();
   last_reference_features_.clear();
   prev_call_index_map_.clear();
+  // The gyro's rotation since the previous call: this frame's prior rotation (gyro_prior.h).
+  gyro_rotation_ = GyroRotation();
+  if (gyro_) {
+    gyro_rotation_ = gyro_->Next(time_s);
+    if (gyro_rotation_.ok) velocity_.SetMeasuredRotation(gyro_rotation_.R_prev_curr);
+  }
 
   // Input checks: expected failures come back as kLost.
   const cv::Size camera_size(camera_.width, camera_.height);
@@ -417,8 +480,9 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   // Below min_features a frame is still matched when the few-point solver can use it (a
   // reference, a prior, at least few_point_min_features features).
   const bool few_point_possible =
-      options_.motion.few_point_motion && Predicted() && reference_.valid &&
-      (prior != nullptr || velocity_.known()) && previous_measured_ && consecutive_lost_ == 0 &&
+      (options_.motion.few_point_motion || (gyro_rotation_.ok && options_.imu.few_point_motion)) &&
+      Predicted() && reference_.valid && (prior != nullptr || velocity_.known()) &&
+      ((previous_measured_ && consecutive_lost_ == 0) || GyroFewPointAfterLoss()) &&
       result.num_features_with_depth >= options_.motion.few_point_min_features;
   if (result.num_features_with_depth < options_.front_end.min_features && !few_point_possible) {
     std::ostringstream msg;
@@ -475,6 +539,7 @@ OdometryResult StereoOdometry::ProcessFeatures(std::vector<Feature> features,
   result.frame_index = frame_index_++;
   result.time_s = time_s;
   result.num_features = static_cast<int>(features.size());
+  gyro_rotation_ = GyroRotation();  // the seam has no gyro
   last_features_.clear();
   last_matches_.clear();
   last_inlier_mask_.clear();

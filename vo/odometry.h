@@ -22,6 +22,8 @@
 //                 → T_world_cam0
 //   no motion     the pose bridged (prior, image shift, lost-frame chain, a
 //                 ground vehicle's bridge and direct alignment)               recovery.h
+//   gyro          the prior's rotation integrated from the caller's gyro
+//                 samples (SetGyro, AddGyroSamples; imu.gyro_prior)           gyro_prior.h
 //   shared        the constant-velocity prior, predictions, pose algebra      motion_model.h
 //   options       OdometryOptions (vo_options.yaml)                          odometry_options.h
 //   result        OdometryResult, FrameDiagnostics, MotionPrior               odometry_result.h
@@ -79,6 +81,7 @@
 #include "vo/back_end.h"
 #include "vo/camera.h"
 #include "vo/front_end.h"
+#include "vo/gyro_prior.h"
 #include "vo/matcher.h"
 #include "vo/motion_estimation.h"
 #include "vo/motion_model.h"
@@ -114,6 +117,22 @@ class StereoOdometry {
   // the constant-velocity prediction.
   OdometryResult Process(const cv::Mat& left, const cv::Mat& right, double time_s,
                          const MotionPrior* prior = nullptr);
+
+  // The gyro (gyro_prior.h), with options().imu.gyro_prior on (otherwise both are ignored):
+  // its mounting and noise model, once before the first frame; then its samples, in time
+  // order, before the Process call of the frame they lead up to (the samples of frames the
+  // caller skips, a frame stride's, too). Each frame's prior rotation is then the gyro's from
+  // the previous call's time_s to this one's (its translation the constant velocity's); a frame
+  // whose interval the samples do not cover keeps the constant velocity's. The gyro's bias is
+  // estimated from the well-tracked frames' rotations. Not used by ProcessFeatures.
+  void SetGyro(const GyroCalibration& calibration);
+  void AddGyroSamples(const std::vector<GyroSample>& samples);
+  // The gyro's rotation of the last Process call (ok false without the gyro).
+  const GyroRotation& last_gyro_rotation() const { return gyro_rotation_; }
+  // The gyro's bias estimate (rad/s, IMU frame; zero without the gyro).
+  Eigen::Vector3d gyro_bias_radps() const {
+    return gyro_ ? gyro_->bias_radps() : Eigen::Vector3d::Zero();
+  }
 
   // The seam (libviso2's process(matches)): runs the back end (RANSAC, tracks, blend, BA) on
   // externally supplied left-image features and matches, skipping disparity, detection and
@@ -161,6 +180,11 @@ class StereoOdometry {
   // The world's up in the reference camera frame for a ground vehicle whose up is known (the
   // few-point motion and the weak-motion check are planar about it); null otherwise.
   const Eigen::Vector3d* VehicleUpAtReference(Eigen::Vector3d* storage) const;
+  // With the gyro's rotation for this frame, the few-point motion is used after lost frames too
+  // (imu.few_point_motion and imu.few_point_after_loss).
+  bool GyroFewPointAfterLoss() const {
+    return gyro_rotation_.ok && options_.imu.few_point_motion && options_.imu.few_point_after_loss;
+  }
   // The tracker predicts its matches (matcher.prediction is not kNone).
   bool Predicted() const { return options_.tracker.matcher.prediction != PredictionMode::kNone; }
   // A lost frame: pose bridged (or `chained`, see Recovery::BridgedPose), reference and
@@ -219,6 +243,8 @@ class StereoOdometry {
   std::vector<Match> last_matches_;
   std::vector<bool> last_inlier_mask_;
   std::vector<Feature> last_reference_features_;
+  std::unique_ptr<GyroPrior> gyro_;       // SetGyro with imu.gyro_prior on; null otherwise
+  GyroRotation gyro_rotation_;            // this call's rotation from the gyro (when ok)
   cv::Mat current_left_;                  // this call's left image
   std::vector<int> prev_call_index_map_;  // ProcessFeatures: given index → kept index of the
                                           // previous call's features (empty when unusable)

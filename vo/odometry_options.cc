@@ -27,7 +27,8 @@ bool OdometryOptions::IsValid(std::string* error) const {
   if (!PartIsValid(front_end, "front_end", error) ||
       !PartIsValid(initial_orientation, "initial_orientation", error) ||
       !PartIsValid(tracker, "tracker", error) || !PartIsValid(motion, "motion", error) ||
-      !PartIsValid(recovery, "recovery", error) || !PartIsValid(back_end, "back_end", error)) {
+      !PartIsValid(recovery, "recovery", error) || !PartIsValid(back_end, "back_end", error) ||
+      !PartIsValid(imu, "imu", error)) {
     return false;
   }
   std::ostringstream msg;

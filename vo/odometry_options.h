@@ -14,6 +14,7 @@
 #include "vo/back_end.h"
 #include "vo/camera.h"
 #include "vo/front_end.h"
+#include "vo/gyro_prior.h"
 #include "vo/initial_orientation.h"
 #include "vo/motion_estimation.h"
 #include "vo/recovery.h"
@@ -52,6 +53,8 @@ struct OdometryOptions {
   MotionOptions motion;                           // motion_estimation.h
   RecoveryOptions recovery;                       // recovery.h
   BackEndOptions back_end;                        // back_end.h
+  ImuOptions imu;  // gyro_prior.h: the gyro's rotation as the prior's (when the caller gives
+                   // gyro samples)
 
   // Each stage's IsValid (the message starts with the stage's name), then what spans two
   // stages (a sift_ratio matcher needs the SIFT detector's descriptors).

@@ -236,6 +236,10 @@ bool PriorMotionOptions::IsValid(std::string* error) const {
   return false;
 }
 
+// A rotation prior at least this tight (degrees) is a measurement (a gyro's, gyro_prior.h), not
+// an extrapolation: the 1-point translation hypotheses below.
+constexpr double kMeasuredRotationSigmaDeg = 0.5;
+
 PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
                                           const std::vector<StereoCorrespondence>& corr,
                                           const Eigen::Isometry3d& T_prior,
@@ -358,6 +362,22 @@ PriorMotionResult EstimateMotionWithPrior(const StereoCamera& camera,
           FitVehicleToOnePoint(camera, corr[i], model, Eigen::Vector2d(point_yaw[i], 0.0), o,
                                &x_fit))
         consider(x_fit);
+    }
+  }
+  // A 6-DoF prior whose rotation is measured (a gyro's: prior_rotation_sigma_deg at most
+  // kMeasuredRotationSigmaDeg) and whose translation is far off (the constant velocity carried
+  // into a robot that stops to turn): when no hypothesis above has the support the result
+  // needs, each point's own translation with the prior's rotation (p_prev = R p_curr + t for
+  // that point, its current position from its disparity) as well.
+  if (!model.vehicle && up_curr == nullptr && best_n < needed &&
+      o.prior_rotation_sigma_deg <= kMeasuredRotationSigmaDeg) {
+    for (size_t i = 0; i < corr.size(); ++i) {
+      if (!(corr[i].disparity_curr_px > 0.0)) continue;
+      const Eigen::Vector3d p_curr = camera.Backproject(
+          corr[i].uv_curr_px.x(), corr[i].uv_curr_px.y(), corr[i].disparity_curr_px);
+      Vector6d x = Vector6d::Zero();
+      x.tail<3>() = R_prior.transpose() * (corr[i].p_prev_cam0 - T_prior.translation()) - p_curr;
+      consider(x);
     }
   }
   if (best_n == 0) {

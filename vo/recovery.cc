@@ -130,9 +130,9 @@ Eigen::Isometry3d Recovery::DirectAlignedPose(const BridgeContext& c,
   const Eigen::Vector2d start =
       VehicleMotionParameters(c.T_world_prev.inverse() * bridged, up, axle);
   if (!start.allFinite()) return bridged;
-  const DirectAlignmentResult direct =
-      AlignVehicleDirect(camera_, previous_left_, c.current_left, scene_planes_, up, axle,
-                         start.x(), start.y(), o.vehicle_direct);
+  const DirectAlignmentResult direct = AlignVehicleDirect(
+      camera_, previous_left_, c.current_left, scene_planes_, up, axle, start.x(), start.y(),
+      o.vehicle_direct, c.velocity->has_measured_rotation() ? c.measured_rotation_sigma_rad : 0.0);
   result->times.predict_ms += ElapsedMs(t);
   if (!direct.ok) return bridged;
   const Eigen::Isometry3d T = VehicleMotion(up, axle, direct.yaw_rad, direct.forward_m);
@@ -181,7 +181,8 @@ Eigen::Isometry3d Recovery::AlignedBridgePose(const BridgeContext& c,
   const double axle = motion_.few_point.axle_behind_camera_m;
   const Eigen::Vector2d yaw_forward = VehicleMotionParameters(T, up, axle);
   double yaw = yaw_forward.x();
-  if (yaw_forward.allFinite() &&
+  // The gyro's yaw (a measured rotation in the prior) is not re-measured on the features.
+  if (yaw_forward.allFinite() && !c.velocity->has_measured_rotation() &&
       AlignVehicleYaw(camera_, previous_frame_features_, last_features, up, axle, yaw_forward.y(),
                       o.vehicle_bridge, &yaw, &pairs)) {
     T = VehicleMotion(up, axle, yaw, yaw_forward.y());
@@ -198,8 +199,11 @@ Eigen::Isometry3d Recovery::ShiftCorrectedPose(const BridgeContext& c, OdometryR
   const std::vector<Feature>& last_features = *c.features;
   const Eigen::Isometry3d predicted = c.T_world_prev * BridgeMotion(c);
   const RecoveryOptions& o = options_;
+  // A rotation measured by another sensor (the gyro, gyro_prior.h) is not corrected by the image
+  // shift, which cannot tell a turn from parallax.
   if (!predicted_ || !o.rotation_from_shift || previous_left_.empty() || c.current_left.empty() ||
-      previous_left_.size() != c.current_left.size()) {
+      previous_left_.size() != c.current_left.size() ||
+      (prior == nullptr && c.velocity->has_measured_rotation())) {
     return predicted;
   }
   const Clock::time_point t = Clock::now();

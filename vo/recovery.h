@@ -153,6 +153,9 @@ struct BridgeContext {
   const std::vector<Feature>* features = nullptr;  // this frame's features with depth
   bool after_loss = false;                         // frames were lost since the last tracked one
   ConstantVelocity* velocity = nullptr;            // the prior, moved by what the recovery measures
+  double measured_rotation_sigma_rad = 0.0;  // > 0: the prior's rotation was measured (the gyro's,
+                                             // ConstantVelocity::has_measured_rotation) with this
+                                             // σ: a prior term of the direct alignment's yaw
 };
 
 class Recovery {

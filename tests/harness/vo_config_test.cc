@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -46,7 +47,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
   std::map<std::string, int> counts;
   CountLeaves(yaml, "", &counts);
   const Recorded recorded[] = {
-      {"OdometryOptions", sizeof(vo::OdometryOptions), 1656},
+      {"OdometryOptions", sizeof(vo::OdometryOptions), 1712},
       {"FrontEndOptions", sizeof(vo::FrontEndOptions), 304},
       {"InitialOrientationOptions", sizeof(vo::InitialOrientationOptions), 192},
       {"TrackerOptions", sizeof(vo::TrackerOptions), 544},
@@ -76,6 +77,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
       {"ImageShiftOptions", sizeof(vo::ImageShiftOptions), 56},
       {"BridgeAlignmentOptions", sizeof(vo::BridgeAlignmentOptions), 32},
       {"DirectAlignmentOptions", sizeof(vo::DirectAlignmentOptions), 96},
+      {"ImuOptions", sizeof(vo::ImuOptions), 56},
   };
   for (const Recorded& r : recorded)
     EXPECT_EQ(r.size, r.recorded_size)
@@ -117,6 +119,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
       {"back_end.ba", 12},
       {"back_end.vehicle_planar", 4},
       {"back_end.flat_floor", 3},
+      {"imu", 9},
   };
   EXPECT_EQ(counts, expected);
 }
@@ -192,6 +195,9 @@ TEST(VoConfigTest, EveryOldKeyIsRefusedAndItsNewKeyHoldsTheSameValue) {
   ASSERT_TRUE(harness::ParseVoConfig(renamed_text, "renamed.yaml", &read, &error)) << error;
   std::map<std::string, std::string> written;
   Leaves(YAML::Load(harness::VoConfigToYaml(read)), "", &written);
+  // The imu group (issue #35) came after the earlier layout: the file has none of its keys.
+  for (auto it = written.begin(); it != written.end();)
+    it = it->first.rfind("imu.", 0) == 0 ? written.erase(it) : std::next(it);
   EXPECT_EQ(written, expected);  // every new key once, with the old key's value
 }
 

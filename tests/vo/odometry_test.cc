@@ -1215,6 +1215,84 @@ TEST(OdometryPredictionTest, AnExternalMotionPriorBridgesBlackFramesExactly) {
   EXPECT_THAT(EstimatedMotion(r, 0, 9), IsNearPose(TrueTurnMotion(0, 9), 0.5 * kDeg, 0.02));
 }
 
+// The turn's gyro (gyro_prior.h): 1 kHz samples of the true rate, constant over each frame's
+// interval (the samples in (t_{k-1}, t_k] carry interval k's), in an IMU frame turned against
+// the camera's.
+Eigen::Matrix3d TestImuMounting() {
+  return (Eigen::AngleAxisd(90.0 * kDeg, Eigen::Vector3d::UnitX()) *
+          Eigen::AngleAxisd(-20.0 * kDeg, Eigen::Vector3d::UnitZ()))
+      .toRotationMatrix();
+}
+std::vector<GyroSample> TurnGyroSamples(int k) {
+  const Eigen::AngleAxisd aa(TrueTurnMotion(std::max(k - 1, 0), std::max(k, 1)).linear());
+  const Eigen::Vector3d w_cam = aa.angle() * aa.axis() / 0.1;
+  std::vector<GyroSample> samples;
+  for (int j = k == 0 ? 0 : 1; j <= 100; ++j) {
+    GyroSample g;
+    g.time_s = 0.1 * (k - 1) + 0.001 * j;
+    if (k == 0) g.time_s = 0.0;
+    g.rate_radps = TestImuMounting() * w_cam;
+    samples.push_back(g);
+    if (k == 0) break;
+  }
+  return samples;
+}
+// The turn with frames 7 and 8 black, the gyro's samples given (or not).
+std::vector<OdometryResult> RunTurnWithGyro(const OdometryOptions& options, bool samples) {
+  StereoOdometry vo(HallwayCamera(), options);
+  GyroCalibration calibration;
+  calibration.R_imu_cam = TestImuMounting();
+  if (samples) vo.SetGyro(calibration);
+  std::vector<OdometryResult> r;
+  const cv::Mat black = cv::Mat::zeros(HallwayCamera().height, HallwayCamera().width, CV_8UC1);
+  for (int i = 0; i < 12; ++i) {
+    if (samples) vo.AddGyroSamples(TurnGyroSamples(i));
+    const bool is_black = i == 7 || i == 8;
+    r.push_back(vo.Process(is_black ? black : TurnSequence()[i].left,
+                           is_black ? black : TurnSequence()[i].right, 0.1 * i));
+  }
+  return r;
+}
+
+TEST(OdometryGyroTest, BlackFramesAreBridgedByTheGyrosRotation) {
+  // Frames 7 and 8 cannot be matched (black). The turn stops after frame 7: the constant
+  // velocity carries 7° a frame into frame 8, the gyro measures the stop.
+  const std::vector<OdometryResult> with = RunTurnWithGyro(OdometryOptions(), true);
+  const std::vector<OdometryResult> without = RunTurnWithGyro(OdometryOptions(), false);
+  for (int i : {7, 8}) {
+    EXPECT_TRUE(IsLostFrame(with[i])) << with[i].message;
+    EXPECT_TRUE(IsLostFrame(without[i])) << without[i].message;
+    // Each bridged frame's rotation is the gyro's: within 0.1° of the truth (the samples'
+    // trapezoid across the stop costs 0.035°).
+    EXPECT_LT(RotationAngleRad(EstimatedMotion(with, i - 1, i).linear(),
+                               TrueTurnMotion(i - 1, i).linear()),
+              0.1 * kDeg)
+        << i;
+  }
+  // Without the gyro frame 8 is extrapolated by the turn that has stopped.
+  EXPECT_GT(
+      RotationAngleRad(EstimatedMotion(without, 7, 8).linear(), TrueTurnMotion(7, 8).linear()),
+      5.0 * kDeg);
+  // Frame 9 is measured against frame 6 again; the whole turn is tracked.
+  EXPECT_TRUE(with[9].motion_measured) << with[9].message;
+  EXPECT_EQ(with[9].reference_frame_index, 6);
+  EXPECT_THAT(EstimatedMotion(with, 0, 11), IsNearPose(TrueTurnMotion(0, 11), 0.5 * kDeg, 0.02));
+}
+
+TEST(OdometryGyroTest, WithoutTheGyroPriorTheSamplesChangeNothing) {
+  // imu.gyro_prior false: the samples are ignored, bit for bit.
+  OdometryOptions off;
+  off.imu.gyro_prior = false;
+  const std::vector<OdometryResult> a = RunTurnWithGyro(off, true);
+  const std::vector<OdometryResult> b = RunTurnWithGyro(OdometryOptions(), false);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].T_world_cam0.matrix(), b[i].T_world_cam0.matrix()) << i;
+    EXPECT_EQ(a[i].status, b[i].status) << i;
+    EXPECT_EQ(a[i].num_inliers, b[i].num_inliers) << i;
+  }
+}
+
 TEST(OdometryPredictionTest, AFrameWithoutDepthFollowsTheTurnByItsImageShift) {
   // Frames 7 and 8 lose their right image (no depth, no motion), but the left images still show
   // how the view turned: frame 8, where the turn has stopped while the constant velocity says

@@ -49,6 +49,30 @@ double RotationErrorRad(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) 
   return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
 }
 
+TEST(PriorMotionTest, AMeasuredRotationLetsOnePointGiveTheTranslation) {
+  // A robot that stopped to turn in front of a wall: the prior's rotation is the gyro's (exact,
+  // σ 0.05°), its translation the constant velocity's cruise step (10 cm a frame) where the
+  // camera moved 1 cm. No rotation correction explains 10 cm at 0.85 m; each point's own
+  // translation does (gyro_prior.h: the few-point motion with the gyro's rotation).
+  const StereoCamera cam = TestCamera();
+  const Eigen::Isometry3d T_true = Motion(6.0, {0.01, 0.0, 0.002});
+  Eigen::Isometry3d prior = T_true;
+  prior.translation() = Eigen::Vector3d(0.0, 0.0, 0.10);
+  std::vector<StereoCorrespondence> corr;
+  for (const Eigen::Vector3d& p : WallSpecks()) corr.push_back(Exact(cam, T_true, p));
+  PriorMotionOptions options;
+  options.prior_rotation_sigma_deg = 0.05;
+  const PriorMotionResult r = EstimateMotionWithPrior(cam, corr, prior, options);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.num_inliers, 3);
+  // The fit is the MAP one: the prior's translation (σ 1 cm) still pulls a few millimetres.
+  EXPECT_THAT(r.T_prev_curr, IsNearPose(T_true, 0.01 * kDeg, 0.01));
+  // An extrapolated rotation (the default σ, 2°): no such hypothesis, as before.
+  const PriorMotionResult d = EstimateMotionWithPrior(cam, corr, prior);
+  EXPECT_FALSE(d.ok && (d.T_prev_curr.translation() - T_true.translation()).norm() < 1e-3)
+      << d.message;
+}
+
 TEST(PriorMotionTest, ExactWhenTheTruthIsThePrior) {
   const StereoCamera cam = TestCamera();
   const Eigen::Isometry3d T_true = Motion(2.2, {0.006, 0.0, 0.001});
