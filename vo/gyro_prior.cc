@@ -184,4 +184,21 @@ void GyroPrior::Observe(bool measured, const Eigen::Matrix3d& R_prev_curr_vo) {
   stretch_vo_.setIdentity();
 }
 
+void RejectWeakMotionAgainstGyro(const ImuOptions& options, int reliable_min_inliers,
+                                 const Eigen::Matrix3d& R_prior, RansacResult* ransac) {
+  if (!ransac->ok() || ransac->num_inliers >= reliable_min_inliers ||
+      !ransac->T_prev_curr.matrix().allFinite())
+    return;
+  const double error_rad =
+      Eigen::AngleAxisd(R_prior.transpose() * ransac->T_prev_curr.linear()).angle();
+  if (error_rad <= options.max_weak_rotation_error_deg * M_PI / 180.0) return;
+  std::ostringstream msg;
+  msg << "a weak motion (" << ransac->num_inliers << " inliers) turns " << error_rad * 180.0 / M_PI
+      << " deg from the gyro's rotation";
+  ransac->status = RansacResult::Status::kNoConsensus;
+  ransac->message = msg.str();
+  ransac->num_inliers = 0;
+  ransac->inlier_mask.assign(ransac->inlier_mask.size(), false);
+}
+
 }  // namespace vo

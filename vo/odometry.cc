@@ -78,6 +78,10 @@ void StereoOdometry::AddGyroSamples(const std::vector<GyroSample>& samples) {
   if (gyro_) gyro_->AddSamples(samples);
 }
 
+bool StereoOdometry::GyroFewPointAfterLoss() const {
+  return gyro_rotation_.ok && options_.imu.few_point_motion && options_.imu.few_point_after_loss;
+}
+
 void StereoOdometry::Reset() {
   back_end_.Reset();
   tracker_->Reset();
@@ -274,26 +278,9 @@ OdometryResult StereoOdometry::Track(OdometryResult result, MatchFrame frame, Mo
     frame_motion_options.few_point.prior_rotation_sigma_deg =
         std::max(options_.imu.min_rotation_sigma_deg, gyro_rotation_.sigma_rad() * 180.0 / M_PI);
   }
-  // A weak RANSAC motion (fewer than reliable_min_inliers inliers) whose rotation the gyro
-  // contradicts is a wrong consensus: it goes on as one without a consensus (the few-point
-  // motion, with the gyro's rotation as its prior).
-  const double gyro_gate_rad = options_.imu.max_weak_rotation_error_deg * M_PI / 180.0;
-  if (gyro_rotation_.ok && T_ref_curr_prior != nullptr && attempt.ransac.ok() &&
-      attempt.ransac.num_inliers < options_.motion.reliable_min_inliers &&
-      IsFinitePose(attempt.ransac.T_prev_curr)) {
-    const double error_rad = Eigen::AngleAxisd(T_ref_curr_prior->linear().transpose() *
-                                               attempt.ransac.T_prev_curr.linear())
-                                 .angle();
-    if (error_rad > gyro_gate_rad) {
-      std::ostringstream msg;
-      msg << "a weak motion (" << attempt.ransac.num_inliers << " inliers) turns "
-          << error_rad * 180.0 / M_PI << " deg from the gyro's rotation";
-      attempt.ransac.status = RansacResult::Status::kNoConsensus;
-      attempt.ransac.message = msg.str();
-      attempt.ransac.num_inliers = 0;
-      attempt.ransac.inlier_mask.assign(attempt.ransac.inlier_mask.size(), false);
-    }
-  }
+  if (gyro_rotation_.ok && T_ref_curr_prior != nullptr)
+    RejectWeakMotionAgainstGyro(options_.imu, options_.motion.reliable_min_inliers,
+                                T_ref_curr_prior->linear(), &attempt.ransac);
   const FrameMotion motion = ResolveFrameMotion(
       camera_, frame_motion_options,
       static_cast<int>(frame.features.size()) < options_.front_end.min_features, ref_features,

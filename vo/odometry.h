@@ -119,20 +119,12 @@ class StereoOdometry {
                          const MotionPrior* prior = nullptr);
 
   // The gyro (gyro_prior.h), with options().imu.gyro_prior on (otherwise both are ignored):
-  // its mounting and noise model, once before the first frame; then its samples, in time
-  // order, before the Process call of the frame they lead up to (the samples of frames the
-  // caller skips, a frame stride's, too). Each frame's prior rotation is then the gyro's from
-  // the previous call's time_s to this one's (its translation the constant velocity's); a frame
-  // whose interval the samples do not cover keeps the constant velocity's. The gyro's bias is
-  // estimated from the well-tracked frames' rotations. Not used by ProcessFeatures.
+  // its mounting and noise model once, then its samples in time order before the Process call
+  // of the frame they lead up to (a skipped frame's too). Each frame's prior rotation is then
+  // the gyro's since the previous call (its translation the constant velocity's); a frame the
+  // samples do not cover keeps the constant velocity's. Not used by ProcessFeatures.
   void SetGyro(const GyroCalibration& calibration);
   void AddGyroSamples(const std::vector<GyroSample>& samples);
-  // The gyro's rotation of the last Process call (ok false without the gyro).
-  const GyroRotation& last_gyro_rotation() const { return gyro_rotation_; }
-  // The gyro's bias estimate (rad/s, IMU frame; zero without the gyro).
-  Eigen::Vector3d gyro_bias_radps() const {
-    return gyro_ ? gyro_->bias_radps() : Eigen::Vector3d::Zero();
-  }
 
   // The seam (libviso2's process(matches)): runs the back end (RANSAC, tracks, blend, BA) on
   // externally supplied left-image features and matches, skipping disparity, detection and
@@ -182,9 +174,7 @@ class StereoOdometry {
   const Eigen::Vector3d* VehicleUpAtReference(Eigen::Vector3d* storage) const;
   // With the gyro's rotation for this frame, the few-point motion is used after lost frames too
   // (imu.few_point_motion and imu.few_point_after_loss).
-  bool GyroFewPointAfterLoss() const {
-    return gyro_rotation_.ok && options_.imu.few_point_motion && options_.imu.few_point_after_loss;
-  }
+  bool GyroFewPointAfterLoss() const;
   // The tracker predicts its matches (matcher.prediction is not kNone).
   bool Predicted() const { return options_.tracker.matcher.prediction != PredictionMode::kNone; }
   // A lost frame: pose bridged (or `chained`, see Recovery::BridgedPose), reference and

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -223,6 +224,29 @@ TEST(GyroPriorTest, OptionsRefuseBadFields) {
       {"noise_density", [](GyroCalibration* c) { c->noise_density = -1.0; }},
       {"random_walk", [](GyroCalibration* c) { c->random_walk = INFINITY; }},
   });
+}
+
+TEST(GyroPriorTest, AWeakMotionTheGyroContradictsIsNoConsensus) {
+  const ImuOptions options;  // max_weak_rotation_error_deg 0.5
+  const Eigen::Matrix3d R_gyro(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()));
+  auto ransac_at = [&](double off_deg, int inliers) {
+    RansacResult r;
+    r.status = RansacResult::Status::kOk;
+    r.num_inliers = inliers;
+    r.inlier_mask.assign(40, true);
+    r.T_prev_curr = Eigen::Isometry3d::Identity();
+    r.T_prev_curr.linear() =
+        R_gyro * Eigen::AngleAxisd(off_deg * M_PI / 180.0, Eigen::Vector3d::UnitX());
+    RejectWeakMotionAgainstGyro(options, 30, R_gyro, &r);
+    return r;
+  };
+  const RansacResult far = ransac_at(0.8, 12);
+  EXPECT_EQ(far.status, RansacResult::Status::kNoConsensus);
+  EXPECT_EQ(far.num_inliers, 0);
+  EXPECT_EQ(std::count(far.inlier_mask.begin(), far.inlier_mask.end(), true), 0);
+  EXPECT_THAT(far.message, ::testing::HasSubstr("from the gyro's rotation"));
+  EXPECT_TRUE(ransac_at(0.3, 12).ok());  // within the gate
+  EXPECT_TRUE(ransac_at(5.0, 30).ok());  // reliable: never second-guessed
 }
 
 }  // namespace
