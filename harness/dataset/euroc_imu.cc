@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <filesystem>
+#include <functional>
 
 #include "harness/dataset/common.h"
 #include "harness/dataset/internal.h"
@@ -42,6 +43,34 @@ bool ParseStamp(std::string_view text, int64_t* value) {
   if (text.empty()) return false;
   const std::from_chars_result r = std::from_chars(text.data(), text.data() + text.size(), *value);
   return r.ec == std::errc() && r.ptr == text.data() + text.size();
+}
+
+// Reads the data rows of a EuRoC CSV whose lines are "<timestamp ns>,<fields>" (comments and
+// blank lines skipped) and calls row(line_no, stamp, its text, the numbers after it) for each;
+// a row without a stamp before its first comma, or without `fields` numbers after it, is
+// refused at file:line (`layout` names the line's fields, `numbers` those after the stamp).
+bool ForEachStampedRow(
+    const std::string& path, size_t fields, const std::string& layout, const std::string& numbers,
+    const std::function<bool(int, int64_t, std::string_view, const std::vector<double>&)>& row,
+    std::string* error) {
+  std::vector<std::string> lines;
+  if (!ReadTextLines(path, &lines, error)) return false;
+  std::vector<double> v;
+  std::string what;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (IsBlankOrComment(lines[i])) continue;
+    const int line_no = static_cast<int>(i) + 1;
+    const std::string_view line(lines[i]);
+    const size_t comma = line.find(',');
+    int64_t stamp = 0;
+    if (comma == std::string_view::npos || !ParseStamp(line.substr(0, comma), &stamp))
+      return Fail(error, Where(path, line_no) + "expected '" + layout + "' (" +
+                             std::to_string(fields + 1) + " fields)");
+    if (!ParseNumbers(line.substr(comma + 1), fields, &v, &what))
+      return Fail(error, Where(path, line_no) + what + " after the time stamp (" + numbers + ")");
+    if (!row(line_no, stamp, line.substr(0, comma), v)) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -122,33 +151,23 @@ bool WriteEurocImu(const std::string& mav0, const std::vector<sim::ImuSample>& s
 
 bool ReadEurocImu(const std::string& path, std::vector<int64_t>* t_ns,
                   std::vector<sim::ImuSample>* samples, std::string* error) {
-  std::vector<std::string> lines;
-  if (!ReadTextLines(path, &lines, error)) return false;
   t_ns->clear();
   samples->clear();
   IncreasingStamps<int64_t> order(path);
-  std::vector<double> v;
-  std::string what;
-  for (size_t i = 0; i < lines.size(); ++i) {
-    if (IsBlankOrComment(lines[i])) continue;
-    const int line_no = static_cast<int>(i) + 1;
-    const std::string_view line(lines[i]);
-    const size_t comma = line.find(',');
-    int64_t stamp = 0;
-    if (comma == std::string_view::npos || !ParseStamp(line.substr(0, comma), &stamp))
-      return Fail(error, Where(path, line_no) +
-                             "expected '<timestamp ns>,w_x,w_y,w_z,a_x,a_y,a_z' (7 fields)");
-    if (!order.Next(stamp, line.substr(0, comma), line_no, error)) return false;
-    if (!ParseNumbers(line.substr(comma + 1), 6, &v, &what))
-      return Fail(error, Where(path, line_no) + what +
-                             " after the time stamp (w_RS_S xyz [rad s^-1], a_RS_S xyz [m s^-2])");
+  const auto row = [&](int line_no, int64_t stamp, std::string_view text,
+                       const std::vector<double>& v) {
+    if (!order.Next(stamp, text, line_no, error)) return false;
     sim::ImuSample s;
     s.time_s = dataset_internal::NsToSeconds(stamp);
     s.gyro_radps = Eigen::Vector3d(v[0], v[1], v[2]);
     s.accel_mps2 = Eigen::Vector3d(v[3], v[4], v[5]);
     t_ns->push_back(stamp);
     samples->push_back(s);
-  }
+    return true;
+  };
+  if (!ForEachStampedRow(path, 6, "<timestamp ns>,w_x,w_y,w_z,a_x,a_y,a_z",
+                         "w_RS_S xyz [rad s^-1], a_RS_S xyz [m s^-2]", row, error))
+    return false;
   if (samples->empty()) return Fail(error, path + ": no IMU samples");
   return true;
 }
@@ -158,30 +177,14 @@ bool ReadEurocImuGroundTruth(const std::string& path, const std::vector<int64_t>
   if (samples->size() != t_ns.size())
     return Fail(error, path + ": ReadEurocImuGroundTruth: " + std::to_string(t_ns.size()) +
                            " stamps for " + std::to_string(samples->size()) + " samples");
-  std::vector<std::string> lines;
-  if (!ReadTextLines(path, &lines, error)) return false;
   size_t next = 0;  // the sample the next line is for
-  std::vector<double> v;
-  std::string what;
-  for (size_t i = 0; i < lines.size(); ++i) {
-    if (IsBlankOrComment(lines[i])) continue;
-    const int line_no = static_cast<int>(i) + 1;
-    const std::string_view line(lines[i]);
-    const size_t comma = line.find(',');
-    int64_t stamp = 0;
-    if (comma == std::string_view::npos || !ParseStamp(line.substr(0, comma), &stamp))
-      return Fail(error, Where(path, line_no) +
-                             "expected '<timestamp ns>,p xyz,q wxyz,v xyz,b_w xyz,b_a xyz' "
-                             "(17 fields)");
+  const auto row = [&](int line_no, int64_t stamp, std::string_view, const std::vector<double>& v) {
     if (next >= t_ns.size() || stamp != t_ns[next])
       return Fail(error,
                   Where(path, line_no) + "time stamp " + std::to_string(stamp) +
                       (next < t_ns.size() ? " is not the IMU sample's " + std::to_string(t_ns[next])
                                           : " is past the last IMU sample's") +
                       " (expected one line per imu0 sample, at its stamp)");
-    if (!ParseNumbers(line.substr(comma + 1), 16, &v, &what))
-      return Fail(error, Where(path, line_no) + what +
-                             " after the time stamp (p xyz, q wxyz, v xyz, b_w xyz, b_a xyz)");
     Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
     if (!(q.norm() > 0.5 && q.norm() < 2.0))
       return Fail(error, Where(path, line_no) + "the quaternion (fields 5-8) is not a rotation");
@@ -192,7 +195,11 @@ bool ReadEurocImuGroundTruth(const std::string& path, const std::vector<int64_t>
     s.v_world_mps = Eigen::Vector3d(v[7], v[8], v[9]);
     s.gyro_bias_radps = Eigen::Vector3d(v[10], v[11], v[12]);
     s.accel_bias_mps2 = Eigen::Vector3d(v[13], v[14], v[15]);
-  }
+    return true;
+  };
+  if (!ForEachStampedRow(path, 16, "<timestamp ns>,p xyz,q wxyz,v xyz,b_w xyz,b_a xyz",
+                         "p xyz, q wxyz, v xyz, b_w xyz, b_a xyz", row, error))
+    return false;
   if (next != t_ns.size())
     return Fail(error, path + ": " + std::to_string(next) + " lines for " +
                            std::to_string(t_ns.size()) +
