@@ -112,6 +112,15 @@ bool OpenEuroc(const std::string& dir, const EvalOptions& options, StereoSequenc
   sequence->camera = rectification->camera;
   sequence->has_imu = reader->has_imu();
   sequence->imu = reader->imu();
+  if (sequence->has_imu) {
+    // EuRoC's body frame is its IMU's (imu0's T_BS is the identity, in the real datasets and in
+    // vobench's exports): the rectified left camera in the IMU frame is cam0's T_BS turned by
+    // the rectification's rotation (a rotation about cam0's centre).
+    sequence->T_imu_cam0 = reader->cam0().T_body_cam;
+    sequence->T_imu_cam0.linear() =
+        reader->cam0().T_body_cam.linear() * rectification->R_cam0_rect0;
+    sequence->imu_extrinsics_known = true;
+  }
   sequence->expected_frames = static_cast<int>(reader->size());
   sequence->next = [reader, rectification, next = size_t{0}](DatasetFrame* frame,
                                                              std::string* err) mutable {

@@ -60,10 +60,11 @@ struct StereoSequence {
   std::string ground_truth_not_gravity_aligned;
   // An IMU: the frames carry its samples since the previous frame (DatasetFrame::imu). A
   // simulated scenario always has one (its imu keys, the IMU's pose on the rig); a EuRoC folder
-  // when mav0/imu0/data.csv is there (imu: its sensor.yaml's rate and noise numbers;
-  // T_imu_cam0 is not set there: EuRoC's cam0 T_BS is the raw camera's, not the rectified one's).
+  // when mav0/imu0/data.csv is there (imu: its sensor.yaml's rate and noise numbers; T_imu_cam0:
+  // cam0's T_BS, the body being the IMU as in EuRoC, turned by the rectification's rotation).
   // The VO uses its gyro (vo_options.yaml imu.gyro_prior, vo/gyro_prior.h) when T_imu_cam0 is
-  // known (imu_extrinsics_known: a simulated scenario; not yet EuRoC or a bag).
+  // known (imu_extrinsics_known: a simulated scenario, a EuRoC folder; not yet a bag, whose
+  // camera_info carries no mounting on the IMU).
   bool has_imu = false;
   sim::ImuOptions imu;                                           // rate and noise numbers
   Eigen::Isometry3d T_imu_cam0 = Eigen::Isometry3d::Identity();  // cam0 in the IMU frame

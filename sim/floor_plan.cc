@@ -553,7 +553,7 @@ bool ParseFloorPlan(const std::string& yaml_text, const std::string& source_name
       const YAML::Node n = l[i];
       const std::string key = YamlReader::Item("lights", i);
       if (!r.ExpectMap(n, key)) break;
-      r.CheckKeys(n, key, {"type", "pos", "dir", "diffuse"});
+      r.CheckKeys(n, key, {"type", "pos", "dir", "diffuse", "cutoff_deg"});
       PlanLight li;
       std::string type = "directional";
       r.String(n, key, "type", &type);
@@ -570,6 +570,12 @@ bool ParseFloorPlan(const std::string& yaml_text, const std::string& source_name
       r.Check(li.dir.norm() > 1e-6, n, key, "dir", "expected a non-zero direction");
       r.Double(n, key, "diffuse", &li.diffuse);
       r.Check(li.diffuse >= 0 && li.diffuse <= 1, n, key, "diffuse", "expected in [0, 1]");
+      if (YamlReader::Has(n, "cutoff_deg")) {
+        r.Check(!li.directional, n, key, "cutoff_deg", "only a point light has a cone");
+        r.Double(n, key, "cutoff_deg", &li.cutoff_deg);
+        r.Check(li.cutoff_deg > 0 && li.cutoff_deg <= 90, n, key, "cutoff_deg",
+                "expected an angle in (0, 90] degrees");
+      }
       p.lights.push_back(li);
     }
   } else {
@@ -863,8 +869,9 @@ std::string FloorPlanToMjcf(const FloorPlan& plan, const std::string& robot_incl
     x << "    <light directional=\"" << (l.directional ? "true" : "false") << "\" pos=\""
       << Num(l.pos.x()) << " " << Num(l.pos.y()) << " " << Num(l.pos.z()) << "\" dir=\""
       << Num(l.dir.x()) << " " << Num(l.dir.y()) << " " << Num(l.dir.z()) << "\" diffuse=\""
-      << Num(l.diffuse) << " " << Num(l.diffuse) << " " << Num(l.diffuse)
-      << "\" specular=\"0 0 0\" castshadow=\"false\"/>\n";
+      << Num(l.diffuse) << " " << Num(l.diffuse) << " " << Num(l.diffuse) << "\"";
+    if (l.cutoff_deg > 0) x << " cutoff=\"" << Num(l.cutoff_deg) << "\"";
+    x << " specular=\"0 0 0\" castshadow=\"false\"/>\n";
   }
   x << "    <!-- physics floor: infinite, collision only (group 3 is never drawn) -->\n";
   x << "    <geom name=\"physics_floor\" type=\"plane\" size=\"0 0 1\" group=\"3\" "

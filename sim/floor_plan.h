@@ -97,6 +97,10 @@ struct PlanLight {
   Eigen::Vector3d pos = Eigen::Vector3d(0, 0, 5);  // (m)
   Eigen::Vector3d dir = Eigen::Vector3d(0, 0, -1);
   double diffuse = 0.25;  // grey level of the light's diffuse colour, [0, 1]
+  // A point light's cone: MuJoCo's lights that are not directional are spotlights, lighting
+  // what lies within cutoff_deg of `dir` (falling off as cos^10 of the angle). 0: not given,
+  // MuJoCo's default (45 degrees) and the MJCF carries no cutoff.
+  double cutoff_deg = 0.0;
 };
 
 struct FloorPlan {

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <sstream>
 #include <tuple>
@@ -260,6 +261,49 @@ TEST(RenderTest, ALensIsRawInEurocAndRectifiedElsewhereAsEvalRectifiesIt) {
     EXPECT_GT(trajectory.size(), 100u);
     EXPECT_EQ(trajectory, ReadAll(fs::path(dir / "eval") / "trajectory_kitti.txt")) << lens;
   }
+}
+
+// Issue #34: everything that goes wrong in a real building at once (two people walking, a
+// flickering tube, a 1 % baseline error in the exported calibration, a radtan lens) rendered as
+// EuRoC; `vobench eval --format euroc` rectifies the raw images with the exported calibration and
+// the VO (defaults) measures every frame of a short straight path (2 m).
+TEST(RenderTest, PeopleFlickerCalibrationErrorAndALensRenderAsEurocAndEvalLosesNoFrame) {
+  TempDir dir("render_realism");
+  // A 2 m straight path: people walk lines of 1.5 m beside it (sim/people.h).
+  std::string yaml = ShortScenario(
+      dir,
+      "people:\n  count: 2\n  seed: 4\n"
+      "lights:\n  flicker_hz: 2.7\n  flicker_depth: 0.3\n"
+      "calibration_error:\n  baseline_pct: 1.0\n"
+      "camera:\n  distortion: {model: radtan, coeffs: [-0.28, 0.07, 0.0002, 0.00002]}\n");
+  std::string text = ReadAll(yaml);
+  const std::string short_path = "  - [0.8, 0]\n";
+  ASSERT_NE(text.find(short_path), std::string::npos);
+  text.replace(text.find(short_path), short_path.size(), "  - [2.0, 0]\n");
+  WriteText(yaml, text);
+  const std::string euroc = dir / "euroc";
+  const auto r = RunVobench("render " + yaml + " --out " + euroc + " -q --format euroc");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const vo::StereoCamera rectified = ExpectKittiSideIsEvalsRectification(euroc);
+  std::string error;
+  sim::Scenario scenario;
+  ASSERT_TRUE(sim::LoadScenario(yaml, &scenario, &error)) << error;
+  EXPECT_NEAR(rectified.baseline_m, 1.01 * scenario.camera.baseline_m, 1e-9);  // the error
+  EXPECT_EQ(scenario.people.count, 2);
+  harness::EurocReader reader;
+  ASSERT_TRUE(reader.Open(euroc, &error)) << error;
+  ASSERT_GE(reader.size(), 10u);
+
+  const auto eval = RunVobench("eval --format euroc --dataset " + euroc + " -q --no-plots --out " +
+                               (dir / "eval"));
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  std::ifstream in(fs::path(dir / "eval") / "metrics.json");
+  const nlohmann::json m = nlohmann::json::parse(in);
+  EXPECT_EQ(m["frames"], static_cast<int>(reader.size()));
+  EXPECT_EQ(m["frames_not_initialised"], 0);
+  EXPECT_EQ(m["lost_frames"], 0) << m.dump(1);
+  EXPECT_EQ(m["ground_truth_frames"], static_cast<int>(reader.size()));
+  EXPECT_LT(m["end_pose_error_m"].get<double>(), 0.05) << m.dump(1);  // of a 2 m path
 }
 
 class RenderBadInputTest : public ::testing::Test {

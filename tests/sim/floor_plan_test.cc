@@ -237,6 +237,11 @@ TEST(FloorPlanTest, BadPlansAreRefusedAtFileAndLine) {
       {"rooms:\n  - {name: r, rect: [0, 0, 4, 4], colour: red}\n",
        "plan.yaml:2: key 'rooms[0].colour': unknown key"},
       {"ceiling_height_m: 2.5\n", "plan.yaml:1: a floor plan needs at least one corridor"},
+      {"rooms:\n  - {name: r, rect: [0, 0, 4, 4]}\nlights:\n  - {type: directional, cutoff_deg: "
+       "30}\n",
+       "plan.yaml:4: key 'lights[0].cutoff_deg': only a point light has a cone"},
+      {"rooms:\n  - {name: r, rect: [0, 0, 4, 4]}\nlights:\n  - {type: point, cutoff_deg: 120}\n",
+       "plan.yaml:4: key 'lights[0].cutoff_deg': expected an angle in (0, 90] degrees"},
   };
   for (const Case& c : cases) {
     sim::FloorPlan plan;

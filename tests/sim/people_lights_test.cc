@@ -5,7 +5,9 @@
 // auto-exposure is a first-order step response; bad values are refused at their line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/core.hpp>
 #include <string>
 #include <utility>
@@ -238,6 +240,81 @@ TEST(LightsTest, ASwitchedOffLampDarkensTheFramesFromItsSwitch) {
     // The geometry does not change with the light.
     EXPECT_TRUE(SameBytes(a.frames[k].depth_m, b.frames[k].depth_m)) << k;
   }
+}
+
+// A lamp is a spotlight over the floor of a plain corridor (a floor plan with a dim directional
+// light 0 and lamp 1 at (3, 0, 2.4) pointing down, a 20 degree cone: a disc of radius
+// 2.4 tan 20 = 0.87 m on the floor, well inside the 2.4 m wide corridor). Switched off from the
+// start, it darkens exactly its region: every pixel whose surface point lies outside the cone by
+// more than one quad of the floor's rendering grid keeps its byte, every pixel well inside
+// (within 12 degrees) is darker, and most of the view is outside. MuJoCo's fixed-function
+// lighting is computed at the vertices of a plane's grid and interpolated across each quad; the
+// quads are 0.2 m for a plan's 0.1 m grid spacing (the changed pixels reach 0.19 m past the
+// cone, more than the 0.14 m diagonal of 0.1 m quads), so the margin is a 0.2 m quad's diagonal.
+TEST(LightsTest, ALampSwitchedOffDarkensExactlyItsRegion) {
+  TempDir dir("lamp_region");
+  WriteText(dir / "plan.yaml",
+            "ceiling_height_m: 2.5\nfloor: plain\nceiling: plain\n"
+            "corridors:\n  - {name: hall, centre: [[-1.5, 0], [9, 0]], width_m: 2.4, walls: "
+            "plain}\n"
+            "lights:\n  - {type: directional, dir: [0.3, 0.2, -1], diffuse: 0.05}\n"
+            "  - {type: point, pos: [3, 0, 2.4], dir: [0, 0, -1], diffuse: 0.2, cutoff_deg: "
+            "20}\n");
+  WriteText(dir / "s.yaml",
+            "floor_plan: plan.yaml\npath:\n  - [0, 0]\n  - [1, 0]\ncamera:\n  width: 160\n"
+            "  height: 120\n");
+  sim::Scenario lit;
+  std::string error;
+  ASSERT_TRUE(sim::LoadScenario(dir / "s.yaml", &lit, &error)) << error;
+  lit.noise = sim::NoiseOptions();
+  sim::Scenario dark = lit;
+  sim::LightSwitch off;
+  off.at_s = 0.0;
+  off.light = 1;
+  dark.lights.switches = {off};
+  const SimRun a = Simulate(lit, 1), b = Simulate(dark, 1);
+  ASSERT_EQ(a.frames.size(), 1u);
+  ASSERT_EQ(b.frames.size(), 1u);
+  const sim::StereoFrame& fa = a.frames[0];
+  const sim::StereoFrame& fb = b.frames[0];
+  EXPECT_TRUE(SameBytes(fa.depth_m, fb.depth_m));
+
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  sim::IntrinsicsFromFovy(lit.camera.fovy_deg, lit.camera.width, lit.camera.height, &fx, &fy, &cx,
+                          &cy);
+  const Eigen::Vector3d lamp(3, 0, 2.4), down(0, 0, -1);
+  const double cutoff = 20.0 * M_PI / 180.0, cell_m = 0.2 * std::sqrt(2.0);
+  int outside = 0, inside = 0, outside_changed = 0, inside_not_darker = 0;
+  double inside_darkening = 0.0;
+  for (int v = 0; v < fa.left.rows; ++v) {
+    for (int u = 0; u < fa.left.cols; ++u) {
+      const double z = fa.depth_m.at<float>(v, u);
+      const Eigen::Vector3d p =
+          fa.T_world_cam0 * Eigen::Vector3d((u - cx) / fx * z, (v - cy) / fy * z, z);
+      const Eigen::Vector3d ray = p - lamp;
+      const double angle = std::acos(std::clamp(ray.normalized().dot(down), -1.0, 1.0));
+      // How far the point lies outside the cone's surface (m).
+      const double beyond_m = ray.norm() * std::sin(std::min(angle - cutoff, M_PI / 2));
+      const int lit_grey = fa.left.at<uchar>(v, u), dark_grey = fb.left.at<uchar>(v, u);
+      if (angle > cutoff && beyond_m > cell_m) {
+        ++outside;
+        outside_changed += lit_grey != dark_grey;
+      } else if (angle < 12.0 * M_PI / 180.0) {
+        ++inside;
+        inside_not_darker += dark_grey >= lit_grey;
+        inside_darkening += lit_grey - dark_grey;
+      }
+    }
+  }
+  std::printf(
+      "lamp off: %d pixels outside the cone (%d changed), %d inside (%d not darker), "
+      "darker by %.1f grey levels on average\n",
+      outside, outside_changed, inside, inside_not_darker, inside_darkening / std::max(inside, 1));
+  EXPECT_GT(outside, fa.left.rows * fa.left.cols / 2);
+  EXPECT_GT(inside, 200);
+  EXPECT_EQ(outside_changed, 0) << "of " << outside << " pixels outside the lamp's cone";
+  EXPECT_EQ(inside_not_darker, 0) << "of " << inside << " pixels inside the lamp's cone";
+  EXPECT_GT(inside_darkening / std::max(inside, 1), 10.0);  // grey levels, on average
 }
 
 // 2.5 Hz flicker of depth 0.5 at 10 Hz: brightness 1, 0.75, 0.5, 0.75, 1, ... (period 4 frames).
