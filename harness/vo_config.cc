@@ -425,6 +425,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"imu.gyro_prior", Bool(&o->imu.gyro_prior)},
       {"imu.few_point_motion", Bool(&o->imu.few_point_motion)},
       {"imu.few_point_after_loss", Bool(&o->imu.few_point_after_loss)},
+      {"imu.ba_rotation_prior", Bool(&o->imu.ba_rotation_prior)},
       {"imu.max_weak_rotation_error_deg", Number(&o->imu.max_weak_rotation_error_deg, 1e-9, 180.0)},
       {"imu.min_rotation_sigma_deg", Number(&o->imu.min_rotation_sigma_deg, 1e-9, 180.0)},
       {"imu.initial_bias_sigma_radps", Number(&o->imu.initial_bias_sigma_radps, 0.0, 100.0)},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <sstream>
 
 #include "vo/motion_model.h"
@@ -103,7 +104,10 @@ PlanarMotionPrior WindowPlanarPrior(const BackEndOptions& options,
 BackEnd::BackEnd(const BackEndOptions& options)
     : options_(options), window_(WindowOptions(options)) {}
 
-void BackEnd::Reset() { window_.Reset(); }
+void BackEnd::Reset() {
+  window_.Reset();
+  gyro_chain_.clear();
+}
 
 TrackUpdateResult BackEnd::Start(int64_t frame_index, std::vector<Feature>* features,
                                  const Eigen::Isometry3d& T_world_cam0) {
@@ -130,7 +134,52 @@ BackEndAdd BackEnd::Add(int64_t frame_index, int64_t ref_frame_index,
 
 WindowRefinement BackEnd::Refine(const StereoCamera& camera, int64_t frame_index,
                                  const VehicleGeometry& geometry) {
-  return window_.Refine(camera, frame_index, WindowPlanarPrior(options_, geometry));
+  return window_.Refine(camera, frame_index, WindowPlanarPrior(options_, geometry),
+                        GyroRotationPriors());
+}
+
+void BackEnd::AddGyroRotation(int64_t frame_index, const GyroRotation& rotation,
+                              double min_rotation_sigma_deg) {
+  // Frames older than the window's oldest (and than the previous frame) are no longer needed.
+  const std::deque<int64_t>& window = window_.tracks().window_frame_ids();
+  const int64_t oldest =
+      window.empty() ? frame_index - 1 : std::min(window.front(), frame_index - 1);
+  gyro_chain_.erase(gyro_chain_.begin(), gyro_chain_.lower_bound(oldest));
+  GyroNode node;
+  node.first = frame_index;
+  const auto prev = gyro_chain_.find(frame_index - 1);
+  const double sigma_rad =
+      std::max(min_rotation_sigma_deg * M_PI / 180.0, rotation.ok ? rotation.sigma_rad() : 0.0);
+  if (rotation.ok && prev != gyro_chain_.end() && rotation.R_prev_curr.allFinite() &&
+      std::isfinite(sigma_rad)) {
+    node.first = prev->second.first;
+    node.R_first_frame = prev->second.R_first_frame * rotation.R_prev_curr;
+    node.variance_rad2 = prev->second.variance_rad2 + sigma_rad * sigma_rad;
+  }
+  gyro_chain_[frame_index] = node;
+}
+
+std::vector<WindowRotationPrior> BackEnd::GyroRotationPriors() const {
+  std::vector<WindowRotationPrior> priors;
+  const GyroNode* previous = nullptr;
+  int64_t previous_frame = -1;
+  for (int64_t frame : window_.tracks().window_frame_ids()) {
+    const auto it = gyro_chain_.find(frame);
+    const GyroNode* node =
+        it != gyro_chain_.end() && Pose(frame) != nullptr ? &it->second : nullptr;
+    if (node != nullptr && previous != nullptr && node->first == previous->first &&
+        node->variance_rad2 > previous->variance_rad2) {
+      WindowRotationPrior p;
+      p.frame_a = previous_frame;
+      p.frame_b = frame;
+      p.R_a_b = previous->R_first_frame.transpose() * node->R_first_frame;
+      p.sigma_rad = std::sqrt(node->variance_rad2 - previous->variance_rad2);
+      priors.push_back(p);
+    }
+    previous = node;
+    previous_frame = frame;
+  }
+  return priors;
 }
 
 Eigen::Isometry3d BackEnd::MotionFromReference(int64_t ref_frame_index,

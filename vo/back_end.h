@@ -10,16 +10,20 @@
 // caller). The back end knows nothing of matching, RANSAC or recovery: it receives the frame's
 // features, its inlier matches, its measured motion and the prior's, and gives back the poses
 // and the refined motion from the reference, which the motion model (motion_model.h) takes in.
+// With a gyro (imu.gyro_prior and imu.ba_rotation_prior), the adjustment also holds consecutive
+// window frames to the gyro's rotation between them (AddGyroRotation, rotation_prior.h).
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "vo/bundle_adjustment.h"
 #include "vo/camera.h"
+#include "vo/gyro_prior.h"
 #include "vo/planar_motion_prior.h"
 #include "vo/sliding_window.h"
 #include "vo/tracks.h"
@@ -152,9 +156,27 @@ class BackEnd {
   const TrackManager& tracks() const { return window_.tracks(); }
   const BackEndOptions& options() const { return options_; }
 
+  // The gyro's rotation of frame `frame_index` (every processed frame, indices consecutive):
+  // R_prev_curr from the frame before, its σ max(min_rotation_sigma_deg, rotation.sigma_rad());
+  // not ok breaks the chain there. Refine then holds each pair of consecutive window frames
+  // whose chain is unbroken to the product of the rotations between them (σ² summed).
+  void AddGyroRotation(int64_t frame_index, const GyroRotation& rotation,
+                       double min_rotation_sigma_deg);
+  // The priors Refine gives the window now (consecutive window frames, oldest first).
+  std::vector<WindowRotationPrior> GyroRotationPriors() const;
+
  private:
+  // A frame of the gyro's chain: the chain's first frame, the rotation R_first_frame and the
+  // variance summed along it (rad²).
+  struct GyroNode {
+    int64_t first = -1;
+    Eigen::Matrix3d R_first_frame = Eigen::Matrix3d::Identity();
+    double variance_rad2 = 0.0;
+  };
+
   BackEndOptions options_;
-  SlidingWindow window_;  // tracks, window poses and the bundle adjustment
+  SlidingWindow window_;                    // tracks, window poses and the bundle adjustment
+  std::map<int64_t, GyroNode> gyro_chain_;  // by frame index, from the window's oldest frame
 };
 
 }  // namespace vo

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "vo/rotation_prior.h"
 #include "vo/schur_lm.h"
 
 namespace vo {
@@ -291,6 +292,7 @@ struct BackendProblem {
   std::vector<int> observations;  // indices into the input's observations
   std::vector<bool> pose_in_problem;
   std::vector<std::pair<int, int>> planar_links;  // (earlier, later) pose of each planar block
+  std::vector<RotationPrior> rotation_priors;     // the input's that take part
 };
 
 // Ceres' linear solver for BundleAdjustmentOptions::linear_solver (see BaLinearSolver).
@@ -352,6 +354,12 @@ BackendResult SolveWithCeres(const StereoCamera& cam, const BundleAdjustmentProb
                                         7, 7>(new PlanarMotionResidual(input.planar)),
         nullptr, bp->poses[a].data(), bp->poses[b].data());
   }
+  for (const RotationPrior& prior : bp->rotation_priors) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<RotationPriorResidual, RotationPriorResidual::kNumResiduals,
+                                        7, 7>(new RotationPriorResidual(prior)),
+        nullptr, bp->poses[prior.frame_a].data(), bp->poses[prior.frame_b].data());
+  }
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (size_t i = 0; i < bp->poses.size(); ++i) {
     if (!bp->pose_in_problem[i]) continue;
@@ -402,8 +410,9 @@ BackendResult SolveWithSchurLm(const StereoCamera& cam, const BundleAdjustmentPr
   std::vector<bool> pose_is_free(bp->poses.size(), false);
   for (size_t i = 0; i < bp->poses.size(); ++i)
     pose_is_free[i] = static_cast<int>(i) >= options.num_fixed_poses;
-  const SchurLmSummary lm = SolveSchurLm(cam, options, residuals, pose_is_free, &bp->poses,
-                                         &bp->points, bp->planar_links, input.planar);
+  const SchurLmSummary lm =
+      SolveSchurLm(cam, options, residuals, pose_is_free, &bp->poses, &bp->points, bp->planar_links,
+                   input.planar, bp->rotation_priors);
   BackendResult r;
   r.initial_cost = lm.initial_cost;
   r.num_iterations = lm.num_successful_steps + lm.num_unsuccessful_steps;
@@ -446,6 +455,18 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
     msg << "need at least num_fixed_poses = " << options.num_fixed_poses << " poses, got "
         << num_frames;
   if (msg.tellp() != 0) return fail(Status::kInvalidInput);
+  for (size_t k = 0; k < input.rotation_priors.size(); ++k) {
+    const RotationPrior& p = input.rotation_priors[k];
+    if (p.frame_a < 0 || p.frame_a >= num_frames || p.frame_b < 0 || p.frame_b >= num_frames ||
+        p.frame_a == p.frame_b || !p.R_a_b.allFinite() ||
+        !(p.R_a_b * p.R_a_b.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
+        !(p.R_a_b.determinant() > 0.0) || !(p.sigma_rad > 0.0) || !std::isfinite(p.sigma_rad)) {
+      msg << "rotation prior " << k << " refers to frames " << p.frame_a << " / " << p.frame_b
+          << " (have " << num_frames << ", they must differ) or has no rotation or no finite "
+          << "sigma_rad > 0";
+      return fail(Status::kInvalidInput);
+    }
+  }
   for (int i = 0; i < num_frames; ++i) {
     if (!input.T_world_cam0[i].matrix().allFinite()) {
       msg << "pose " << i << " is not finite";
@@ -533,6 +554,13 @@ BundleAdjustmentSummary RunBundleAdjustment(const StereoCamera& cam,
     }
     s.num_planar_links = static_cast<int>(bp.planar_links.size());
   }
+  for (const RotationPrior& prior : input.rotation_priors) {
+    if (!bp.pose_in_problem[prior.frame_a] || !bp.pose_in_problem[prior.frame_b]) continue;
+    if (prior.frame_a < options.num_fixed_poses && prior.frame_b < options.num_fixed_poses)
+      continue;
+    bp.rotation_priors.push_back(prior);
+  }
+  s.num_rotation_priors = static_cast<int>(bp.rotation_priors.size());
 
   // --- plain rms of the used observations (before) ---
   // sqrt(Σ |e|² / #image observations) over the used observations (and, with

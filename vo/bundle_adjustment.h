@@ -24,6 +24,11 @@
 // change, no lift, no sideways slip of the axle; planar_motion_prior.h), without a robust
 // loss. Both backends evaluate the same templated residual.
 //
+// Gyro (optional, BundleAdjustmentProblem::rotation_priors): residuals between two poses that
+// hold their relative rotation to a gyro's (rotation_prior.h), without a robust loss. Both
+// backends evaluate the same templated residual. None by default: the result is then bit for
+// bit what it was without them.
+//
 // Gauge. The num_fixed_poses oldest poses (default 1: the oldest of the window) are held
 // constant (Problem::SetParameterBlockConstant); the stereo baseline fixes the scale.
 //
@@ -116,6 +121,15 @@ struct BaObservation {
   Eigen::Vector2d uv_right_px = Eigen::Vector2d::Zero();  // right image (pixels), if has_right
 };
 
+// A relative-rotation prior between two poses (rotation_prior.h): the rotation of camera
+// frame_b in camera frame_a measured by a gyro, R_a_b = R_world_aᵀ R_world_b ideally.
+struct RotationPrior {
+  int frame_a = -1;                                     // index into T_world_cam0
+  int frame_b = -1;                                     // index into T_world_cam0, != frame_a
+  Eigen::Matrix3d R_a_b = Eigen::Matrix3d::Identity();  // rotation of b in a (camera frames)
+  double sigma_rad = 1.0;                               // σ about any axis (radians), > 0
+};
+
 // Initial values and measurements. Frames are ordered oldest first; the first
 // num_fixed_poses frames are held constant.
 struct BundleAdjustmentProblem {
@@ -126,6 +140,9 @@ struct BundleAdjustmentProblem {
   // 4-residual block links each pose that takes part to the previous one that does (in this
   // order), unless both are held constant.
   PlanarMotionPrior planar;
+  // Relative-rotation priors (a gyro's), may be empty: one 3-residual block each, unless a
+  // pose of it has no observation used or both are held constant.
+  std::vector<RotationPrior> rotation_priors;
 };
 
 struct BundleAdjustmentSummary {
@@ -149,6 +166,7 @@ struct BundleAdjustmentSummary {
                                 // the start counts as one successful, as in Ceres)
   int num_residual_blocks = 0;  // observations in the problem
   int num_planar_links = 0;     // planar motion prior blocks in the problem
+  int num_rotation_priors = 0;  // relative-rotation prior blocks in the problem
   int num_points_optimized = 0;
   std::string linear_solver;  // linear solver used: Ceres', e.g. "SPARSE_SCHUR (SUITE_SPARSE)",
                               // or "SCHUR_LM (dense Cholesky)"

@@ -5,7 +5,9 @@
 // ImuOptions::gyro_prior on, the prior's rotation of each frame is the gyro's (its translation
 // stays the constant velocity's): the matching gates, the bridge of a frame without matches,
 // the lost-frame chain, the few-point motion (whose rotation prior σ becomes the gyro's) and
-// the blend with the measured motion all use it. Without samples, or with gyro_prior off,
+// the blend with the measured motion all use it, and the windowed bundle adjustment holds
+// consecutive window frames to the gyro's rotation between them (imu.ba_rotation_prior,
+// back_end.h, rotation_prior.h). Without samples, or with gyro_prior off,
 // nothing changes (bit for bit).
 //
 // Integration. The samples are rates ω_i (rad/s, IMU frame) at times t_i; between two frames
@@ -62,6 +64,11 @@ struct ImuOptions {
                                      // rotation since the reference is the gyro's, the few
                                      // matches measure the translation the constant velocity
                                      // extrapolated
+  bool ba_rotation_prior = true;     // the windowed bundle adjustment holds each pair of
+                                     // consecutive window frames whose frames between were all
+                                     // given the gyro's rotation to the gyro's rotation between
+                                     // them (rotation_prior.h; σ as below, the frames' variances
+                                     // summed); used only with gyro_prior on
   double max_weak_rotation_error_deg = 0.5;  // a weak RANSAC motion (fewer than
                                              // motion.reliable_min_inliers inliers) whose
                                              // rotation is farther than this from the gyro's
@@ -69,7 +76,8 @@ struct ImuOptions {
                                              // instead), > 0
   double min_rotation_sigma_deg = 0.05;      // σ of the gyro's rotation as a prior term (the
                                              // few-point motion's rotation prior, the direct
-                                             // alignment's yaw prior): the gyro's own σ, at least
+                                             // alignment's yaw prior, the bundle adjustment's
+                                             // rotation prior): the gyro's own σ, at least
                                              // this (degrees; the IMU's mounting and time stamps
                                              // are not exact), > 0
   double initial_bias_sigma_radps = 0.005;   // σ of the bias before any estimate (rad/s), >= 0

@@ -429,6 +429,9 @@ OdometryResult StereoOdometry::Process(const cv::Mat& left, const cv::Mat& right
   if (gyro_) {
     gyro_rotation_ = gyro_->Next(time_s);
     if (gyro_rotation_.ok) velocity_.SetMeasuredRotation(gyro_rotation_.R_prev_curr);
+    if (options_.imu.ba_rotation_prior)  // the BA's rotation prior (back_end.h)
+      back_end_.AddGyroRotation(result.frame_index, gyro_rotation_,
+                                options_.imu.min_rotation_sigma_deg);
   }
 
   // Input checks: expected failures come back as kLost.

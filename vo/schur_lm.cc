@@ -13,6 +13,8 @@
 #include <sstream>
 #include <utility>
 
+#include "vo/rotation_prior.h"
+
 namespace vo {
 namespace {
 
@@ -167,6 +169,31 @@ Matrix6 LinkJtJ(const LinkJacobian& A, const LinkJacobian& B) {
          A.bottomRows<3>().transpose() * B.bottomRows<3>();
 }
 
+// A rotation prior block (rotation_prior.h) of poses a and b: its residual and its Jacobians
+// w.r.t. the two tangents [δθ δt] (zero for δt), by ceres::Jet over the two quaternions times
+// the manifold's Plus Jacobian.
+using RotationLinkJacobian = Eigen::Matrix<double, 3, 6>;
+void RotationResidualAndJacobians(const RotationPriorResidual& f, const PoseBlock7& a,
+                                  const PoseBlock7& b, Eigen::Vector3d* r,
+                                  RotationLinkJacobian* J_a, RotationLinkJacobian* J_b) {
+  using Jet = ceres::Jet<double, 8>;
+  Jet pa[7], pb[7], out[3];
+  for (int c = 0; c < 7; ++c) {
+    pa[c] = c < 4 ? Jet(a[c], c) : Jet(a[c]);
+    pb[c] = c < 4 ? Jet(b[c], 4 + c) : Jet(b[c]);
+  }
+  f(pa, pb, out);
+  Eigen::Matrix<double, 3, 8> J;
+  for (int k = 0; k < 3; ++k) {
+    (*r)(k) = out[k].a;
+    J.row(k) = out[k].v.transpose();
+  }
+  J_a->leftCols<3>() = J.leftCols<4>() * QuaternionPlusJacobian(a.data());
+  J_a->rightCols<3>().setZero();
+  J_b->leftCols<3>() = J.rightCols<4>() * QuaternionPlusJacobian(b.data());
+  J_b->rightCols<3>().setZero();
+}
+
 // The residual block r = [u_l, v_l, u_r, v_r] − observed (rows 2, 3 zero for a left-only
 // observation) of the point at v = p_world − t_world_cam0 and, optionally, the distinct rows of
 // ∂r/∂p_world: a.row(0) of u_l, a.row(1) of v_l (and of v_r, the same), a.row(2) of u_r (zero
@@ -234,7 +261,8 @@ class Solver {
   Solver(const StereoCamera& cam, const BundleAdjustmentOptions& options,
          const std::vector<SchurLmResidual>& residuals, const std::vector<bool>& pose_is_free,
          std::vector<PoseBlock7>* poses, std::vector<Eigen::Vector3d>* points,
-         const std::vector<std::pair<int, int>>& planar_links, const PlanarMotionPrior& planar);
+         const std::vector<std::pair<int, int>>& planar_links, const PlanarMotionPrior& planar,
+         const std::vector<RotationPrior>& rotation_priors);
   SchurLmSummary Run();
 
  private:
@@ -263,11 +291,22 @@ class Solver {
     LinkVector r;
     LinkJacobian J_a, J_b;
   };
+  // A rotation prior block: its link and its residual.
+  struct RotationLink {
+    Link link;
+    RotationPriorResidual f;
+  };
+  // A rotation prior block linearised.
+  struct RotationLinkLinearisation {
+    Eigen::Vector3d r;
+    RotationLinkJacobian J_a, J_b;
+  };
   // The linearisation at one point of parameter space: per block, and per slot (6) and per
   // point (3) the gradient Jᵀr and the squared Jacobian column norms diag(JᵀJ).
   struct Linearisation {
     std::vector<BlockLinearisation> blocks;
     std::vector<LinkLinearisation> links;
+    std::vector<RotationLinkLinearisation> rotation_links;
     std::vector<Vector6> grad_pose, col_sq_pose;
     std::vector<Eigen::Vector3d> grad_point, col_sq_point;
   };
@@ -293,6 +332,7 @@ class Solver {
   std::vector<Block> blocks_;     // ordered by point, then by residual index
   std::vector<Link> links_;       // planar prior blocks
   std::unique_ptr<PlanarMotionResidual> planar_;  // their residual (when there are links)
+  std::vector<RotationLink> rotation_links_;      // rotation prior blocks
 
   // Current parameters x and the candidate x ⊞ δ (compact points).
   std::vector<PoseBlock7> x_poses_, cand_poses_;
@@ -318,7 +358,7 @@ Solver::Solver(const StereoCamera& cam, const BundleAdjustmentOptions& options,
                const std::vector<SchurLmResidual>& residuals, const std::vector<bool>& pose_is_free,
                std::vector<PoseBlock7>* poses, std::vector<Eigen::Vector3d>* points,
                const std::vector<std::pair<int, int>>& planar_links,
-               const PlanarMotionPrior& planar)
+               const PlanarMotionPrior& planar, const std::vector<RotationPrior>& rotation_priors)
     : cam_(cam), options_(options), residuals_(residuals), out_poses_(poses), out_points_(points) {
   const int num_poses = static_cast<int>(poses->size());
   const int num_points = static_cast<int>(points->size());
@@ -353,6 +393,18 @@ Solver::Solver(const StereoCamera& cam, const BundleAdjustmentOptions& options,
     links_.push_back(Link{a, b, slot[a], slot[b]});
   }
   if (!links_.empty()) planar_ = std::make_unique<PlanarMotionResidual>(planar);
+  for (const RotationPrior& prior : rotation_priors) {
+    const int a = prior.frame_a, b = prior.frame_b;
+    if (a < 0 || a >= num_poses || b < 0 || b >= num_poses || a == b || !pose_used[a] ||
+        !pose_used[b]) {
+      std::ostringstream msg;
+      msg << "rotation prior (" << a << ", " << b
+          << ") refers to the same pose twice or to one no residual refers to";
+      Abort(msg.str());
+    }
+    rotation_links_.push_back(
+        RotationLink{Link{a, b, slot[a], slot[b]}, RotationPriorResidual(prior)});
+  }
   for (int j = 0; j < num_points; ++j) {
     if (compact[j] < 0) continue;
     compact[j] = static_cast<int>(point_index_.size());
@@ -386,6 +438,7 @@ Solver::Solver(const StereoCamera& cam, const BundleAdjustmentOptions& options,
   for (Linearisation* lin : {&lin_, &cand_lin_}) {
     lin->blocks.resize(blocks_.size());
     lin->links.resize(links_.size());
+    lin->rotation_links.resize(rotation_links_.size());
     lin->grad_pose.resize(nf);
     lin->col_sq_pose.resize(nf);
     lin->grad_point.resize(np);
@@ -466,6 +519,19 @@ bool Solver::Evaluate(const std::vector<PoseBlock7>& poses,
       if (slot < 0) continue;
       lin->grad_pose[slot] += LinkJtr(*J, l.r);
       lin->col_sq_pose[slot] += LinkColumnSquaredNorms(*J);
+    }
+  }
+  for (size_t k = 0; k < rotation_links_.size(); ++k) {
+    const Link& link = rotation_links_[k].link;
+    RotationLinkLinearisation& l = lin->rotation_links[k];
+    RotationResidualAndJacobians(rotation_links_[k].f, poses[link.pose_a], poses[link.pose_b], &l.r,
+                                 &l.J_a, &l.J_b);
+    total += 0.5 * l.r.squaredNorm();
+    for (const auto& [slot, J] :
+         {std::make_pair(link.slot_a, &l.J_a), std::make_pair(link.slot_b, &l.J_b)}) {
+      if (slot < 0) continue;
+      lin->grad_pose[slot] += J->transpose() * l.r;
+      lin->col_sq_pose[slot] += J->colwise().squaredNorm().transpose();
     }
   }
   if (!std::isfinite(total)) return false;
@@ -599,6 +665,25 @@ bool Solver::ComputeStep(double radius, bool reuse_diagonal, double* model_cost_
         S_blocks_[link.slot_b * nf + link.slot_a] += LinkJtJ(l.J_b, l.J_a);
     }
   }
+  // Rotation prior blocks: the same pose terms.
+  for (size_t k = 0; k < rotation_links_.size(); ++k) {
+    const Link& link = rotation_links_[k].link;
+    const RotationLinkLinearisation& l = lin_.rotation_links[k];
+    if (link.slot_a >= 0) {
+      S_blocks_[link.slot_a * nf + link.slot_a] += l.J_a.transpose() * l.J_a;
+      S_rhs_[link.slot_a] += l.J_a.transpose() * l.r;
+    }
+    if (link.slot_b >= 0) {
+      S_blocks_[link.slot_b * nf + link.slot_b] += l.J_b.transpose() * l.J_b;
+      S_rhs_[link.slot_b] += l.J_b.transpose() * l.r;
+    }
+    if (link.slot_a >= 0 && link.slot_b >= 0) {
+      if (link.slot_a > link.slot_b)
+        S_blocks_[link.slot_a * nf + link.slot_b] += l.J_a.transpose() * l.J_b;
+      else
+        S_blocks_[link.slot_b * nf + link.slot_a] += l.J_b.transpose() * l.J_a;
+    }
+  }
   // Reduced camera system by dense Cholesky (lower triangle), then the points back-substituted.
   if (nf > 0) {
     for (int a = 0; a < nf; ++a) {
@@ -642,6 +727,14 @@ bool Solver::ComputeStep(double radius, bool reuse_diagonal, double* model_cost_
     if (link.slot_a >= 0) jd += l.J_a * step_pose_[link.slot_a];
     if (link.slot_b >= 0) jd += l.J_b * step_pose_[link.slot_b];
     change -= LinkDot(jd, l.r) + 0.5 * LinkSquaredNorm(jd);
+  }
+  for (size_t k = 0; k < rotation_links_.size(); ++k) {
+    const Link& link = rotation_links_[k].link;
+    const RotationLinkLinearisation& l = lin_.rotation_links[k];
+    Eigen::Vector3d jd = Eigen::Vector3d::Zero();
+    if (link.slot_a >= 0) jd += l.J_a * step_pose_[link.slot_a];
+    if (link.slot_b >= 0) jd += l.J_b * step_pose_[link.slot_b];
+    change -= jd.dot(l.r) + 0.5 * jd.squaredNorm();
   }
   *model_cost_change = change;
   return change > 0.0;
@@ -818,8 +911,10 @@ SchurLmSummary SolveSchurLm(const StereoCamera& cam, const BundleAdjustmentOptio
                             const std::vector<bool>& pose_is_free, std::vector<PoseBlock7>* poses,
                             std::vector<Eigen::Vector3d>* points,
                             const std::vector<std::pair<int, int>>& planar_links,
-                            const PlanarMotionPrior& planar) {
-  Solver solver(cam, options, residuals, pose_is_free, poses, points, planar_links, planar);
+                            const PlanarMotionPrior& planar,
+                            const std::vector<RotationPrior>& rotation_priors) {
+  Solver solver(cam, options, residuals, pose_is_free, poses, points, planar_links, planar,
+                rotation_priors);
   return solver.Run();
 }
 

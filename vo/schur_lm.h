@@ -95,12 +95,15 @@ using PoseBlock7 = std::array<double, 7>;  // [qx qy qz qw tx ty tz] of T_world_
 // (planar_motion_prior.h; plain squares, its Jacobian from ceres::Jet and the manifold's Plus
 // Jacobian, as the Ceres backend's AutoDiffCostFunction): they enter the cost, the gradient,
 // the Jacobi scaling and the reduced camera system (a pose–pose block couples the two poses).
+// `rotation_priors` (frame_a, frame_b index the pose blocks, both referred to by a residual)
+// add a RotationPriorResidual each (rotation_prior.h), the same way.
 SchurLmSummary SolveSchurLm(const StereoCamera& cam, const BundleAdjustmentOptions& options,
                             const std::vector<SchurLmResidual>& residuals,
                             const std::vector<bool>& pose_is_free, std::vector<PoseBlock7>* poses,
                             std::vector<Eigen::Vector3d>* points,
                             const std::vector<std::pair<int, int>>& planar_links = {},
-                            const PlanarMotionPrior& planar = PlanarMotionPrior());
+                            const PlanarMotionPrior& planar = PlanarMotionPrior(),
+                            const std::vector<RotationPrior>& rotation_priors = {});
 
 // One residual block and its Jacobians, unweighted: r = [u_l, v_l, u_r, v_r] − observed (rows
 // 2, 3 and their Jacobian rows zero for a left-only observation), J_pose w.r.t. the pose's

@@ -33,6 +33,7 @@ BundleAdjustmentProblem SelectBaPoints(BundleAdjustmentProblem problem, int max_
   BundleAdjustmentProblem selected;
   selected.T_world_cam0 = std::move(problem.T_world_cam0);
   selected.planar = problem.planar;
+  selected.rotation_priors = problem.rotation_priors;
   for (int j : order) {
     new_index[j] = static_cast<int>(selected.points_world.size());
     selected.points_world.push_back(problem.points_world[j]);
@@ -81,7 +82,8 @@ TrackUpdateResult SlidingWindow::Add(int64_t frame_index, std::vector<Feature>* 
 }
 
 WindowRefinement SlidingWindow::Refine(const StereoCamera& camera, int64_t newest_frame_index,
-                                       const PlanarMotionPrior& planar) {
+                                       const PlanarMotionPrior& planar,
+                                       const std::vector<WindowRotationPrior>& rotations) {
   WindowRefinement r;
   const auto newest_pose = T_world_cam0_by_frame_.find(newest_frame_index);
   if (!options_.use_bundle_adjustment || T_world_cam0_by_frame_.size() < 2 ||
@@ -95,6 +97,17 @@ WindowRefinement SlidingWindow::Refine(const StereoCamera& camera, int64_t newes
       SelectBaPoints(MakeWindowProblem(tracks_, T_world_cam0_by_frame_, &frame_ids),
                      options_.max_points, options_.ba.min_frames_per_point);
   problem.planar = planar;
+  for (const WindowRotationPrior& w : rotations) {
+    const auto a = std::find(frame_ids.begin(), frame_ids.end(), w.frame_a);
+    const auto b = std::find(frame_ids.begin(), frame_ids.end(), w.frame_b);
+    if (a == frame_ids.end() || b == frame_ids.end() || a == b) continue;
+    RotationPrior prior;
+    prior.frame_a = static_cast<int>(a - frame_ids.begin());
+    prior.frame_b = static_cast<int>(b - frame_ids.begin());
+    prior.R_a_b = w.R_a_b;
+    prior.sigma_rad = w.sigma_rad;
+    problem.rotation_priors.push_back(prior);
+  }
   if (static_cast<int>(problem.T_world_cam0.size()) <= options_.ba.num_fixed_poses) return r;
   const BundleAdjustmentSummary ba = RunBundleAdjustment(camera, problem, options_.ba);
   bool usable = ba.ok() && ba.T_world_cam0.size() == frame_ids.size();

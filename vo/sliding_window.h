@@ -34,6 +34,16 @@ struct SlidingWindowOptions {
   BundleAdjustmentOptions ba;         // the solver (ba.min_frames_per_point selects points)
 };
 
+// A relative-rotation prior between two frames of the window (frame indices): the rotation
+// R_a_b of camera frame_b in camera frame_a (a gyro's), σ sigma_rad (BundleAdjustmentProblem::
+// rotation_priors).
+struct WindowRotationPrior {
+  int64_t frame_a = -1;
+  int64_t frame_b = -1;
+  Eigen::Matrix3d R_a_b = Eigen::Matrix3d::Identity();
+  double sigma_rad = 1.0;  // radians, > 0
+};
+
 // What Refine() did.
 struct WindowRefinement {
   bool attempted = false;  // the window had at least two poses and more than the fixed ones
@@ -61,9 +71,11 @@ class SlidingWindow {
                         const Eigen::Isometry3d& T_world_cam0_initial);
   // Bundle adjustment of the window, `newest_frame_index` the frame just added.
   // `planar`: a ground vehicle's motion prior between consecutive window poses (off unless
-  // enabled; BundleAdjustmentProblem::planar).
+  // enabled; BundleAdjustmentProblem::planar). `rotations`: relative-rotation priors between
+  // frames of the window (those of a frame not in the problem are left out).
   WindowRefinement Refine(const StereoCamera& camera, int64_t newest_frame_index,
-                          const PlanarMotionPrior& planar = PlanarMotionPrior());
+                          const PlanarMotionPrior& planar = PlanarMotionPrior(),
+                          const std::vector<WindowRotationPrior>& rotations = {});
 
   // Pose of a frame of the window (null when it is not in the window).
   const Eigen::Isometry3d* Pose(int64_t frame_index) const;

@@ -119,7 +119,7 @@ TEST(VoConfigTest, EveryOptionFieldIsRegistered) {
       {"back_end.ba", 12},
       {"back_end.vehicle_planar", 4},
       {"back_end.flat_floor", 3},
-      {"imu", 9},
+      {"imu", 10},
   };
   EXPECT_EQ(counts, expected);
 }
