@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tests/test_util.h"
+#include "tests/vo/ba_test_util.h"
 #include "tests/vo/vo_test_util.h"
 #include "vo/back_end.h"
 #include "vo/bundle_adjustment.h"
@@ -27,11 +28,8 @@ using test::Normal;
 using test::TestCamera;
 using vobench_test::IsNearPose;
 
-// The two backends agree to rounding (as tests/vo/bundle_adjustment_test.cc).
-constexpr double kBackendCostRelTol = 1e-10;
-constexpr double kBackendTolRad = 1e-9;
-constexpr double kBackendTolM = 1e-9;
-constexpr double kBackendPointTolM = 1e-7;
+// The two backends agree to rounding: test::ExpectSameSolution (tests/vo/ba_test_util.h).
+using test::ExpectSameSolution;
 
 Eigen::Matrix3d RotY(double deg) {
   return Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -123,25 +121,6 @@ BundleAdjustmentSummary Solve(const BundleAdjustmentProblem& p, BundleAdjustment
                               BaSolver solver) {
   options.solver = solver;
   return RunBundleAdjustment(TestCamera(), p, options);
-}
-
-void ExpectSameSolution(const BundleAdjustmentSummary& ceres, const BundleAdjustmentSummary& lm) {
-  ASSERT_TRUE(ceres.ok()) << ceres.message;
-  ASSERT_TRUE(lm.ok()) << lm.message;
-  EXPECT_NEAR(lm.initial_cost, ceres.initial_cost, kBackendCostRelTol * ceres.initial_cost);
-  EXPECT_NEAR(lm.final_cost, ceres.final_cost, kBackendCostRelTol * ceres.final_cost + 1e-20);
-  EXPECT_EQ(lm.num_iterations, ceres.num_iterations);
-  EXPECT_EQ(lm.converged, ceres.converged);
-  EXPECT_EQ(lm.num_rotation_priors, ceres.num_rotation_priors);
-  EXPECT_EQ(lm.observation_is_outlier, ceres.observation_is_outlier);
-  ASSERT_EQ(lm.T_world_cam0.size(), ceres.T_world_cam0.size());
-  for (size_t i = 0; i < lm.T_world_cam0.size(); ++i)
-    EXPECT_THAT(lm.T_world_cam0[i], IsNearPose(ceres.T_world_cam0[i], kBackendTolRad, kBackendTolM))
-        << "frame " << i;
-  ASSERT_EQ(lm.points_world.size(), ceres.points_world.size());
-  for (size_t j = 0; j < lm.points_world.size(); ++j)
-    EXPECT_LT((lm.points_world[j] - ceres.points_world[j]).norm(), kBackendPointTolM)
-        << "point " << j;
 }
 
 // Bit for bit the same result.

@@ -9,6 +9,7 @@
 #include <functional>
 
 #include "tests/test_util.h"
+#include "tests/vo/ba_test_util.h"
 #include "tests/vo/vo_test_util.h"
 #include "vo/prior_motion.h"  // vo::VehicleMotion
 #include "vo/ransac.h"        // vo::SplitMix64
@@ -16,6 +17,7 @@
 namespace vo {
 namespace {
 
+using test::ExpectSameSolution;
 using vobench_test::IsNearPose;
 
 constexpr int kNumFrames = 5;
@@ -397,33 +399,7 @@ TEST_P(BundleAdjustmentTest, MakeWindowProblemFromTracks) {
 // --- the hand-written backend against Ceres ---
 // Same problem, same trust-region rules: the iterates differ by rounding only, so the
 // optimum, the iteration count, the termination and the outlier flags are the same.
-constexpr double kBackendCostRelTol = 1e-10;  // relative final-cost difference
-constexpr double kBackendTolRad = 1e-9;       // pose rotation difference
-constexpr double kBackendTolM = 1e-9;         // pose translation difference (metres)
-// Point difference (metres): points up to 10 m, whose depth the 0.12 m baseline conditions
-// poorly, amplify the rounding differences most (1.2e-8 m seen without a robust loss).
-constexpr double kBackendPointTolM = 1e-7;
-
-void ExpectSameSolution(const BundleAdjustmentSummary& ceres, const BundleAdjustmentSummary& lm) {
-  ASSERT_TRUE(ceres.ok()) << ceres.message;
-  ASSERT_TRUE(lm.ok()) << lm.message;
-  EXPECT_NEAR(lm.initial_cost, ceres.initial_cost, kBackendCostRelTol * ceres.initial_cost);
-  EXPECT_NEAR(lm.final_cost, ceres.final_cost, kBackendCostRelTol * ceres.final_cost + 1e-20);
-  EXPECT_EQ(lm.num_iterations, ceres.num_iterations);
-  EXPECT_EQ(lm.converged, ceres.converged);
-  EXPECT_EQ(lm.num_residual_blocks, ceres.num_residual_blocks);
-  EXPECT_EQ(lm.point_optimized, ceres.point_optimized);
-  EXPECT_EQ(lm.observation_is_outlier, ceres.observation_is_outlier);
-  ASSERT_EQ(lm.T_world_cam0.size(), ceres.T_world_cam0.size());
-  for (size_t i = 0; i < lm.T_world_cam0.size(); ++i)
-    EXPECT_THAT(lm.T_world_cam0[i], IsNearPose(ceres.T_world_cam0[i], kBackendTolRad, kBackendTolM))
-        << "frame " << i;
-  ASSERT_EQ(lm.points_world.size(), ceres.points_world.size());
-  for (size_t j = 0; j < lm.points_world.size(); ++j)
-    EXPECT_LT((lm.points_world[j] - ceres.points_world[j]).norm(), kBackendPointTolM)
-        << "point " << j;
-  EXPECT_NEAR(lm.rms_inlier_reprojection_after_px, ceres.rms_inlier_reprojection_after_px, 1e-9);
-}
+// (tests/vo/ba_test_util.h: ExpectSameSolution and its tolerances.)
 
 // Corrupts about `fraction` of the observations by 20–50 px (a wrong match in a track).
 void Corrupt(double fraction, uint64_t seed, BundleAdjustmentProblem* p) {
