@@ -10,6 +10,7 @@
 #include <map>
 #include <sstream>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "sim/yaml_input.h"
@@ -99,6 +100,28 @@ Entry Wavelengths(std::vector<double>* field) {
 // vo::OdometryOptions and its nested Options structs (tests/harness/vo_config_test.cc fails
 // when a struct grows a field that is not listed here). Ranges are what YAML may hold; each
 // Options::IsValid checks the finer rules after reading.
+// The keys of a direct alignment's options (recovery.vehicle_direct, recovery.free_direct).
+std::vector<std::pair<std::string, Entry>> DirectAlignmentKeys(const std::string& prefix,
+                                                               bool* enabled,
+                                                               vo::DirectAlignmentOptions* d) {
+  return {
+      {prefix + ".enabled", Bool(enabled)},
+      {prefix + ".pyramid_levels", Number(&d->pyramid_levels, 1, 6)},
+      {prefix + ".min_gradient", Number(&d->min_gradient, 1e-6, 1000.0)},
+      {prefix + ".max_pixels", Number(&d->max_pixels, 1, 10000000)},
+      {prefix + ".max_iterations", Number(&d->max_iterations, 1, 100000)},
+      {prefix + ".huber_k", Number(&d->huber_k, 1e-6, 1000.0)},
+      {prefix + ".tukey_k", Number(&d->tukey_k, 0.0, 1000.0)},
+      {prefix + ".min_pixels", Number(&d->min_pixels, 1, 10000000)},
+      {prefix + ".max_yaw_sigma_deg", Number(&d->max_yaw_sigma_deg, 1e-9, 180.0)},
+      {prefix + ".max_forward_sigma_m", Number(&d->max_forward_sigma_m, 1e-9, 100.0)},
+      {prefix + ".max_yaw_change_deg", Number(&d->max_yaw_change_deg, 1e-9, 180.0)},
+      {prefix + ".max_forward_change_m", Number(&d->max_forward_change_m, 1e-9, 100.0)},
+      {prefix + ".min_depth_m", Number(&d->min_depth_m, 1e-9, 1e6)},
+      {prefix + ".max_depth_m", Number(&d->max_depth_m, 1e-9, 1e6)},
+  };
+}
+
 std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
   const double kInf = 1e12;
   const int kBig = 100000000;
@@ -118,7 +141,7 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
   using vo::BaSolver;
   using vo::DisparityAlgorithm;
   using vo::RobustLoss;
-  return {
+  std::vector<std::pair<std::string, Entry>> keys = {
       {"platform", Enum(&o->platform,
                         {vo::Platform::kAuto, vo::Platform::kFree, vo::Platform::kGroundVehicle})},
       {"vehicle.enabled", Bool(&mo.ground_vehicle)},
@@ -368,26 +391,16 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
        Number(&rc.vehicle_bridge.disparity_sigma_px, 1e-6, 1000.0)},
       {"recovery.vehicle_bridge.step_sigma_m",
        Number(&rc.vehicle_bridge.step_sigma_m, 1e-9, 100.0)},
-      {"recovery.vehicle_direct.enabled", Bool(&rc.vehicle_direct_alignment)},
-      {"recovery.vehicle_direct.pyramid_levels", Number(&rc.vehicle_direct.pyramid_levels, 1, 6)},
-      {"recovery.vehicle_direct.min_gradient",
-       Number(&rc.vehicle_direct.min_gradient, 1e-6, 1000.0)},
-      {"recovery.vehicle_direct.max_pixels", Number(&rc.vehicle_direct.max_pixels, 1, 10000000)},
-      {"recovery.vehicle_direct.max_iterations",
-       Number(&rc.vehicle_direct.max_iterations, 1, 100000)},
-      {"recovery.vehicle_direct.huber_k", Number(&rc.vehicle_direct.huber_k, 1e-6, 1000.0)},
-      {"recovery.vehicle_direct.tukey_k", Number(&rc.vehicle_direct.tukey_k, 0.0, 1000.0)},
-      {"recovery.vehicle_direct.min_pixels", Number(&rc.vehicle_direct.min_pixels, 1, 10000000)},
-      {"recovery.vehicle_direct.max_yaw_sigma_deg",
-       Number(&rc.vehicle_direct.max_yaw_sigma_deg, 1e-9, 180.0)},
-      {"recovery.vehicle_direct.max_forward_sigma_m",
-       Number(&rc.vehicle_direct.max_forward_sigma_m, 1e-9, 100.0)},
-      {"recovery.vehicle_direct.max_yaw_change_deg",
-       Number(&rc.vehicle_direct.max_yaw_change_deg, 1e-9, 180.0)},
-      {"recovery.vehicle_direct.max_forward_change_m",
-       Number(&rc.vehicle_direct.max_forward_change_m, 1e-9, 100.0)},
-      {"recovery.vehicle_direct.min_depth_m", Number(&rc.vehicle_direct.min_depth_m, 1e-9, 1e6)},
-      {"recovery.vehicle_direct.max_depth_m", Number(&rc.vehicle_direct.max_depth_m, 1e-9, 1e6)},
+  };
+  for (auto& key : DirectAlignmentKeys("recovery.vehicle_direct", &rc.vehicle_direct_alignment,
+                                       &rc.vehicle_direct)) {
+    keys.push_back(std::move(key));
+  }
+  for (auto& key :
+       DirectAlignmentKeys("recovery.free_direct", &rc.free_direct_alignment, &rc.free_direct)) {
+    keys.push_back(std::move(key));
+  }
+  std::vector<std::pair<std::string, Entry>> rest = {
       {"recovery.reinit_after_lost_frames", Number(&rc.reinit_after_lost_frames, 1, 100000)},
       {"back_end.bundle_adjustment", Bool(&o->back_end.bundle_adjustment)},
       {"back_end.window_frames", Number(&o->back_end.window_frames, 3, 10)},
@@ -432,7 +445,12 @@ std::vector<std::pair<std::string, Entry>> Registry(vo::OdometryOptions* o) {
       {"imu.bias_gain", Number(&o->imu.bias_gain, 0.0, 1.0)},
       {"imu.bias_window_s", Number(&o->imu.bias_window_s, 1e-9, 1e6)},
       {"imu.max_bias_radps", Number(&o->imu.max_bias_radps, 1e-9, 100.0)},
+      {"imu.standing_start_s", Number(&o->imu.standing_start_s, 0.0, 1e6)},
+      {"imu.standing_max_std_radps", Number(&o->imu.standing_max_std_radps, 1e-9, 100.0)},
+      {"imu.max_standing_bias_radps", Number(&o->imu.max_standing_bias_radps, 1e-9, 100.0)},
   };
+  for (auto& key : rest) keys.push_back(std::move(key));
+  return keys;
 }
 
 // The keys of vo_options.yaml before the options were grouped by the pipeline's stages (issue

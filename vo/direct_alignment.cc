@@ -2,12 +2,14 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include "vo/bilinear.h"
 #include "vo/prior_motion.h"
@@ -134,12 +136,11 @@ bool Project(const Level& L, const Eigen::Isometry3d& T_curr_prev, const Eigen::
   return true;
 }
 
-// The pixels that (yaw, forward) = theta moves at least 3 pixels inside the current image: the
+// The pixels that the motion T_prev_curr moves at least 3 pixels inside the current image: the
 // level's fixed set (a pixel that leaves the view later costs as an outlier, Linearise).
 std::vector<PlanePixel> InView(const Level& curr_level, std::vector<PlanePixel> pixels,
-                               const Eigen::Vector3d& up, double axle,
-                               const Eigen::Vector2d& theta) {
-  const Eigen::Isometry3d T = VehicleMotion(up, axle, theta.x(), theta.y()).inverse();
+                               const Eigen::Isometry3d& T_prev_curr) {
+  const Eigen::Isometry3d T = T_prev_curr.inverse();
   const double margin = 3.0;
   std::vector<PlanePixel> kept;
   for (const PlanePixel& px : pixels) {
@@ -160,26 +161,38 @@ double RobustSigma(std::vector<double> abs_residuals) {
   return std::max(1.0, 1.4826 * abs_residuals[mid]);  // at least one grey level
 }
 
-// One level's residuals, optionally with Jacobians, for parameters (yaw, forward).
+// A motion model of N parameters: Motion(theta) is T_prev_curr. The vehicle's (yaw, forward);
+// the free platform's (ω, t): T_prev_curr = [R_start · Exp(ω) | t].
+template <int N>
+using Vec = Eigen::Matrix<double, N, 1>;
+template <int N>
+using Mat = Eigen::Matrix<double, N, N>;
+
+// One level's residuals, optionally with Jacobians (forward differences of step 1e-5 in each
+// parameter).
+template <int N>
 struct Linearisation {
   int n = 0;
-  double cost = 0.0;  // Σ Huber ρ
-  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d g = Eigen::Vector2d::Zero();
+  double cost = 0.0;  // Σ ρ
+  Mat<N> H = Mat<N>::Zero();
+  Vec<N> g = Vec<N>::Zero();
   std::vector<double> abs_residuals;
 };
 
-Linearisation Linearise(const Level& curr_level, const std::vector<PlanePixel>& pixels,
-                        const Eigen::Vector3d& up, double axle, const Eigen::Vector2d& theta,
-                        double threshold, bool tukey, bool jacobians) {
-  Linearisation lin;
-  const Eigen::Isometry3d T = VehicleMotion(up, axle, theta.x(), theta.y()).inverse();
-  constexpr double kEpsYaw = 1e-5;
-  constexpr double kEpsForward = 1e-5;
-  Eigen::Isometry3d T_yaw, T_forward;
+template <int N, typename Motion>
+Linearisation<N> Linearise(const Level& curr_level, const std::vector<PlanePixel>& pixels,
+                           const Motion& motion, const Vec<N>& theta, double threshold, bool tukey,
+                           bool jacobians) {
+  Linearisation<N> lin;
+  const Eigen::Isometry3d T = motion(theta).inverse();
+  constexpr double kEps = 1e-5;
+  std::array<Eigen::Isometry3d, N> T_k;
   if (jacobians) {
-    T_yaw = VehicleMotion(up, axle, theta.x() + kEpsYaw, theta.y()).inverse();
-    T_forward = VehicleMotion(up, axle, theta.x(), theta.y() + kEpsForward).inverse();
+    for (int k = 0; k < N; ++k) {
+      Vec<N> moved = theta;
+      moved(k) += kEps;
+      T_k[k] = motion(moved).inverse();
+    }
   }
   lin.abs_residuals.reserve(pixels.size());
   for (const PlanePixel& px : pixels) {
@@ -206,21 +219,171 @@ Linearisation Linearise(const Level& curr_level, const std::vector<PlanePixel>& 
     lin.abs_residuals.push_back(a);
     ++lin.n;
     if (!jacobians) continue;
-    Eigen::Vector2d uv_yaw, uv_forward;
+    std::array<Eigen::Vector2d, N> uv_k;
+    bool projected = true;
+    for (int k = 0; k < N && projected; ++k) {
+      projected = Project(curr_level, T_k[k], px.p_prev, &uv_k[k]);
+    }
     double gx = 0.0, gy = 0.0;
-    if (!Project(curr_level, T_yaw, px.p_prev, &uv_yaw) ||
-        !Project(curr_level, T_forward, px.p_prev, &uv_forward) ||
-        !Sample(curr_level.gx, uv.x(), uv.y(), &gx) ||
+    if (!projected || !Sample(curr_level.gx, uv.x(), uv.y(), &gx) ||
         !Sample(curr_level.gy, uv.x(), uv.y(), &gy)) {
       continue;
     }
     const Eigen::Vector2d grad(gx, gy);
-    const Eigen::Vector2d J(grad.dot(uv_yaw - uv) / kEpsYaw,
-                            grad.dot(uv_forward - uv) / kEpsForward);
+    Vec<N> J;
+    for (int k = 0; k < N; ++k) J(k) = grad.dot(uv_k[k] - uv) / kEps;
     lin.H += w * J * J.transpose();
     lin.g += w * J * r;
   }
   return lin;
+}
+
+// What the coarse-to-fine Gauss-Newton found: the parameters, and on the finest level the
+// support, the robust residual σ and the covariance (zero when the finest level had no pixel in
+// view, infinite when its information was singular).
+template <int N>
+struct Alignment {
+  Vec<N> theta;
+  int pixels = 0;
+  int iterations = 0;
+  double residual_sigma = 0.0;
+  Mat<N> covariance = Mat<N>::Zero();
+};
+
+// Σ ρ(r) over the previous image's pixels on the planes (unit normals), coarse to fine from
+// theta0, with the prior ½ w_k (θ_k − θ0_k)² for each parameter whose prior_sigma_k > 0 (w_k in
+// the grey levels' units: the level's robust residual variance over σ_k²).
+template <int N, typename Motion>
+Alignment<N> AlignCoarseToFine(const StereoCamera& camera, const cv::Mat& prev, const cv::Mat& curr,
+                               const std::vector<ScenePlane>& unit_planes, const Motion& motion,
+                               const Vec<N>& theta0, const Vec<N>& prior_sigma,
+                               const DirectAlignmentOptions& options) {
+  Alignment<N> result;
+  // Levels that keep at least 40 pixels across.
+  int levels = options.pyramid_levels;
+  while (levels > 1 && (std::min(camera.width, camera.height) >> (levels - 1)) < 40) --levels;
+  const std::vector<Level> P = Pyramid(prev, camera, levels);
+  const std::vector<Level> C = Pyramid(curr, camera, levels);
+
+  Vec<N> theta = theta0;
+  bool any_prior = false;
+  for (int k = 0; k < N; ++k) {
+    any_prior = any_prior || (prior_sigma(k) > 0.0 && std::isfinite(prior_sigma(k)));
+  }
+  Vec<N> prior_weight = Vec<N>::Zero();
+  auto AddPrior = [&](const Vec<N>& at, Linearisation<N>* lin) {
+    for (int k = 0; k < N; ++k) {
+      if (!(prior_weight(k) > 0.0)) continue;
+      const double d = at(k) - theta0(k);
+      lin->cost += 0.5 * prior_weight(k) * d * d;
+      lin->H(k, k) += prior_weight(k);
+      lin->g(k) += prior_weight(k) * d;
+    }
+  };
+  for (int l = levels - 1; l >= 0; --l) {
+    const std::vector<PlanePixel> pixels =
+        InView(C[l], SelectPixels(P[l], unit_planes, options), motion(theta));
+    if (pixels.empty()) continue;
+    // Huber weights on every level; on the finest, then Tukey's biweight (tukey_k > 0), which
+    // gives the pixels off the plane (the floor below a wall) no weight at all.
+    const int passes = l == 0 && options.tukey_k > 0.0 ? 2 : 1;
+    double threshold = 0.0;
+    bool tukey = false;
+    for (int pass = 0; pass < passes; ++pass) {
+      tukey = pass == 1;
+      const double sigma =
+          RobustSigma(Linearise<N>(C[l], pixels, motion, theta, 1e300, false, false).abs_residuals);
+      threshold = (tukey ? options.tukey_k : options.huber_k) * sigma;
+      for (int k = 0; k < N; ++k) {
+        const double s = prior_sigma(k);
+        prior_weight(k) = s > 0.0 && std::isfinite(s) ? sigma * sigma / (s * s) : 0.0;
+      }
+      bool converged = false;
+      for (int it = 0; it < options.max_iterations && !converged; ++it) {
+        ++result.iterations;
+        Linearisation<N> lin = Linearise<N>(C[l], pixels, motion, theta, threshold, tukey, true);
+        if (any_prior) AddPrior(theta, &lin);
+        if (lin.n < 3 || !(lin.H.determinant() > 0.0)) break;
+        Vec<N> step = -lin.H.ldlt().solve(lin.g);
+        if (!step.allFinite()) break;
+        bool improved = false;
+        for (int halving = 0; halving < 6 && !improved; ++halving, step *= 0.5) {
+          Linearisation<N> trial =
+              Linearise<N>(C[l], pixels, motion, theta + step, threshold, tukey, false);
+          if (any_prior) AddPrior(theta + step, &trial);
+          if (trial.cost < lin.cost) {
+            theta += step;
+            improved = true;
+          }
+        }
+        converged = !improved || step.cwiseAbs().maxCoeff() < 1e-7;
+      }
+    }
+    if (l > 0) continue;
+    // The finest level: the measurement's support and uncertainty.
+    Linearisation<N> final_lin = Linearise<N>(C[0], pixels, motion, theta, threshold, tukey, true);
+    if (any_prior) AddPrior(theta, &final_lin);
+    result.pixels = final_lin.n;
+    result.residual_sigma = RobustSigma(final_lin.abs_residuals);
+    if (final_lin.n >= 3 && final_lin.H.determinant() > 0.0) {
+      // The robustly weighted information, the robust residual variance.
+      result.covariance = result.residual_sigma * result.residual_sigma * final_lin.H.inverse();
+    } else {
+      result.covariance.setConstant(std::numeric_limits<double>::infinity());
+    }
+  }
+  result.theta = theta;
+  return result;
+}
+
+// The finest level's robust costs of two results a and b of the same alignment, on the same
+// pixels (those in view of both) with the same threshold (tukey_k, else huber_k, times the
+// larger of the two robust σ): which of two basins fits the images better.
+template <int N, typename Motion>
+std::pair<double, double> CompareAtFinest(const StereoCamera& camera, const cv::Mat& prev,
+                                          const cv::Mat& curr,
+                                          const std::vector<ScenePlane>& unit_planes,
+                                          const Motion& motion, const Vec<N>& a, const Vec<N>& b,
+                                          const DirectAlignmentOptions& options) {
+  const std::vector<Level> P = Pyramid(prev, camera, 1);
+  const std::vector<Level> C = Pyramid(curr, camera, 1);
+  const std::vector<PlanePixel> pixels =
+      InView(C[0], InView(C[0], SelectPixels(P[0], unit_planes, options), motion(a)), motion(b));
+  const double sigma = std::max(
+      RobustSigma(Linearise<N>(C[0], pixels, motion, a, 1e300, false, false).abs_residuals),
+      RobustSigma(Linearise<N>(C[0], pixels, motion, b, 1e300, false, false).abs_residuals));
+  const bool tukey = options.tukey_k > 0.0;
+  const double threshold = (tukey ? options.tukey_k : options.huber_k) * sigma;
+  return {Linearise<N>(C[0], pixels, motion, a, threshold, tukey, false).cost,
+          Linearise<N>(C[0], pixels, motion, b, threshold, tukey, false).cost};
+}
+
+// The options, the images (8-bit grey of the camera's size) and the planes (finite, in front),
+// the planes with unit normals; false with *message otherwise.
+bool CheckInput(const StereoCamera& camera, const DirectAlignmentOptions& options,
+                const cv::Mat& prev, const cv::Mat& curr, const std::vector<ScenePlane>& planes,
+                std::vector<ScenePlane>* unit, std::string* message) {
+  std::string error;
+  if (!options.IsValid(&error)) {
+    *message = "invalid options: " + error;
+    return false;
+  }
+  if (prev.empty() || curr.empty() || prev.type() != CV_8UC1 || curr.type() != CV_8UC1 ||
+      prev.size() != curr.size() || prev.cols != camera.width || prev.rows != camera.height) {
+    *message = "images must be 8-bit grey of the camera's size";
+    return false;
+  }
+  for (const ScenePlane& plane : planes) {
+    if (!plane.normal.allFinite() || !(plane.normal.norm() > 0.5) || !(plane.distance_m > 0.0) ||
+        !std::isfinite(plane.distance_m)) {
+      *message = "invalid plane";
+      return false;
+    }
+    unit->push_back(plane);
+    unit->back().distance_m /= plane.normal.norm();
+    unit->back().normal.normalize();
+  }
+  return true;
 }
 
 }  // namespace
@@ -234,105 +397,26 @@ DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::M
   DirectAlignmentResult result;
   result.yaw_rad = yaw0_rad;
   result.forward_m = forward0_m;
-  std::string error;
-  if (!options.IsValid(&error)) {
-    result.message = "invalid options: " + error;
-    return result;
-  }
-  if (prev.empty() || curr.empty() || prev.type() != CV_8UC1 || curr.type() != CV_8UC1 ||
-      prev.size() != curr.size() || prev.cols != camera.width || prev.rows != camera.height) {
-    result.message = "images must be 8-bit grey of the camera's size";
-    return result;
-  }
   std::vector<ScenePlane> unit;
-  for (const ScenePlane& plane : planes) {
-    if (!plane.normal.allFinite() || !(plane.normal.norm() > 0.5) || !(plane.distance_m > 0.0) ||
-        !std::isfinite(plane.distance_m)) {
-      result.message = "invalid plane";
-      return result;
-    }
-    unit.push_back(plane);
-    unit.back().distance_m /= plane.normal.norm();
-    unit.back().normal.normalize();
-  }
+  if (!CheckInput(camera, options, prev, curr, planes, &unit, &result.message)) return result;
   if (unit.empty() || !up_prev.allFinite() || !(up_prev.norm() > 0.0) || !std::isfinite(yaw0_rad) ||
       !std::isfinite(forward0_m)) {
     result.message = "no plane, or an invalid up or start";
     return result;
   }
-  // Levels that keep at least 40 pixels across.
-  int levels = options.pyramid_levels;
-  while (levels > 1 && (std::min(camera.width, camera.height) >> (levels - 1)) < 40) --levels;
-  const std::vector<Level> P = Pyramid(prev, camera, levels);
-  const std::vector<Level> C = Pyramid(curr, camera, levels);
   const Eigen::Vector3d up = up_prev.normalized();
-
-  Eigen::Vector2d theta(yaw0_rad, forward0_m);
-  // The yaw prior (yaw_prior_sigma_rad > 0): ½ w (yaw − yaw0)² in the cost, w in the units of
-  // the grey levels' squares (the level's robust residual variance over σ²).
-  const bool yaw_prior = yaw_prior_sigma_rad > 0.0 && std::isfinite(yaw_prior_sigma_rad);
-  double prior_weight = 0.0;
-  auto AddYawPrior = [&](const Eigen::Vector2d& at, Linearisation* lin) {
-    const double d = at.x() - yaw0_rad;
-    lin->cost += 0.5 * prior_weight * d * d;
-    lin->H(0, 0) += prior_weight;
-    lin->g(0) += prior_weight * d;
+  auto motion = [&](const Vec<2>& theta) {
+    return VehicleMotion(up, axle_behind_camera_m, theta.x(), theta.y());
   };
-  for (int l = levels - 1; l >= 0; --l) {
-    const std::vector<PlanePixel> pixels =
-        InView(C[l], SelectPixels(P[l], unit, options), up, axle_behind_camera_m, theta);
-    if (pixels.empty()) continue;
-    // Huber weights on every level; on the finest, then Tukey's biweight (tukey_k > 0), which
-    // gives the pixels off the plane (the floor below a wall) no weight at all.
-    const int passes = l == 0 && options.tukey_k > 0.0 ? 2 : 1;
-    double threshold = 0.0;
-    bool tukey = false;
-    for (int pass = 0; pass < passes; ++pass) {
-      tukey = pass == 1;
-      const double sigma =
-          RobustSigma(Linearise(C[l], pixels, up, axle_behind_camera_m, theta, 1e300, false, false)
-                          .abs_residuals);
-      threshold = (tukey ? options.tukey_k : options.huber_k) * sigma;
-      prior_weight = yaw_prior ? sigma * sigma / (yaw_prior_sigma_rad * yaw_prior_sigma_rad) : 0.0;
-      bool converged = false;
-      for (int it = 0; it < options.max_iterations && !converged; ++it) {
-        ++result.iterations;
-        Linearisation lin =
-            Linearise(C[l], pixels, up, axle_behind_camera_m, theta, threshold, tukey, true);
-        if (yaw_prior) AddYawPrior(theta, &lin);
-        if (lin.n < 3 || !(lin.H.determinant() > 0.0)) break;
-        Eigen::Vector2d step = -lin.H.ldlt().solve(lin.g);
-        if (!step.allFinite()) break;
-        bool improved = false;
-        for (int halving = 0; halving < 6 && !improved; ++halving, step *= 0.5) {
-          Linearisation trial = Linearise(C[l], pixels, up, axle_behind_camera_m, theta + step,
-                                          threshold, tukey, false);
-          if (yaw_prior) AddYawPrior(theta + step, &trial);
-          if (trial.cost < lin.cost) {
-            theta += step;
-            improved = true;
-          }
-        }
-        converged = !improved || (std::abs(step.x()) < 1e-7 && std::abs(step.y()) < 1e-7);
-      }
-    }
-    if (l > 0) continue;
-    // The finest level: the measurement's support and uncertainty.
-    Linearisation final_lin =
-        Linearise(C[0], pixels, up, axle_behind_camera_m, theta, threshold, tukey, true);
-    if (yaw_prior) AddYawPrior(theta, &final_lin);
-    result.pixels = final_lin.n;
-    result.residual_sigma = RobustSigma(final_lin.abs_residuals);
-    if (final_lin.n >= 3 && final_lin.H.determinant() > 0.0) {
-      // The robustly weighted information, the robust residual variance.
-      const Eigen::Matrix2d covariance =
-          result.residual_sigma * result.residual_sigma * final_lin.H.inverse();
-      result.yaw_sigma_rad = std::sqrt(std::max(0.0, covariance(0, 0)));
-      result.forward_sigma_m = std::sqrt(std::max(0.0, covariance(1, 1)));
-    } else {
-      result.yaw_sigma_rad = result.forward_sigma_m = std::numeric_limits<double>::infinity();
-    }
-  }
+  const Alignment<2> a =
+      AlignCoarseToFine<2>(camera, prev, curr, unit, motion, Vec<2>(yaw0_rad, forward0_m),
+                           Vec<2>(yaw_prior_sigma_rad, 0.0), options);
+  const Eigen::Vector2d theta = a.theta;
+  result.iterations = a.iterations;
+  result.pixels = a.pixels;
+  result.residual_sigma = a.residual_sigma;
+  result.yaw_sigma_rad = std::sqrt(std::max(0.0, a.covariance(0, 0)));
+  result.forward_sigma_m = std::sqrt(std::max(0.0, a.covariance(1, 1)));
   if (!theta.allFinite()) {
     result.message = "did not converge";
     return result;
@@ -356,6 +440,85 @@ DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::M
     result.forward_m = theta.y();
   }
   return result;
+}
+
+FreeDirectAlignmentResult AlignFreeDirect(const StereoCamera& camera, const cv::Mat& prev,
+                                          const cv::Mat& curr,
+                                          const std::vector<ScenePlane>& planes,
+                                          const Eigen::Isometry3d& T_prev_curr0,
+                                          const DirectAlignmentOptions& options,
+                                          double rotation_prior_sigma_rad, bool standing_start) {
+  FreeDirectAlignmentResult result;
+  result.T_prev_curr = T_prev_curr0;
+  std::vector<ScenePlane> unit;
+  if (!CheckInput(camera, options, prev, curr, planes, &unit, &result.message)) return result;
+  if (unit.empty() || !T_prev_curr0.matrix().allFinite()) {
+    result.message = "no plane, or an invalid start";
+    return result;
+  }
+  if (!(rotation_prior_sigma_rad > 0.0) || !std::isfinite(rotation_prior_sigma_rad)) {
+    result.message = "no gyro rotation (its sigma must be > 0)";
+    return result;
+  }
+  const Eigen::Matrix3d R0 = T_prev_curr0.linear();
+  auto motion = [&](const Vec<3>& t) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = R0;
+    T.translation() = t;
+    return T;
+  };
+  // One alignment from the translation `start` and its checks (as AlignVehicleDirect's).
+  auto align_from = [&](const Eigen::Vector3d& start) {
+    FreeDirectAlignmentResult r;
+    r.T_prev_curr = T_prev_curr0;
+    const Alignment<3> a =
+        AlignCoarseToFine<3>(camera, prev, curr, unit, motion, start, Vec<3>::Zero(), options);
+    r.iterations = a.iterations;
+    r.pixels = a.pixels;
+    r.residual_sigma = a.residual_sigma;
+    r.rotation_sigma_rad = rotation_prior_sigma_rad;
+    // σ along the worst axis: the square root of the covariance's largest eigenvalue.
+    if (a.covariance.allFinite()) {
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(a.covariance,
+                                                               Eigen::EigenvaluesOnly);
+      r.translation_sigma_m = std::sqrt(std::max(0.0, eig.eigenvalues()(2)));
+    } else {
+      r.translation_sigma_m = std::numeric_limits<double>::infinity();
+    }
+    if (!a.theta.allFinite()) {
+      r.message = "did not converge";
+      return r;
+    }
+    const double translation_change = (a.theta - start).norm();
+    std::ostringstream why;
+    if (r.pixels < options.min_pixels) {
+      why << r.pixels << " pixels in view (need " << options.min_pixels << ")";
+    } else if (r.translation_sigma_m > options.max_forward_sigma_m) {
+      why << "uncertain: sigma(translation) " << r.translation_sigma_m << " m";
+    } else if (translation_change > options.max_forward_change_m) {
+      why << "moved too far from the start (translation " << translation_change << " m)";
+    }
+    r.message = why.str();
+    r.ok = r.message.empty();
+    if (r.ok) r.T_prev_curr = motion(a.theta);
+    return r;
+  };
+  const Eigen::Vector3d t0 = T_prev_curr0.translation();
+  FreeDirectAlignmentResult result_from_start = align_from(t0);
+  if (!standing_start || t0.isZero(0.0)) return result_from_start;
+  // The second start, standing still (the translation 0): a robot that brakes in front of the
+  // wall leaves the constant velocity's start behind, out of the basin; where both converge,
+  // the result whose grey levels fit better (the same pixels and threshold) is the measurement.
+  FreeDirectAlignmentResult result_standing = align_from(Eigen::Vector3d::Zero());
+  result_standing.from_standing = true;
+  result_standing.iterations += result_from_start.iterations;
+  result_from_start.iterations = result_standing.iterations;
+  if (!result_standing.ok) return result_from_start;
+  if (!result_from_start.ok) return result_standing;
+  const std::pair<double, double> costs = CompareAtFinest<3>(
+      camera, prev, curr, unit, motion, Vec<3>(result_from_start.T_prev_curr.translation()),
+      Vec<3>(result_standing.T_prev_curr.translation()), options);
+  return costs.second < costs.first ? result_standing : result_from_start;
 }
 
 namespace {

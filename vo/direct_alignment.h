@@ -97,6 +97,44 @@ DirectAlignmentResult AlignVehicleDirect(const StereoCamera& camera, const cv::M
                                          double forward0_m, const DirectAlignmentOptions& options,
                                          double yaw_prior_sigma_rad = 0.0);
 
+// The same alignment for a 6-DoF motion (the free platform: a handheld rig, a drone, any
+// sequence without a vehicle model), issue #35, with a gyro: T_prev_curr = [R_gyro | t], the
+// rotation the start's (the gyro's, gyro_prior.h, of σ rotation_prior_sigma_rad > 0) and the
+// translation t measured from the images (from the start's), with the same residuals, robust
+// weights, pyramid and planes: the rotation from the gyro, the translation from the images.
+// Two other forms were tried and are not offered. A prior term on the rotation (as the
+// vehicle's yaw prior): the grey levels of thousands of pixels outweigh a gyro's σ of 0.05°
+// by orders of magnitude, and planes that are not quite the scene's then turned the estimate
+// 0.1-0.2° a frame away from a gyro that is right to 0.01° (l_hallway texture seed 3, frames
+// 209-214). No gyro, all six parameters from the images: in front of one plane with a few
+// marks a sideways step and a turn look alike, and the fit was confidently wrong (a 10 mm step
+// read as 2.8 mm up). Without a gyro rotation (σ <= 0) the result is no measurement.
+// The options are read for the translation: max_forward_sigma_m bounds its σ along its worst
+// axis, max_forward_change_m its change |t − t_start| (the yaw bounds are not used).
+// standing_start: a second alignment starts from the translation 0 (standing still); where
+// both are measurements, the one whose grey levels fit better (the finest level's robust cost
+// on the pixels in view of both, with one threshold) is the result. A robot that brakes in
+// front of the wall leaves a constant velocity's start behind, outside the basin.
+struct FreeDirectAlignmentResult {
+  bool ok = false;  // a measurement (as AlignVehicleDirect's)
+  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();  // the start when not ok
+  int pixels = 0;
+  int iterations = 0;
+  double residual_sigma = 0.0;
+  double rotation_sigma_rad = 0.0;   // the gyro's σ (the rotation is its)
+  double translation_sigma_m = 0.0;  // finest level's Gauss-Newton σ along the worst axis
+  bool from_standing = false;        // the result of the second start (standing still)
+  std::string message;               // why not ok
+};
+
+FreeDirectAlignmentResult AlignFreeDirect(const StereoCamera& camera, const cv::Mat& prev,
+                                          const cv::Mat& curr,
+                                          const std::vector<ScenePlane>& planes,
+                                          const Eigen::Isometry3d& T_prev_curr0,
+                                          const DirectAlignmentOptions& options,
+                                          double rotation_prior_sigma_rad,
+                                          bool standing_start = true);
+
 // The plane that most features with depth lie on (camera frame): a feature is on it when its
 // disparity is within tolerance_px of the plane's at its pixel. Deterministic RANSAC over
 // triples, refined by least squares on the inliers. False when fewer than min_inliers features

@@ -43,6 +43,12 @@ bool ImuOptions::IsValid(std::string* error) const {
     msg << "bias_window_s must be finite and > 0, got " << bias_window_s;
   } else if (!(max_bias_radps > 0.0) || !std::isfinite(max_bias_radps)) {
     msg << "max_bias_radps must be finite and > 0, got " << max_bias_radps;
+  } else if (!(standing_start_s >= 0.0) || !std::isfinite(standing_start_s)) {
+    msg << "standing_start_s must be finite and >= 0, got " << standing_start_s;
+  } else if (!(standing_max_std_radps > 0.0) || !std::isfinite(standing_max_std_radps)) {
+    msg << "standing_max_std_radps must be finite and > 0, got " << standing_max_std_radps;
+  } else if (!(max_standing_bias_radps > 0.0) || !std::isfinite(max_standing_bias_radps)) {
+    msg << "max_standing_bias_radps must be finite and > 0, got " << max_standing_bias_radps;
   }
   return NoBrokenRule(msg, error);
 }
@@ -117,6 +123,8 @@ void GyroPrior::Reset() {
   have_time_ = false;
   last_time_s_ = 0.0;
   bias_.setZero();
+  bias_origin_.setZero();
+  standing_start_ = false;
   bias_variance_ = options_.initial_bias_sigma_radps * options_.initial_bias_sigma_radps;
   bias_updates_ = 0;
   last_ = GyroRotation();
@@ -129,7 +137,40 @@ void GyroPrior::AddSamples(const std::vector<GyroSample>& samples) {
   samples_.insert(samples_.end(), samples.begin(), samples.end());
 }
 
+void GyroPrior::EstimateStandingBias(double t_s) {
+  const double window = options_.standing_start_s;
+  if (!(window > 0.0) || !std::isfinite(t_s)) return;
+  double first = t_s, last = t_s - window;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const GyroSample& g : samples_) {
+    if (!(g.time_s >= t_s - window && g.time_s <= t_s) || !g.rate_radps.allFinite()) continue;
+    first = std::min(first, g.time_s);
+    last = std::max(last, g.time_s);
+    sum += g.rate_radps;
+    ++n;
+  }
+  if (n < 10 || !(last - first >= 0.9 * window)) return;
+  const Eigen::Vector3d mean = sum / n;
+  Eigen::Vector3d variance = Eigen::Vector3d::Zero();
+  for (const GyroSample& g : samples_) {
+    if (!(g.time_s >= t_s - window && g.time_s <= t_s) || !g.rate_radps.allFinite()) continue;
+    variance += (g.rate_radps - mean).cwiseAbs2();
+  }
+  variance /= std::max(1, n - 1);
+  const double max_std = options_.standing_max_std_radps;
+  if (!(variance.maxCoeff() <= max_std * max_std) ||
+      !(mean.norm() <= options_.max_standing_bias_radps)) {
+    return;  // turning (or shaking) before the first frame: no standing start
+  }
+  bias_ = mean;
+  bias_origin_ = mean;
+  bias_variance_ = variance.maxCoeff() / n;
+  standing_start_ = true;
+}
+
 GyroRotation GyroPrior::Next(double t_s) {
+  if (!have_time_) EstimateStandingBias(t_s);
   GyroRotation r;
   if (have_time_ && t_s > last_time_s_) {
     const double dt = t_s - last_time_s_;
@@ -175,7 +216,10 @@ void GyroPrior::Observe(bool measured, const Eigen::Matrix3d& R_prev_curr_vo) {
   if (error.allFinite() && error.norm() <= options_.max_bias_radps) {
     const double k = options_.bias_gain;
     bias_ += k * error;
-    if (bias_.norm() > options_.max_bias_radps) bias_ *= options_.max_bias_radps / bias_.norm();
+    const Eigen::Vector3d online = bias_ - bias_origin_;
+    if (online.norm() > options_.max_bias_radps) {
+      bias_ = bias_origin_ + online * (options_.max_bias_radps / online.norm());
+    }
     bias_variance_ *= (1.0 - k);
     ++bias_updates_;
   }

@@ -30,8 +30,10 @@
 // low gain bias_gain (the VO's rotation over a stretch of seconds is good to a fraction of a
 // degree; a frame's to ~0.1°, which over 1/30 s would be a bias of degrees per second). A
 // stretch whose observation is larger than max_bias_radps is the VO's error, not the gyro's,
-// and is dropped. A robot standing still at the start gives the same observation (the VO sees
-// no rotation): the standing start is the first stretch.
+// and is dropped. Before that, the standing start (ImuOptions::standing_start_s): the samples
+// of the last second before the first frame, when they look still, give the bias as their
+// mean (a real gyro's turn-on bias, too large for the online filter's bound, which then holds
+// its corrections within max_bias_radps of that estimate).
 #pragma once
 
 #include <Eigen/Core>
@@ -48,12 +50,13 @@ struct ImuOptions {
   bool gyro_prior = false;  // when the caller gives gyro samples (StereoOdometry::SetGyro and
                             // AddGyroSamples), each frame's prior rotation is the gyro's (see the
                             // header comment); false = the constant velocity's, as without an IMU,
-                            // bit for bit. Off by default for now (issue #35): on, it removes 101
-                            // of the 6-DoF mode's 113 lost frames at stride 1 (l_hallway seeds
-                            // 1-10, results/gyro_prior/summary.md), but at stride 3 three seeds
-                            // end worse, the ground vehicle's stride 3 is mixed, and every
-                            // committed figure would change; the default turns on with the 6-DoF
-                            // recovery (point 2) and the results made again
+                            // bit for bit. Off by default for now (issue #35): on, with the BA's
+                            // rotation prior and the free platform's direct alignment, the 6-DoF
+                            // mode loses 2 / 1 frames at strides 1 / 3 on l_hallway seeds 1-10
+                            // (113 / 50 without the gyro) and every seed ends within 0.14 m
+                            // (results/gyro_prior/free_direct.md); the default waits for 0 lost,
+                            // the ground vehicle's 40-run sweep with it, and every committed
+                            // figure made again
   bool few_point_motion = true;      // with the gyro's rotation, a frame RANSAC cannot measure
                                      // takes the few-point motion (motion.few_point_motion) on
                                      // any platform: its rotation is the gyro's (σ below), the
@@ -64,17 +67,16 @@ struct ImuOptions {
                                      // rotation since the reference is the gyro's, the few
                                      // matches measure the translation the constant velocity
                                      // extrapolated
-  bool ba_rotation_prior = false;    // the windowed bundle adjustment holds each pair of
+  bool ba_rotation_prior = true;     // the windowed bundle adjustment holds each pair of
                                      // consecutive window frames whose frames between were all
                                      // given the gyro's rotation to the gyro's rotation between
                                      // them (rotation_prior.h; σ as below, the frames' variances
-                                     // summed); used only with gyro_prior on. Off by default: a
-                                     // real gyro's turn-on bias (EuRoC V1_01's ADIS16448:
-                                     // 0.078 rad/s about z, measured standing still) is not
-                                     // estimated in the first seconds and the prior then turns
-                                     // the estimate with it (the real clip: 1.1° in 0.95 s
-                                     // where the images alone keep 0.09°); the simulated IMU
-                                     // starts without one (sim/imu.h)
+                                     // summed); used only with gyro_prior on. It needs the
+                                     // gyro's bias from the first frames: a real gyro's turn-on
+                                     // bias (EuRoC V1_01's ADIS16448: 0.078 rad/s about z) comes
+                                     // from the standing start (standing_start_s); without it
+                                     // the prior turned the real standing clip's estimate 1.1°
+                                     // in 0.95 s (0.08° with it; the images alone 0.09°)
   double max_weak_rotation_error_deg = 0.5;  // a weak RANSAC motion (fewer than
                                              // motion.reliable_min_inliers inliers) whose
                                              // rotation is farther than this from the gyro's
@@ -93,7 +95,19 @@ struct ImuOptions {
   double bias_window_s = 2.0;    // a stretch of well-tracked frames this long (seconds) is
                                  // one observation of the bias, > 0
   double max_bias_radps = 0.02;  // an observation larger than this (rad/s) is dropped
-                                 // (the VO's error), and the estimate is kept within it, > 0
+                                 // (the VO's error), and the estimate is kept within it of the
+                                 // standing start's (or of 0), > 0
+  // The standing start: on the first frame, the gyro samples of the standing_start_s seconds
+  // before it (they must span 90 % of that), when they look still (each axis' standard
+  // deviation at most standing_max_std_radps: the sensor's noise and a standing platform's
+  // vibration, not a turn) and their mean is at most max_standing_bias_radps, give the bias:
+  // their mean, its variance the largest axis' variance over the number of samples. A real
+  // gyro's turn-on bias (EuRoC V1_01's ADIS16448: 0.078 rad/s about z, std 0.013-0.021 rad/s
+  // standing; 0.035-0.26 rad/s in flight) is then known from the first frame; the online
+  // estimate corrects it from there (max_bias_radps about it). 0: off (the bias starts at 0).
+  double standing_start_s = 1.0;         // >= 0
+  double standing_max_std_radps = 0.03;  // > 0
+  double max_standing_bias_radps = 0.2;  // > 0
 
   bool IsValid(std::string* error) const;
 };
@@ -150,17 +164,23 @@ class GyroPrior {
   void Observe(bool measured, const Eigen::Matrix3d& R_prev_curr_vo);
 
   const Eigen::Vector3d& bias_radps() const { return bias_; }
+  bool standing_start() const { return standing_start_; }  // the bias came from a standing start
   double bias_variance() const { return bias_variance_; }
   int bias_updates() const { return bias_updates_; }
   void Reset();
 
  private:
+  // The standing start before the first frame at t_s (see ImuOptions::standing_start_s).
+  void EstimateStandingBias(double t_s);
+
   ImuOptions options_;
   GyroCalibration calibration_;
   std::vector<GyroSample> samples_;
   bool have_time_ = false;
   double last_time_s_ = 0.0;
   Eigen::Vector3d bias_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bias_origin_ = Eigen::Vector3d::Zero();  // the standing start's (or 0)
+  bool standing_start_ = false;
   double bias_variance_ = 0.0;
   int bias_updates_ = 0;
   // The last Next's result (the interval Observe speaks of).

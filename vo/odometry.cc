@@ -130,7 +130,7 @@ OdometryResult StereoOdometry::Finish(OdometryResult result, const Eigen::Isomet
                               result.num_inliers >= options_.motion.reliable_min_inliers;
     gyro_->Observe(well_tracked, result.T_prev_curr.linear());
   }
-  recovery_.EndFrame(last_features_, result.T_prev_curr, current_left_);
+  recovery_.EndFrame(last_features_, result.T_prev_curr, current_left_, gyro_ != nullptr);
   // Next frame's disparity search range from the depths of this one (full after a loss).
   scene_num_disparities_ = result.status != TrackingStatus::kLost
                                ? SceneNumDisparities(last_features_, options_.front_end)

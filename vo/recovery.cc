@@ -37,6 +37,7 @@ bool RecoveryOptions::IsValid(std::string* error) const {
        (vehicle_direct_alignment && !PartIsValid(vehicle_direct, "vehicle_direct", error)))) {
     return false;
   }
+  if (free_direct_alignment && !PartIsValid(free_direct, "free_direct", error)) return false;
   std::ostringstream msg;
   if (!(rotation_min_shift_score >= -1.0 && rotation_min_shift_score <= 1.0)) {
     msg << "rotation_min_shift_score must be in [-1, 1], got " << rotation_min_shift_score;
@@ -62,6 +63,12 @@ bool RecoveryOptions::IsValid(std::string* error) const {
   return NoBrokenRule(msg, error);
 }
 
+DirectAlignmentOptions RecoveryOptions::FreeDirectDefaults() {
+  DirectAlignmentOptions o;
+  o.max_forward_sigma_m = 0.003;  // the worst of three axes (a step along the view is the zoom)
+  return o;
+}
+
 Recovery::Recovery(const StereoCamera& camera, const RecoveryOptions& options,
                    const MotionOptions& motion, const TrackerOptions& tracker)
     : camera_(camera),
@@ -81,11 +88,13 @@ void Recovery::Reset() {
 }
 
 void Recovery::EndFrame(const std::vector<Feature>& features, const Eigen::Isometry3d& T_prev_curr,
-                        cv::Mat left) {
+                        cv::Mat left, bool gyro) {
   // Only the bridge alignment reads the previous frame's features: no copy per frame otherwise.
   if (motion_.ground_vehicle && options_.vehicle_bridge_alignment) {
     previous_frame_features_ = features;
     if (options_.vehicle_direct_alignment) UpdateScenePlanes(features, T_prev_curr);
+  } else if (!motion_.ground_vehicle && options_.free_direct_alignment && gyro) {
+    UpdateScenePlanes(features, T_prev_curr);
   }
   previous_left_ = std::move(left);
 }
@@ -111,6 +120,12 @@ Eigen::Isometry3d Recovery::BridgedPose(const BridgeContext& c, OdometryResult* 
   if (chained != nullptr) return *chained;  // measured against the lost-frame chain
   const Eigen::Isometry3d bridged = ShiftCorrectedPose(c, result);
   const RecoveryOptions& o = options_;
+  if (!motion_.ground_vehicle) {
+    const bool gyro = c.velocity->has_measured_rotation() && c.measured_rotation_sigma_rad > 0.0;
+    return o.free_direct_alignment && gyro && c.prior == nullptr && predicted_
+               ? FreeDirectAlignedPose(c, bridged, result)
+               : bridged;
+  }
   if (c.prior != nullptr || !motion_.ground_vehicle || !o.vehicle_bridge_alignment ||
       !c.world_up_known || !predicted_) {
     return bridged;
@@ -141,6 +156,23 @@ Eigen::Isometry3d Recovery::DirectAlignedPose(const BridgeContext& c,
   result->direct_motion = true;
   result->motion_measured = true;
   return c.T_world_prev * T;
+}
+
+Eigen::Isometry3d Recovery::FreeDirectAlignedPose(const BridgeContext& c,
+                                                  const Eigen::Isometry3d& bridged,
+                                                  OdometryResult* result) {
+  if (scene_planes_.empty() || previous_left_.empty() || c.current_left.empty()) return bridged;
+  const Clock::time_point t = Clock::now();
+  const Eigen::Isometry3d start = c.T_world_prev.inverse() * bridged;
+  const FreeDirectAlignmentResult direct =
+      AlignFreeDirect(camera_, previous_left_, c.current_left, scene_planes_, start,
+                      options_.free_direct, c.measured_rotation_sigma_rad);
+  result->times.predict_ms += ElapsedMs(t);
+  if (!direct.ok || !IsFinitePose(direct.T_prev_curr)) return bridged;
+  c.velocity->ReplaceIfKnown(direct.T_prev_curr);
+  result->direct_motion = true;
+  result->motion_measured = true;
+  return c.T_world_prev * direct.T_prev_curr;
 }
 
 void Recovery::UpdateScenePlanes(const std::vector<Feature>& features,

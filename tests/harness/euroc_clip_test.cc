@@ -179,32 +179,50 @@ TEST(EurocClipTest, StandingStillWithTheRealGyroTurnsAsTheGroundTruth) {
             1e-12);
   EXPECT_EQ(sequence.T_imu_cam0.translation(), reader.cam0().T_body_cam.translation());
 
-  vo::OdometryOptions vo_options;
-  vo_options.imu.gyro_prior = true;
-  RunOptions run;
-  run.out_dir = dir / "run";
-  run.progress = false;
-  run.plots = false;
-  RunSummary s;
-  ASSERT_TRUE(EvalDataset(kClip, options, vo_options, run, &s, &info, &error)) << error;
-  EXPECT_EQ(s.metrics.frames, 20);
-  EXPECT_LE(s.lost_frames, kMaxStandStillLostFrames);
-  std::ifstream options_yaml(run.out_dir + "/vo_options.yaml");
-  std::stringstream recorded;
-  recorded << options_yaml.rdbuf();
-  EXPECT_NE(recorded.str().find("gyro_prior: true"), std::string::npos) << recorded.str();
-  std::vector<StampedPose> est, gt;
-  ASSERT_TRUE(ReadTum(run.out_dir + "/trajectory_world_tum.txt", &est, &error)) << error;
-  ASSERT_TRUE(ReadTum(run.out_dir + "/groundtruth_world_tum.txt", &gt, &error)) << error;
-  ASSERT_EQ(est.size(), 20u);
-  ASSERT_EQ(gt.size(), 20u);
-  double worst_deg = 0.0;
-  for (size_t k = 0; k < est.size(); ++k)
-    worst_deg = std::max(worst_deg, RotationSinceFirstErrorDeg(est, gt, k));
-  std::printf("standing still with the gyro: worst rotation error %.4f deg, ATE %.4f m\n",
-              worst_deg, s.metrics.ate_rmse_m);
-  EXPECT_LE(worst_deg, kMaxGyroStandStillRotationDeg);
-  EXPECT_LE(s.metrics.ate_rmse_m, kMaxStandStillAteM);
+  // The gyro prior alone; with the window BA's rotation prior too (its default); and that
+  // without the standing start: the ADIS16448's turn-on bias (0.078 rad/s about z) is then not
+  // known in the clip's 0.95 s and the BA's prior turns the estimate with it (1.1°).
+  struct Case {
+    const char* name;
+    bool ba_rotation_prior;
+    double standing_start_s;
+    bool within;
+  };
+  for (const Case& c : {Case{"gyro prior", false, 1.0, true}, Case{"and BA prior", true, 1.0, true},
+                        Case{"no standing start", true, 0.0, false}}) {
+    vo::OdometryOptions vo_options;
+    vo_options.imu.gyro_prior = true;
+    vo_options.imu.ba_rotation_prior = c.ba_rotation_prior;
+    vo_options.imu.standing_start_s = c.standing_start_s;
+    RunOptions run;
+    run.out_dir = dir / c.name;
+    run.progress = false;
+    run.plots = false;
+    RunSummary s;
+    ASSERT_TRUE(EvalDataset(kClip, options, vo_options, run, &s, &info, &error)) << error;
+    EXPECT_EQ(s.metrics.frames, 20);
+    EXPECT_LE(s.lost_frames, kMaxStandStillLostFrames);
+    std::ifstream options_yaml(run.out_dir + "/vo_options.yaml");
+    std::stringstream recorded;
+    recorded << options_yaml.rdbuf();
+    EXPECT_NE(recorded.str().find("gyro_prior: true"), std::string::npos) << recorded.str();
+    std::vector<StampedPose> est, gt;
+    ASSERT_TRUE(ReadTum(run.out_dir + "/trajectory_world_tum.txt", &est, &error)) << error;
+    ASSERT_TRUE(ReadTum(run.out_dir + "/groundtruth_world_tum.txt", &gt, &error)) << error;
+    ASSERT_EQ(est.size(), 20u);
+    ASSERT_EQ(gt.size(), 20u);
+    double worst_deg = 0.0;
+    for (size_t k = 0; k < est.size(); ++k)
+      worst_deg = std::max(worst_deg, RotationSinceFirstErrorDeg(est, gt, k));
+    std::printf("standing still with the gyro (%s): worst rotation error %.4f deg, ATE %.4f m\n",
+                c.name, worst_deg, s.metrics.ate_rmse_m);
+    if (c.within) {
+      EXPECT_LE(worst_deg, kMaxGyroStandStillRotationDeg) << c.name;
+      EXPECT_LE(s.metrics.ate_rmse_m, kMaxStandStillAteM) << c.name;
+    } else {
+      EXPECT_GT(worst_deg, 0.5) << c.name;
+    }
+  }
 }
 
 // --- The moving pairs: img_3 -> img_2, 0.5 s apart (img_3 is the earlier one).

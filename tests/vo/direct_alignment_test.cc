@@ -8,6 +8,7 @@
 
 #include "tests/vo/vo_test_util.h"
 #include "vo/prior_motion.h"
+#include "vo/recovery.h"
 
 namespace vo {
 namespace {
@@ -19,6 +20,10 @@ constexpr double kDeg = M_PI / 180.0;
 const Eigen::Vector3d kUp(0.0, -1.0, 0.0);  // camera frame: y down, a level camera
 constexpr double kAxleM = 0.15;             // the camera 0.15 m ahead of the wheel axle
 constexpr double kWallM = 0.85;             // the end wall, 0.85 m ahead of the first camera
+
+double RecoveryDefaultsMaxTranslationSigma() {
+  return RecoveryOptions::FreeDirectDefaults().max_forward_sigma_m;
+}
 
 // What a plain end wall shows (wall coordinates x right, y down, metres): grey paint, the lower
 // edge of a picture frame, a soft shadow and a few specks; optionally nothing but the paint.
@@ -153,6 +158,63 @@ TEST(DirectAlignmentTest, BadInputIsRefused) {
   r = AlignVehicleDirect(camera, image, image, {}, kUp, kAxleM, 0.0, 0.0, {});
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.message.find("plane"), std::string::npos) << r.message;
+}
+
+// The free platform (6 DoF, issue #35): a camera that turns about a slanted axis and steps
+// sideways, down and ahead in front of the same plain wall. The gyro gives the rotation (exact
+// here, σ 0.05°); the start's translation is a constant velocity's, off by 8, 5 and 15 mm. The
+// alignment keeps the gyro's rotation and measures the translation from the wall's few marks.
+TEST(DirectAlignmentTest, AFreeMotionIsMeasuredWithTheGyrosRotation) {
+  const StereoCamera camera = TestCamera();
+  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
+  T_prev_curr.linear() = Eigen::AngleAxisd(1.6 * kDeg, Eigen::Vector3d(0.3, -1.0, 0.2).normalized())
+                             .toRotationMatrix();
+  T_prev_curr.translation() = Eigen::Vector3d(-0.006, 0.004, 0.012);
+  const cv::Mat prev = RenderWall(camera, Eigen::Isometry3d::Identity(), true, 11);
+  const cv::Mat curr = RenderWall(camera, T_prev_curr, true, 12);
+  Eigen::Isometry3d start = T_prev_curr;
+  start.translation() += Eigen::Vector3d(0.008, -0.005, 0.015);
+  const FreeDirectAlignmentResult r =
+      AlignFreeDirect(camera, prev, curr, Wall(), start, {}, 0.05 * kDeg);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_TRUE(r.T_prev_curr.linear().isApprox(T_prev_curr.linear(), 1e-12));  // the gyro's
+  const Eigen::Vector3d error = r.T_prev_curr.translation() - T_prev_curr.translation();
+  EXPECT_LT(error.head<2>().norm(), 0.0005) << error.transpose();
+  EXPECT_LT(std::abs(error.z()), 0.0015) << error.transpose();  // the zoom (see above)
+  EXPECT_GE(r.pixels, DirectAlignmentOptions().min_pixels);
+  EXPECT_LT(r.residual_sigma, 4.0);
+  EXPECT_EQ(r.rotation_sigma_rad, 0.05 * kDeg);
+  EXPECT_GT(r.translation_sigma_m, 0.0);
+  EXPECT_LE(r.translation_sigma_m, RecoveryDefaultsMaxTranslationSigma());
+}
+
+TEST(DirectAlignmentTest, APaintedWallIsNoFreeMeasurementAndBadInputIsRefused) {
+  const StereoCamera camera = TestCamera();
+  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
+  T_prev_curr.translation() = Eigen::Vector3d(0.0, 0.0, 0.01);
+  const cv::Mat prev = RenderWall(camera, Eigen::Isometry3d::Identity(), false, 15);
+  const cv::Mat curr = RenderWall(camera, T_prev_curr, false, 16);
+  FreeDirectAlignmentResult r =
+      AlignFreeDirect(camera, prev, curr, Wall(), T_prev_curr, {}, 0.05 * kDeg);
+  EXPECT_FALSE(r.ok);
+  EXPECT_FALSE(r.message.empty());
+  EXPECT_TRUE(r.T_prev_curr.isApprox(T_prev_curr, 0.0));
+  r = AlignFreeDirect(camera, prev, cv::Mat(), Wall(), T_prev_curr, {}, 0.05 * kDeg);
+  EXPECT_NE(r.message.find("8-bit"), std::string::npos) << r.message;
+  r = AlignFreeDirect(camera, prev, curr, {}, T_prev_curr, {}, 0.05 * kDeg);
+  EXPECT_NE(r.message.find("plane"), std::string::npos) << r.message;
+  Eigen::Isometry3d nan = T_prev_curr;
+  nan.translation().x() = std::nan("");
+  r = AlignFreeDirect(camera, prev, curr, Wall(), nan, {}, 0.05 * kDeg);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.message.find("invalid start"), std::string::npos) << r.message;
+  r = AlignFreeDirect(camera, prev, curr, Wall(), T_prev_curr, {}, 0.0);  // no gyro
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.message.find("gyro"), std::string::npos) << r.message;
+  DirectAlignmentOptions bad;
+  bad.max_pixels = 0;
+  r = AlignFreeDirect(camera, prev, curr, Wall(), T_prev_curr, bad, 0.05 * kDeg);
+  EXPECT_NE(r.message.find("max_pixels"), std::string::npos) << r.message;
 }
 
 // Eight features on a wall turned 20 deg, three on the floor: the wall is the plane.

@@ -210,6 +210,102 @@ TEST(GyroPriorTest, AStretchThatDisagreesGrosslyIsNotABias) {
   EXPECT_EQ(other.bias_updates(), 0);
 }
 
+// A gyro at 200 Hz reading rate(t) + a turn-on bias + noise of 0.015 rad/s per axis (the
+// numbers of EuRoC V1_01's ADIS16448 standing still: 0.078 rad/s about z, 0.013-0.021 rad/s of
+// noise and vibration) from `from_s` to 3 s; the frames start at 0.
+const Eigen::Vector3d kTurnOnBias(-0.002, 0.021, 0.078);
+template <typename Rate>
+std::vector<GyroSample> NoisyGyro(const Rate& rate, double from_s, uint64_t seed) {
+  SplitMix64 rng(seed);
+  std::vector<GyroSample> samples;
+  for (int k = 0; from_s + k * 0.005 <= 3.0 + 1e-9; ++k) {
+    GyroSample g;
+    g.time_s = from_s + k * 0.005;
+    const Eigen::Vector3d noise(test::Normal(&rng), test::Normal(&rng), test::Normal(&rng));
+    g.rate_radps = rate(g.time_s) + kTurnOnBias + 0.015 * noise;
+    samples.push_back(g);
+  }
+  return samples;
+}
+
+// Standing still for 2 s before the first frame, then turning at 0.3 rad/s: the standing start
+// gives the turn-on bias at the first frame (the mean of the last second's 201 samples, good to
+// 0.015 / sqrt(201) = 1.1e-3 rad/s per axis), and the first frame's rotation is right to the
+// noise of its 7 samples (0.015 rad/s · 1/30 s / sqrt(7): 0.011° per axis; asserted 0.05°)
+// where a bias of 0 would be 0.15° off.
+TEST(GyroPriorTest, AStandingStartGivesTheTurnOnBias) {
+  auto rate = [](double t) {
+    return t < 0.0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0, 0.3);
+  };
+  const std::vector<GyroSample> samples = NoisyGyro(rate, -2.0, 21);
+  GyroCalibration calibration;
+  calibration.R_imu_cam = Mounting();
+  GyroPrior gyro(ImuOptions(), calibration);
+  gyro.AddSamples(samples);
+  EXPECT_FALSE(gyro.Next(0.0).ok);  // the first frame
+  ASSERT_TRUE(gyro.standing_start());
+  EXPECT_LT((gyro.bias_radps() - kTurnOnBias).norm(), 0.004) << gyro.bias_radps().transpose();
+  EXPECT_LT(gyro.bias_variance(), 0.002 * 0.002);
+  const GyroRotation r = gyro.Next(1.0 / 30.0);
+  ASSERT_TRUE(r.ok);
+  const Eigen::Matrix3d R_true =
+      Mounting().transpose() * Exp(Eigen::Vector3d(0, 0, 0.3 / 30.0)) * Mounting();
+  EXPECT_LT(AngleBetween(r.R_prev_curr, R_true), 0.05 * kDeg);
+  // Off (standing_start_s 0): the bias starts at 0 and the frame is off by the bias's turn.
+  ImuOptions off;
+  off.standing_start_s = 0.0;
+  GyroPrior plain(off, calibration);
+  plain.AddSamples(samples);
+  plain.Next(0.0);
+  EXPECT_FALSE(plain.standing_start());
+  EXPECT_EQ(plain.bias_radps(), Eigen::Vector3d::Zero());
+  EXPECT_GT(AngleBetween(plain.Next(1.0 / 30.0).R_prev_curr, R_true), 0.1 * kDeg);
+}
+
+// What is no standing start: turning before the first frame (the rate varies by more than
+// standing_max_std_radps), a rate steadier than that but larger than max_standing_bias_radps
+// (a steady turn), and too short a record (0.5 s of the 1 s window).
+TEST(GyroPriorTest, TurningOrTooShortARecordIsNoStandingStart) {
+  auto turning = [](double t) { return Eigen::Vector3d(0.0, 0.0, 0.3 * std::sin(3.0 * t)); };
+  auto steady = [](double) { return Eigen::Vector3d(0.0, 0.0, 0.3); };
+  auto still = [](double) { return Eigen::Vector3d::Zero(); };
+  struct Case {
+    const char* name;
+    std::vector<GyroSample> samples;
+  };
+  const Case cases[] = {{"turning", NoisyGyro(turning, -2.0, 22)},
+                        {"steady turn", NoisyGyro(steady, -2.0, 23)},
+                        {"too short", NoisyGyro(still, -0.5, 24)}};
+  for (const Case& c : cases) {
+    GyroPrior gyro{ImuOptions(), GyroCalibration()};
+    gyro.AddSamples(c.samples);
+    gyro.Next(0.0);
+    EXPECT_FALSE(gyro.standing_start()) << c.name;
+    EXPECT_EQ(gyro.bias_radps(), Eigen::Vector3d::Zero()) << c.name;
+  }
+}
+
+// After a standing start the online estimate corrects the standing one (max_bias_radps about
+// it, not about 0): the VO's exact rotations over a 2 s stretch move it towards the truth, and
+// it stays at the turn-on bias's size (0.078 rad/s, four times max_bias_radps).
+TEST(GyroPriorTest, TheOnlineEstimateCorrectsTheStandingOne) {
+  auto rate = [](double t) {
+    return t < 0.0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0, 0.3);
+  };
+  GyroPrior gyro{ImuOptions(), GyroCalibration()};
+  gyro.AddSamples(NoisyGyro(rate, -2.0, 25));
+  gyro.Next(0.0);
+  ASSERT_TRUE(gyro.standing_start());
+  const double before = (gyro.bias_radps() - kTurnOnBias).norm();
+  for (int i = 1; i <= 61; ++i) {
+    gyro.Next(i / 30.0);
+    gyro.Observe(true, Exp(Eigen::Vector3d(0, 0, 0.3 / 30.0)));
+  }
+  EXPECT_EQ(gyro.bias_updates(), 1);
+  EXPECT_GT(gyro.bias_radps().norm(), 0.07);
+  EXPECT_LT((gyro.bias_radps() - kTurnOnBias).norm(), std::max(before, 0.004));
+}
+
 TEST(GyroPriorTest, OptionsRefuseBadFields) {
   test::ExpectOptionsRefuseBadFields<ImuOptions>({
       {"min_rotation_sigma_deg", [](ImuOptions* o) { o->min_rotation_sigma_deg = 0.0; }},
@@ -218,6 +314,9 @@ TEST(GyroPriorTest, OptionsRefuseBadFields) {
       {"bias_gain", [](ImuOptions* o) { o->bias_gain = 1.5; }},
       {"bias_window_s", [](ImuOptions* o) { o->bias_window_s = 0.0; }},
       {"max_bias_radps", [](ImuOptions* o) { o->max_bias_radps = NAN; }},
+      {"standing_start_s", [](ImuOptions* o) { o->standing_start_s = -1.0; }},
+      {"standing_max_std_radps", [](ImuOptions* o) { o->standing_max_std_radps = 0.0; }},
+      {"max_standing_bias_radps", [](ImuOptions* o) { o->max_standing_bias_radps = NAN; }},
   });
   test::ExpectOptionsRefuseBadFields<GyroCalibration>({
       {"R_imu_cam", [](GyroCalibration* c) { c->R_imu_cam = 2.0 * Eigen::Matrix3d::Identity(); }},

@@ -142,6 +142,7 @@ TEST(RecoveryTest, OptionsRefuseABadFieldByName) {
   test::ExpectOptionsRefuseBadFields<RecoveryOptions>({
       {"vehicle_bridge: ", [](RecoveryOptions* o) { o->vehicle_bridge.min_pairs = 0; }},
       {"vehicle_direct: ", [](RecoveryOptions* o) { o->vehicle_direct.pyramid_levels = 0; }},
+      {"free_direct: ", [](RecoveryOptions* o) { o->free_direct.min_pixels = 0; }},
       {"rotation_min_shift_score", [](RecoveryOptions* o) { o->rotation_min_shift_score = 1.5; }},
       {"rotation_min_peak_ratio", [](RecoveryOptions* o) { o->rotation_min_peak_ratio = 0.5; }},
       {"rotation_min_residual_px", [](RecoveryOptions* o) { o->rotation_min_residual_px = -1.0; }},
