@@ -68,20 +68,9 @@ Scene MakeScene(uint64_t seed, int num_frames, int num_points, double yaw_deg, d
     const Eigen::Vector3d p(half_width_m * (2.0 * rng.Uniform() - 1.0),
                             half_width_m * (2.0 * rng.Uniform() - 1.0),
                             depth_m + depth_spread_m * (2.0 * rng.Uniform() - 1.0));
-    std::vector<BaObservation> obs;
-    for (int i = 0; i < num_frames; ++i) {
-      const Eigen::Vector3d p_cam0 = s.truth.T_world_cam0[i].inverse() * p;
-      Eigen::Vector2d l, r;
-      if (!cam.ProjectLeft(p_cam0, &l) || !cam.ProjectRight(p_cam0, &r)) continue;
-      BaObservation o;
-      o.frame_index = i;
-      o.point_index = static_cast<int>(s.truth.points_world.size());
-      const double v_noise = sigma_px * Normal(&rng);
-      o.uv_left_px = l + Eigen::Vector2d(sigma_px * Normal(&rng), v_noise);
-      o.has_right = true;
-      o.uv_right_px = r + Eigen::Vector2d(sigma_px * Normal(&rng), v_noise);
-      obs.push_back(o);
-    }
+    const std::vector<BaObservation> obs = test::NoisyStereoObservations(
+        cam, s.truth.T_world_cam0, p, static_cast<int>(s.truth.points_world.size()), sigma_px,
+        false, &rng);
     if (obs.size() < 2) continue;
     s.truth.points_world.push_back(p);
     s.truth.observations.insert(s.truth.observations.end(), obs.begin(), obs.end());

@@ -8,11 +8,46 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <vector>
+
 #include "tests/test_util.h"
+#include "tests/vo/vo_test_util.h"
 #include "vo/bundle_adjustment.h"
+#include "vo/camera.h"
+#include "vo/ransac.h"  // vo::SplitMix64
 
 namespace vo {
 namespace test {
+
+// The point p_world seen by the rectified stereo camera at each of T_world_cam0 (frames where it
+// projects in front of both cameras, and with inside_image within both images): observations
+// of point point_index with pixel noise of sigma_px, one vertical noise for both images.
+inline std::vector<BaObservation> NoisyStereoObservations(
+    const StereoCamera& cam, const std::vector<Eigen::Isometry3d>& T_world_cam0,
+    const Eigen::Vector3d& p_world, int point_index, double sigma_px, bool inside_image,
+    SplitMix64* rng) {
+  auto in_image = [&](const Eigen::Vector2d& uv) {
+    return uv.x() >= 0.0 && uv.y() >= 0.0 && uv.x() <= cam.width - 1.0 &&
+           uv.y() <= cam.height - 1.0;
+  };
+  std::vector<BaObservation> obs;
+  for (size_t i = 0; i < T_world_cam0.size(); ++i) {
+    const Eigen::Vector3d p_cam0 = T_world_cam0[i].inverse() * p_world;
+    Eigen::Vector2d l, r;
+    if (!cam.ProjectLeft(p_cam0, &l) || !cam.ProjectRight(p_cam0, &r)) continue;
+    if (inside_image && (!in_image(l) || !in_image(r))) continue;
+    BaObservation o;
+    o.frame_index = static_cast<int>(i);
+    o.point_index = point_index;
+    const double v_noise = sigma_px * Normal(rng);  // rectified: one v for both images
+    o.uv_left_px = l + Eigen::Vector2d(sigma_px * Normal(rng), v_noise);
+    o.has_right = true;
+    o.uv_right_px = r + Eigen::Vector2d(sigma_px * Normal(rng), v_noise);
+    obs.push_back(o);
+  }
+  return obs;
+}
 
 constexpr double kBackendCostRelTol = 1e-10;  // relative final-cost difference
 constexpr double kBackendTolRad = 1e-9;       // pose rotation difference

@@ -39,10 +39,6 @@ using test::Normal;
 
 using test::TestCamera;
 
-bool InImage(const StereoCamera& cam, const Eigen::Vector2d& uv) {
-  return uv.x() >= 0.0 && uv.y() >= 0.0 && uv.x() <= cam.width - 1.0 && uv.y() <= cam.height - 1.0;
-}
-
 struct Scene {
   BundleAdjustmentProblem truth;  // true poses and points, the noisy observations
   BundleAdjustmentProblem start;  // perturbed poses (all but the first) and points
@@ -64,22 +60,9 @@ Scene MakeScene(uint64_t seed, double sigma_px,
   while (static_cast<int>(s.truth.points_world.size()) < kNumPoints) {
     const Eigen::Vector3d p(6.0 * rng.Uniform() - 3.0, 3.0 * rng.Uniform() - 1.5,
                             2.0 + 8.0 * rng.Uniform());
-    std::vector<BaObservation> obs;
-    for (int i = 0; i < kNumFrames; ++i) {
-      const Eigen::Vector3d p_cam0 = s.truth.T_world_cam0[i].inverse() * p;
-      BaObservation o;
-      Eigen::Vector2d l, r;
-      if (!cam.ProjectLeft(p_cam0, &l) || !cam.ProjectRight(p_cam0, &r) || !InImage(cam, l) ||
-          !InImage(cam, r))
-        continue;
-      o.frame_index = i;
-      o.point_index = static_cast<int>(s.truth.points_world.size());
-      const double v_noise = sigma_px * Normal(&rng);  // rectified: one v for both images
-      o.uv_left_px = l + Eigen::Vector2d(sigma_px * Normal(&rng), v_noise);
-      o.has_right = true;
-      o.uv_right_px = r + Eigen::Vector2d(sigma_px * Normal(&rng), v_noise);
-      obs.push_back(o);
-    }
+    const std::vector<BaObservation> obs = test::NoisyStereoObservations(
+        cam, s.truth.T_world_cam0, p, static_cast<int>(s.truth.points_world.size()), sigma_px, true,
+        &rng);
     if (obs.size() < 2) continue;
     s.truth.points_world.push_back(p);
     s.truth.observations.insert(s.truth.observations.end(), obs.begin(), obs.end());
