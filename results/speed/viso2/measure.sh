@@ -40,13 +40,7 @@ g++ -std=c++14 -O3 -DNDEBUG -msse3 -w -I"$SRC" "$SRC"/filter.cpp "$SRC"/matcher.
 
 # The frames: scenes/l_hallway.yaml as it is (320x240) and at KITTI's size (as
 # results/speed/measure.sh renders them).
-variant() {  # name width height fovy baseline
-  sed -e "s|^name: l_hallway|name: $1|" -e "s|^scene: hallway_l.xml|scene: $ROOT/scenes/hallway_l.xml|" \
-      -e "s|^  width: 320|  width: $2|;s|^  height: 240|  height: $3|" \
-      -e "s|^  fovy_deg: 55 |  fovy_deg: $4 |;s|^  baseline_m: 0.09|  baseline_m: $5|" \
-      scenes/l_hallway.yaml > "$WORK/$1.yaml"
-  [ -d "$WORK/ds_$1" ] || { echo "rendering $1 ($2x$3)"; "$NEW" render "$WORK/$1.yaml" --out "$WORK/ds_$1" -q > /dev/null; }
-}
+source "$ROOT/results/speed/variants.sh"
 variant hallway 320 240 55 0.09
 variant kitti 1241 376 29.3 0.54
 
