@@ -140,23 +140,21 @@ void GyroPrior::AddSamples(const std::vector<GyroSample>& samples) {
 void GyroPrior::EstimateStandingBias(double t_s) {
   const double window = options_.standing_start_s;
   if (!(window > 0.0) || !std::isfinite(t_s)) return;
+  std::vector<Eigen::Vector3d> rates;  // the window's samples
   double first = t_s, last = t_s - window;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  int n = 0;
   for (const GyroSample& g : samples_) {
     if (!(g.time_s >= t_s - window && g.time_s <= t_s) || !g.rate_radps.allFinite()) continue;
     first = std::min(first, g.time_s);
     last = std::max(last, g.time_s);
-    sum += g.rate_radps;
-    ++n;
+    rates.push_back(g.rate_radps);
   }
+  const int n = static_cast<int>(rates.size());
   if (n < 10 || !(last - first >= 0.9 * window)) return;
-  const Eigen::Vector3d mean = sum / n;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& w : rates) mean += w;
+  mean /= n;
   Eigen::Vector3d variance = Eigen::Vector3d::Zero();
-  for (const GyroSample& g : samples_) {
-    if (!(g.time_s >= t_s - window && g.time_s <= t_s) || !g.rate_radps.allFinite()) continue;
-    variance += (g.rate_radps - mean).cwiseAbs2();
-  }
+  for (const Eigen::Vector3d& w : rates) variance += (w - mean).cwiseAbs2();
   variance /= std::max(1, n - 1);
   const double max_std = options_.standing_max_std_radps;
   if (!(variance.maxCoeff() <= max_std * max_std) ||

@@ -126,8 +126,7 @@ Eigen::Isometry3d Recovery::BridgedPose(const BridgeContext& c, OdometryResult* 
                ? FreeDirectAlignedPose(c, bridged, result)
                : bridged;
   }
-  if (c.prior != nullptr || !motion_.ground_vehicle || !o.vehicle_bridge_alignment ||
-      !c.world_up_known || !predicted_) {
+  if (c.prior != nullptr || !o.vehicle_bridge_alignment || !c.world_up_known || !predicted_) {
     return bridged;
   }
   const Eigen::Isometry3d aligned = AlignedBridgePose(c, bridged, result);
@@ -151,11 +150,16 @@ Eigen::Isometry3d Recovery::DirectAlignedPose(const BridgeContext& c,
   result->times.predict_ms += ElapsedMs(t);
   if (!direct.ok) return bridged;
   const Eigen::Isometry3d T = VehicleMotion(up, axle, direct.yaw_rad, direct.forward_m);
-  if (!IsFinitePose(T)) return bridged;
-  c.velocity->ReplaceIfKnown(T);
+  return IsFinitePose(T) ? DirectMotion(c, T, result) : bridged;
+}
+
+Eigen::Isometry3d Recovery::DirectMotion(const BridgeContext& c,
+                                         const Eigen::Isometry3d& T_prev_curr,
+                                         OdometryResult* result) {
+  c.velocity->ReplaceIfKnown(T_prev_curr);
   result->direct_motion = true;
   result->motion_measured = true;
-  return c.T_world_prev * T;
+  return c.T_world_prev * T_prev_curr;
 }
 
 Eigen::Isometry3d Recovery::FreeDirectAlignedPose(const BridgeContext& c,
@@ -169,10 +173,7 @@ Eigen::Isometry3d Recovery::FreeDirectAlignedPose(const BridgeContext& c,
                       options_.free_direct, c.measured_rotation_sigma_rad);
   result->times.predict_ms += ElapsedMs(t);
   if (!direct.ok || !IsFinitePose(direct.T_prev_curr)) return bridged;
-  c.velocity->ReplaceIfKnown(direct.T_prev_curr);
-  result->direct_motion = true;
-  result->motion_measured = true;
-  return c.T_world_prev * direct.T_prev_curr;
+  return DirectMotion(c, direct.T_prev_curr, result);
 }
 
 void Recovery::UpdateScenePlanes(const std::vector<Feature>& features,

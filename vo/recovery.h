@@ -136,15 +136,15 @@ struct RecoveryOptions {
   // The free platform's (not ground_vehicle) direct alignment, with the gyro (issue #35): a lost
   // (or re-initialised) frame whose prior rotation is the gyro's (imu.gyro_prior) is measured
   // by aligning the previous left image with this one on the planes of the last features, as
-  // the vehicle's, in 6 DoF (AlignFreeDirect): the rotation held to the gyro's by its σ, the
-  // translation from the images. When it converges with enough pixels and a small enough
-  // covariance (free_direct; its forward bounds read as the translation's along any axis, its yaw
-  // bounds are not used: the rotation is the gyro's; direct_alignment.h) the frame's motion
-  // counts as measured (motion_measured, direct_motion) and becomes the constant velocity.
-  // Without a gyro nothing changes (a 6-DoF alignment in front of one plane cannot tell a
-  // sideways step from a turn). Measured on l_hallway texture seeds 1-10, strides 1 and 3, with
-  // imu.gyro_prior and imu.ba_rotation_prior (results/gyro_prior/free_direct.md): lost frames
-  // 12 / 9 -> 2 / 2, worst end-pose error 0.392 / 0.840 -> 0.139 / 0.137 m.
+  // the vehicle's, in 6 DoF (AlignFreeDirect): the rotation the gyro's, the translation from
+  // the images (from the constant velocity's and from standing still, the better fit). When it
+  // converges with enough pixels and a small enough covariance (free_direct; its forward bounds
+  // read as the translation's along any axis, its yaw bounds are not used; direct_alignment.h)
+  // the frame's motion counts as measured (motion_measured, direct_motion) and becomes the
+  // constant velocity. Without a gyro nothing changes (a 6-DoF alignment in front of one plane
+  // cannot tell a sideways step from a turn). Measured on l_hallway texture seeds 1-10, strides
+  // 1 and 3, with imu.gyro_prior and imu.ba_rotation_prior (results/gyro_prior/free_direct.md):
+  // lost frames 12 / 9 -> 2 / 1, worst end-pose error 0.392 / 0.840 -> 0.139 / 0.127 m.
   bool free_direct_alignment = true;
   DirectAlignmentOptions free_direct = FreeDirectDefaults();
   int reinit_after_lost_frames = 10;  // while this many consecutive frames (or more) have been
@@ -224,6 +224,10 @@ class Recovery {
                                       OdometryResult* result);
   Eigen::Isometry3d FreeDirectAlignedPose(const BridgeContext& c, const Eigen::Isometry3d& bridged,
                                           OdometryResult* result);
+  // A lost frame's motion T_prev_curr measured by a direct alignment: it becomes the constant
+  // velocity and the frame's motion (direct_motion, motion_measured); the frame's pose.
+  Eigen::Isometry3d DirectMotion(const BridgeContext& c, const Eigen::Isometry3d& T_prev_curr,
+                                 OdometryResult* result);
   // The planes of `features`, else the previous ones moved by T_prev_curr (for at most 30
   // frames), for the next frame's direct alignment.
   void UpdateScenePlanes(const std::vector<Feature>& features,
