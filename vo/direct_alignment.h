@@ -124,6 +124,7 @@ struct FreeDirectAlignmentResult {
   double rotation_sigma_rad = 0.0;   // the gyro's σ (the rotation is its)
   double translation_sigma_m = 0.0;  // finest level's Gauss-Newton σ along the worst axis
   bool from_standing = false;        // the result of the second start (standing still)
+  double log_gain = 0.0;             // α: the current image's gain over the previous's, e^α
   std::string message;               // why not ok
 };
 

@@ -91,7 +91,8 @@ struct OdometryResult {
                                      // kRecovered frame matched across the gap); false for the
                                      // first frame, lost frames and re-initialisations (their
                                      // pose is the prior's prediction) unless the direct image
-                                     // alignment measured them (direct_motion)
+                                     // alignment measured them (direct_motion) or they were
+                                     // chained to the lost frame just before (chained_to_frame)
   bool reinitialised = false;        // the pipeline restarted on this frame after a loss
   bool few_point_motion = false;     // the motion came from the few-point solver with the
                                      // prior (MotionOptions::few_point_motion)

@@ -324,6 +324,9 @@ bool Recovery::ChainLostFrame(Tracker* tracker, const MatchFrame& frame, const B
   *T_world_curr = T_world_chain_ * ransac.T_prev_curr;
   result->chained_to_frame = chain_frame_index_;
   result->chain_inliers = ransac.num_inliers;
+  // Chained to the frame just before: its motion was measured by matching, as a tracked frame's
+  // (not a lost frame); chained further back, the frames between were bridged.
+  if (chain_frame_index_ == result->frame_index - 1) result->motion_measured = true;
   // The measured motion moves the constant velocity as a tracked one does (by its support).
   const Eigen::Isometry3d per_frame =
       Root(ransac.T_prev_curr, result->frame_index - chain_frame_index_);

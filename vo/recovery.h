@@ -19,7 +19,8 @@
 // measure is matched against the previous lost frame with features (chain_lost_frames,
 // ChainLostFrame): a turn in front of a plain wall leaves the reference's view behind, but the
 // frames of the gap overlap each other, so their motion is measured link by link (the frame
-// stays lost; OdometryResult::chained_to_frame).
+// stays lost, OdometryResult::chained_to_frame; chained to the frame just before it, its motion
+// is measured and it is not a lost frame).
 //
 // Ground vehicle (MotionOptions::ground_vehicle; off on the free platform, on for a ground
 // vehicle): where the images cannot measure the motion it is a wheeled vehicle's, planar about the
@@ -93,7 +94,8 @@ struct RecoveryOptions {
   // front of a plain wall takes the camera past the reference's view, and the frames of the
   // gap, which do overlap each other, then measure the motion through it (rotation and
   // translation, RANSAC with at least min_inliers inliers) instead of extrapolating the prior.
-  // The frame stays lost (no link to the window; it counts in lost_frames), its pose is the
+  // The frame stays lost (no link to the window; it counts in lost_frames unless chained to the
+  // frame just before it, whose motion to it is then measured), its pose is the
   // chain's pose times that motion, and the motion moves the constant-velocity prior as a
   // tracked one does. Not with matcher.prediction none (the paper's form), the Kalman matcher
   // (stateful), or a caller's MotionPrior (it bridges a lost frame as given). Measured on l_hallway

@@ -42,8 +42,9 @@ double WallGrey(double x, double y, bool textured) {
 
 // The left image of a camera at T_prev_cam (p_prev = T · p_cam) looking at the wall z = kWallM
 // of the previous camera frame: 3 x 3 supersampled, with seeded noise of sigma 1.5 grey levels.
+// gain: the camera's exposure times its analogue gain (1: the previous image's).
 cv::Mat RenderWall(const StereoCamera& camera, const Eigen::Isometry3d& T_prev_cam, bool textured,
-                   uint64_t seed) {
+                   uint64_t seed, double gain = 1.0) {
   SplitMix64 rng(seed);
   cv::Mat image(camera.height, camera.width, CV_8UC1);
   for (int v = 0; v < camera.height; ++v) {
@@ -60,7 +61,7 @@ cv::Mat RenderWall(const StereoCamera& camera, const Eigen::Isometry3d& T_prev_c
           sum += WallGrey(p.x(), p.y(), textured);
         }
       }
-      const double g = sum / 9.0 + 1.5 * test::Normal(&rng);
+      const double g = gain * sum / 9.0 + 1.5 * test::Normal(&rng);
       image.at<uint8_t>(v, u) = cv::saturate_cast<uint8_t>(std::lround(g));
     }
   }
@@ -186,6 +187,32 @@ TEST(DirectAlignmentTest, AFreeMotionIsMeasuredWithTheGyrosRotation) {
   EXPECT_EQ(r.rotation_sigma_rad, 0.05 * kDeg);
   EXPECT_GT(r.translation_sigma_m, 0.0);
   EXPECT_LE(r.translation_sigma_m, RecoveryDefaultsMaxTranslationSigma());
+}
+
+// The same motion seen by a camera whose gain changed between the frames, +4 % (auto-exposure;
+// l_hallway's camera.gain_sigma is 2 % a frame): +5 grey levels on the paint, and on a wall
+// with one edge a step that moves the edge is the cheaper way to explain them. The alignment
+// measures the gain (α = ln 1.04) beside the translation, which stays as exact as above.
+TEST(DirectAlignmentTest, AFreeMotionIsMeasuredThroughAChangeOfGain) {
+  const StereoCamera camera = TestCamera();
+  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
+  T_prev_curr.linear() = Eigen::AngleAxisd(1.6 * kDeg, Eigen::Vector3d(0.3, -1.0, 0.2).normalized())
+                             .toRotationMatrix();
+  T_prev_curr.translation() = Eigen::Vector3d(-0.006, 0.004, 0.012);
+  const cv::Mat prev = RenderWall(camera, Eigen::Isometry3d::Identity(), true, 11);
+  Eigen::Isometry3d start = T_prev_curr;
+  start.translation() += Eigen::Vector3d(0.008, -0.005, 0.015);
+  for (const double gain : {1.04, 0.96}) {
+    const cv::Mat curr = RenderWall(camera, T_prev_curr, true, 12, gain);
+    const FreeDirectAlignmentResult r =
+        AlignFreeDirect(camera, prev, curr, Wall(), start, {}, 0.05 * kDeg);
+    ASSERT_TRUE(r.ok) << gain << ": " << r.message;
+    const Eigen::Vector3d error = r.T_prev_curr.translation() - T_prev_curr.translation();
+    EXPECT_LT(error.head<2>().norm(), 0.0005) << gain << ": " << error.transpose();
+    EXPECT_LT(std::abs(error.z()), 0.0015) << gain << ": " << error.transpose();
+    EXPECT_NEAR(r.log_gain, std::log(gain), 0.006) << gain;  // within 15 % of the change
+    EXPECT_LT(r.residual_sigma, 4.0) << gain;
+  }
 }
 
 TEST(DirectAlignmentTest, APaintedWallIsNoFreeMeasurementAndBadInputIsRefused) {

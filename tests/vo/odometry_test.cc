@@ -1389,7 +1389,9 @@ TEST(OdometryPredictionTest, LostFramesAreChainedSoTheMotionThroughTheGapIsMeasu
   EXPECT_EQ(r[4].chained_to_frame, -1);  // the first lost frame has nothing to chain to
   // Frame 5: the reference cannot measure it, the lost frame 4 can: its pose is frame 4's
   // times the measured motion (3°, 4 cm), where the constant velocity says "standing still".
-  EXPECT_TRUE(IsLostFrame(r[5])) << r[5].message;
+  // Chained to the frame just before it, its motion is measured by matching: not a lost frame.
+  EXPECT_TRUE(r[5].motion_measured) << r[5].message;
+  EXPECT_FALSE(IsLostFrame(r[5])) << r[5].message;
   EXPECT_EQ(r[5].chained_to_frame, 4) << r[5].message;
   EXPECT_GE(r[5].chain_inliers, OdometryOptions().motion.min_inliers);
   EXPECT_THAT(EstimatedMotion(r, 4, 5), IsNearPose(true_motion(4, 5), 0.3 * kDeg, 0.01));
@@ -1404,6 +1406,7 @@ TEST(OdometryPredictionTest, LostFramesAreChainedSoTheMotionThroughTheGapIsMeasu
   off.recovery.chain_lost_frames = false;
   const std::vector<OdometryResult> u = RunFrames(frames, off, {});
   EXPECT_EQ(u[5].chained_to_frame, -1);
+  EXPECT_TRUE(IsLostFrame(u[5])) << u[5].message;
   EXPECT_THAT(EstimatedMotion(u, 4, 5),
               ::testing::Not(IsNearPose(true_motion(4, 5), 0.3 * kDeg, 0.01)));
 
