@@ -165,16 +165,26 @@ TEST(DirectAlignmentTest, BadInputIsRefused) {
 // sideways, down and ahead in front of the same plain wall. The gyro gives the rotation (exact
 // here, σ 0.05°); the start's translation is a constant velocity's, off by 8, 5 and 15 mm. The
 // alignment keeps the gyro's rotation and measures the translation from the wall's few marks.
-TEST(DirectAlignmentTest, AFreeMotionIsMeasuredWithTheGyrosRotation) {
-  const StereoCamera camera = TestCamera();
+Eigen::Isometry3d FreeMotion() {
   Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
   T_prev_curr.linear() = Eigen::AngleAxisd(1.6 * kDeg, Eigen::Vector3d(0.3, -1.0, 0.2).normalized())
                              .toRotationMatrix();
   T_prev_curr.translation() = Eigen::Vector3d(-0.006, 0.004, 0.012);
+  return T_prev_curr;
+}
+
+Eigen::Isometry3d FreeStart() {  // the gyro's rotation, a constant velocity's translation
+  Eigen::Isometry3d start = FreeMotion();
+  start.translation() += Eigen::Vector3d(0.008, -0.005, 0.015);
+  return start;
+}
+
+TEST(DirectAlignmentTest, AFreeMotionIsMeasuredWithTheGyrosRotation) {
+  const StereoCamera camera = TestCamera();
+  const Eigen::Isometry3d T_prev_curr = FreeMotion();
   const cv::Mat prev = RenderWall(camera, Eigen::Isometry3d::Identity(), true, 11);
   const cv::Mat curr = RenderWall(camera, T_prev_curr, true, 12);
-  Eigen::Isometry3d start = T_prev_curr;
-  start.translation() += Eigen::Vector3d(0.008, -0.005, 0.015);
+  const Eigen::Isometry3d start = FreeStart();
   const FreeDirectAlignmentResult r =
       AlignFreeDirect(camera, prev, curr, Wall(), start, {}, 0.05 * kDeg);
   ASSERT_TRUE(r.ok) << r.message;
@@ -195,13 +205,9 @@ TEST(DirectAlignmentTest, AFreeMotionIsMeasuredWithTheGyrosRotation) {
 // measures the gain (α = ln 1.04) beside the translation, which stays as exact as above.
 TEST(DirectAlignmentTest, AFreeMotionIsMeasuredThroughAChangeOfGain) {
   const StereoCamera camera = TestCamera();
-  Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();
-  T_prev_curr.linear() = Eigen::AngleAxisd(1.6 * kDeg, Eigen::Vector3d(0.3, -1.0, 0.2).normalized())
-                             .toRotationMatrix();
-  T_prev_curr.translation() = Eigen::Vector3d(-0.006, 0.004, 0.012);
+  const Eigen::Isometry3d T_prev_curr = FreeMotion();
   const cv::Mat prev = RenderWall(camera, Eigen::Isometry3d::Identity(), true, 11);
-  Eigen::Isometry3d start = T_prev_curr;
-  start.translation() += Eigen::Vector3d(0.008, -0.005, 0.015);
+  const Eigen::Isometry3d start = FreeStart();
   for (const double gain : {1.04, 0.96}) {
     const cv::Mat curr = RenderWall(camera, T_prev_curr, true, 12, gain);
     const FreeDirectAlignmentResult r =
