@@ -192,6 +192,7 @@ Linearisation<N> Linearise(const Level& curr_level, const std::vector<PlanePixel
   std::array<Eigen::Isometry3d, N> T_k;
   if (jacobians) {
     for (int k = 0; k < N; ++k) {
+      if (k == gain_index) continue;
       Vec<N> moved = theta;
       moved(k) += kEps;
       T_k[k] = motion(moved).inverse();
@@ -225,6 +226,7 @@ Linearisation<N> Linearise(const Level& curr_level, const std::vector<PlanePixel
     std::array<Eigen::Vector2d, N> uv_k;
     bool projected = true;
     for (int k = 0; k < N && projected; ++k) {
+      if (k == gain_index) continue;  // the motion does not read α: its derivative is analytic
       projected = Project(curr_level, T_k[k], px.p_prev, &uv_k[k]);
     }
     double gx = 0.0, gy = 0.0;
@@ -234,8 +236,9 @@ Linearisation<N> Linearise(const Level& curr_level, const std::vector<PlanePixel
     }
     const Eigen::Vector2d grad(gx, gy);
     Vec<N> J;
-    for (int k = 0; k < N; ++k) J(k) = grad.dot(uv_k[k] - uv) / kEps;
-    if (gain_index >= 0) J(gain_index) = -gain * px.intensity;  // ∂r/∂α, analytic
+    for (int k = 0; k < N; ++k) {
+      J(k) = k == gain_index ? -gain * px.intensity : grad.dot(uv_k[k] - uv) / kEps;  // ∂r/∂α
+    }
     lin.H += w * J * J.transpose();
     lin.g += w * J * r;
   }
