@@ -49,6 +49,15 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
   return WriteRunFolder(records, *summary, contents, options.out_dir, &folder, error);
 }
 
+bool SequenceGyro(const StereoSequence& sequence, vo::GyroCalibration* gyro) {
+  if (!sequence.has_imu || !sequence.imu_extrinsics_known) return false;
+  *gyro = vo::GyroCalibration();
+  gyro->R_imu_cam = sequence.T_imu_cam0.linear();
+  gyro->noise_density = sequence.imu.gyro_noise_density;
+  gyro->random_walk = sequence.imu.gyro_random_walk;
+  return true;
+}
+
 bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_options,
                  const RunOptions& options, RunSummary* summary, std::string* error) {
   RunOptions o = options;
@@ -56,12 +65,7 @@ bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_o
   o.ground_truth_not_gravity_aligned = sequence.ground_truth_not_gravity_aligned;
   o.feedback = sequence.feedback;
   o.navigation = sequence.navigation;
-  if (sequence.has_imu && sequence.imu_extrinsics_known) {
-    o.has_gyro = true;
-    o.gyro.R_imu_cam = sequence.T_imu_cam0.linear();
-    o.gyro.noise_density = sequence.imu.gyro_noise_density;
-    o.gyro.random_walk = sequence.imu.gyro_random_walk;
-  }
+  o.has_gyro = SequenceGyro(sequence, &o.gyro);
   return RunOdometry(
       sequence.name, sequence.camera, sequence.next, sequence.expected_frames,
       vo::ResolvePlatform(vo_options, sequence.axle_behind_camera_m, sequence.camera_pitch_deg), o,

@@ -59,6 +59,10 @@ bool RunOdometry(const std::string& name, const vo::StereoCamera& camera, FrameS
                  const RunOptions& options, const std::string& scenario_yaml, RunSummary* summary,
                  std::string* error);
 
+// The sequence's gyro for the VO (its mounting and noise numbers): true with an IMU whose
+// mounting is known (StereoSequence::has_imu and imu_extrinsics_known), false otherwise.
+bool SequenceGyro(const StereoSequence& sequence, vo::GyroCalibration* gyro);
+
 // RunOdometry on a sequence (its name, camera, frames, scenario and outline).
 bool RunSequence(const StereoSequence& sequence, const vo::OdometryOptions& vo_options,
                  const RunOptions& options, RunSummary* summary, std::string* error);

@@ -22,6 +22,7 @@
 #include "harness/plots/plots.h"
 #include "harness/progress.h"
 #include "harness/render.h"
+#include "harness/run.h"
 #include "harness/trajectory_io.h"
 #include "harness/vo_config.h"
 #include "sim/simulator.h"
@@ -597,6 +598,7 @@ bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSeque
   sequence->camera = simulated.camera;
   sequence->axle_behind_camera_m = simulated.axle_behind_camera_m;
   sequence->camera_pitch_deg = simulated.camera_pitch_deg;
+  sequence->has_gyro = SequenceGyro(simulated, &sequence->gyro);
   const FrameSource without_depth = [&](DatasetFrame* frame, std::string* err) {
     if (!simulated.next(frame, err)) return false;
     frame->depth_m = cv::Mat();  // not needed: the score uses the poses only
@@ -631,6 +633,7 @@ bool ScoreSequence(const TuneSequence& sequence, const vo::OdometryOptions& opti
     *error = sequence.name + ": fewer than 2 frames";
     return false;
   }
+  if (sequence.has_gyro) odometry->SetGyro(sequence.gyro);
   // The run pipeline without the folder: no progress, no match statistics.
   RunFramesOptions run_options;
   run_options.progress = false;

@@ -123,6 +123,8 @@ struct TuneSequence {
   std::vector<DatasetFrame> frames;
   double axle_behind_camera_m = -1.0;  // the rig's (StereoSequence), < 0 = unknown
   double camera_pitch_deg = std::numeric_limits<double>::quiet_NaN();  // the rig's, NaN = unknown
+  bool has_gyro = false;     // the sequence's gyro (SequenceGyro), as `vobench run` gives it
+  vo::GyroCalibration gyro;  // to the VO (imu.gyro_prior); the frames carry its samples
 };
 bool SimulateTuneScenario(const TuneScenario& scenario, bool progress, TuneSequence* sequence,
                           std::string* error);

@@ -47,16 +47,16 @@ namespace vo {
 
 // The `imu` group of vo_options.yaml.
 struct ImuOptions {
-  bool gyro_prior = false;  // when the caller gives gyro samples (StereoOdometry::SetGyro and
-                            // AddGyroSamples), each frame's prior rotation is the gyro's (see the
-                            // header comment); false = the constant velocity's, as without an IMU,
-                            // bit for bit. Off by default for now (issue #35): on, with the BA's
-                            // rotation prior and the free platform's direct alignment, the 6-DoF
-                            // mode loses 2 / 1 frames at strides 1 / 3 on l_hallway seeds 1-10
-                            // (113 / 50 without the gyro) and every seed ends within 0.14 m
-                            // (results/gyro_prior/free_direct.md); the default waits for 0 lost,
-                            // the ground vehicle's 40-run sweep with it, and every committed
-                            // figure made again
+  bool gyro_prior = true;  // when the caller gives gyro samples (StereoOdometry::SetGyro and
+                           // AddGyroSamples), each frame's prior rotation is the gyro's (see the
+                           // header comment); false = the constant velocity's, as without an IMU,
+                           // bit for bit. On by default (issue #35): with the BA's rotation prior
+                           // and the free platform's direct alignment, the 6-DoF mode loses no
+                           // frame at strides 1 and 3 on l_hallway seeds 1-10 (113 / 50 without
+                           // the gyro; results/gyro_prior/free_direct.md), and the ground
+                           // vehicle's 40-run sweep ends closer on 38 runs
+                           // (results/gyro_prior/vehicle_sweep.md). Without samples (no IMU, a
+                           // bag) nothing changes
   bool few_point_motion = true;      // with the gyro's rotation, a frame RANSAC cannot measure
                                      // takes the few-point motion (motion.few_point_motion) on
                                      // any platform: its rotation is the gyro's (σ below), the

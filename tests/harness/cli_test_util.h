@@ -2,6 +2,7 @@
 #pragma once
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -69,6 +71,22 @@ inline std::vector<std::string> EntriesStartingWith(const std::string& dir,
 inline std::string ReadAll(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Two trajectories as text (trajectory_kitti.txt: 12 numbers a frame) agree number by number
+// within `tolerance`, with the same count of numbers (`frames` × 12).
+inline void ExpectTrajectoriesNear(const std::string& got_text, const std::string& want_text,
+                                   int frames, double tolerance, const std::string& what) {
+  std::istringstream got(got_text), want(want_text);
+  double g = 0.0, w = 0.0;
+  int numbers = 0;
+  while (want >> w) {
+    ASSERT_TRUE(got >> g) << what << ": fewer numbers than the reference's " << numbers;
+    EXPECT_NEAR(g, w, tolerance) << what << ": number " << numbers;
+    ++numbers;
+  }
+  EXPECT_FALSE(got >> g) << what << ": more numbers than the reference's " << numbers;
+  EXPECT_EQ(numbers, 12 * frames) << what;
 }
 
 }  // namespace vobench_test

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ namespace harness {
 namespace {
 
 using vobench_test::CommandResult;
+using vobench_test::ExpectTrajectoriesNear;
 using vobench_test::ReadAll;
 using vobench_test::RunVobench;
 
@@ -147,14 +149,15 @@ fs::path* EvalTest::root_ = nullptr;
 sim::Scenario* EvalTest::scenario_ = nullptr;
 RunSummary* EvalTest::run_ = nullptr;
 
-void ExpectSameAccuracy(const nlohmann::json& a, const nlohmann::json& b, const std::string& what) {
+void ExpectSameAccuracy(const nlohmann::json& a, const nlohmann::json& b, const std::string& what,
+                        double tolerance = kMetricTolerance) {
   for (const char* k :
        {"path_length_m", "end_pose_error_m", "end_rotation_error_deg", "ate_rmse_m",
         "ate_rmse_unaligned_m", "rpe_trans_rmse_m", "rpe_rot_rmse_deg", "drift_pct"}) {
     ASSERT_TRUE(a.contains(k) && b.contains(k)) << what << ": " << k;
     ASSERT_EQ(a[k].is_null(), b[k].is_null()) << what << ": " << k;  // not applicable in both
     if (!a[k].is_null()) {
-      EXPECT_NEAR(a[k].get<double>(), b[k].get<double>(), kMetricTolerance) << what << ": " << k;
+      EXPECT_NEAR(a[k].get<double>(), b[k].get<double>(), tolerance) << what << ": " << k;
     }
   }
   for (const char* k : {"frames", "lost_frames", "ground_truth_frames", "has_ground_truth"})
@@ -162,24 +165,43 @@ void ExpectSameAccuracy(const nlohmann::json& a, const nlohmann::json& b, const 
 }
 
 TEST_F(EvalTest, SimulatorExportsInEachFormatGiveTheRunsTrajectoryAndMetrics) {
-  // `vobench run` on the scenario itself (simulating again) is the reference.
-  const std::string scenario_run = (dir_ / "scenario_run").string();
-  RunSummary s0;
-  std::string error0;
-  ASSERT_TRUE(RunScenario(*scenario_, vo::OdometryOptions(), QuietRun(scenario_run), &s0, &error0))
-      << error0;
-  const nlohmann::json run = ReadJson(scenario_run + "/metrics.json");
-  ASSERT_TRUE(s0.has_ground_truth);
-  EXPECT_GT(s0.metrics.frames, 12);
-  EXPECT_EQ(run["ground_truth_frames"], s0.metrics.frames);
-  const std::string run_trajectory = ReadAll(scenario_run + "/trajectory_kitti.txt");
-  EXPECT_EQ(ReadAll(RunDir() + "/trajectory_kitti.txt"), run_trajectory);  // the fixture's run
+  // `vobench run` on the scenario itself (simulating again) is the reference: without the gyro
+  // for the layouts that carry no IMU (kitti, tum), with it (the default, imu.gyro_prior) for
+  // euroc, whose imu0 holds the simulated IMU and its mounting.
+  struct Reference {
+    std::string trajectory;
+    nlohmann::json metrics;
+  };
+  auto reference = [&](bool gyro, Reference* r) {
+    const std::string dir = (dir_ / (gyro ? "scenario_run_gyro" : "scenario_run")).string();
+    vo::OdometryOptions vo_options;
+    vo_options.imu.gyro_prior = gyro;
+    RunSummary s0;
+    std::string error0;
+    ASSERT_TRUE(RunScenario(*scenario_, vo_options, QuietRun(dir), &s0, &error0)) << error0;
+    r->metrics = ReadJson(dir + "/metrics.json");
+    ASSERT_TRUE(s0.has_ground_truth);
+    EXPECT_GT(s0.metrics.frames, 12);
+    EXPECT_EQ(r->metrics["ground_truth_frames"], s0.metrics.frames);
+    r->trajectory = ReadAll(dir + "/trajectory_kitti.txt");
+  };
+  Reference without_gyro, with_gyro;
+  ASSERT_NO_FATAL_FAILURE(reference(false, &without_gyro));
+  ASSERT_NO_FATAL_FAILURE(reference(true, &with_gyro));
+  EXPECT_NE(with_gyro.trajectory, without_gyro.trajectory);  // the gyro is used
+  // The fixture's run (the frames without their gyro) is the run without the gyro.
+  EXPECT_EQ(ReadAll(RunDir() + "/trajectory_kitti.txt"), without_gyro.trajectory);
   const struct {
     DatasetFormat format;
     std::string dir;
-  } cases[] = {{DatasetFormat::kKitti, Export(DatasetFormat::kEuroc)},
-               {DatasetFormat::kEuroc, Export(DatasetFormat::kEuroc)},
-               {DatasetFormat::kTum, Export(DatasetFormat::kTum)}};
+    const Reference& reference;
+    double tolerance;  // 0: bit for bit
+  } cases[] = {{DatasetFormat::kKitti, Export(DatasetFormat::kEuroc), without_gyro, 0.0},
+               // The gyro's samples are stamped in nanoseconds since the simulation's epoch
+               // (1.77e9 s): read back as seconds, their differences carry ~1e-7 s of rounding,
+               // so the gyro's rotations, and the trajectory, agree to ~1e-6 only.
+               {DatasetFormat::kEuroc, Export(DatasetFormat::kEuroc), with_gyro, 1e-5},
+               {DatasetFormat::kTum, Export(DatasetFormat::kTum), without_gyro, 0.0}};
   for (const auto& c : cases) {
     const std::string name = DatasetFormatName(c.format);
     EvalOptions options;
@@ -192,10 +214,18 @@ TEST_F(EvalTest, SimulatorExportsInEachFormatGiveTheRunsTrajectoryAndMetrics) {
         EvalDataset(c.dir, options, vo::OdometryOptions(), QuietRun(out), &s, &info, &error))
         << name << ": " << error;
     EXPECT_FALSE(info.rectified) << name;  // the simulator's pair is ideal: images untouched
-    EXPECT_EQ(info.ground_truth_frames, static_cast<size_t>(s0.metrics.frames)) << name;
-    // Same frames -> the same trajectory, bit for bit, and the same metrics.
-    EXPECT_EQ(ReadAll(out + "/trajectory_kitti.txt"), run_trajectory) << name;
-    ExpectSameAccuracy(ReadJson(out + "/metrics.json"), run, name);
+    EXPECT_EQ(info.ground_truth_frames, c.reference.metrics["ground_truth_frames"]) << name;
+    // Same frames (and gyro) -> the same trajectory, bit for bit, and the same metrics; the
+    // default VO options on every layout (the gyro is used where the layout has one).
+    const std::string trajectory = ReadAll(out + "/trajectory_kitti.txt");
+    if (c.tolerance == 0.0) {
+      EXPECT_EQ(trajectory, c.reference.trajectory) << name;
+      ExpectSameAccuracy(ReadJson(out + "/metrics.json"), c.reference.metrics, name);
+    } else {
+      ExpectTrajectoriesNear(trajectory, c.reference.trajectory,
+                             c.reference.metrics["frames"].get<int>(), c.tolerance, name);
+      ExpectSameAccuracy(ReadJson(out + "/metrics.json"), c.reference.metrics, name, c.tolerance);
+    }
     for (const char* f : {"trajectory_world_tum.txt", "groundtruth_world_tum.txt", "per_frame.csv",
                           "vo_options.yaml", "report.md", "estimate_in_gt_world_tum.txt"})
       EXPECT_TRUE(fs::exists(out + "/" + f)) << name << ": " << f;

@@ -5,9 +5,9 @@
 // simulated gyro (imu.gyro_prior) every frame's rotation is the truth's within 0.1° on both
 // platforms: the featureless frames take the gyro's rotation, the frames tracked on the cabinet
 // (one plane, 40-50 inliers, whose rotation the free platform's RANSAC reads 0.1-0.6° off) are
-// held to it by the window BA's gyro rotation prior (imu.ba_rotation_prior, turned on here with
-// imu.gyro_prior; off by default, gyro_prior.h says why). Without the gyro (the default) both
-// platforms lose those frames and end tens of degrees off: the behaviour of before the gyro.
+// held to it by the window BA's gyro rotation prior (imu.ba_rotation_prior; both on by
+// default). Without the gyro (imu.gyro_prior false) both platforms lose those frames and end
+// tens of degrees off: the behaviour of before the gyro.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>

@@ -1257,8 +1257,8 @@ std::vector<OdometryResult> RunTurnWithGyro(const OdometryOptions& options, bool
 TEST(OdometryGyroTest, BlackFramesAreBridgedByTheGyrosRotation) {
   // Frames 7 and 8 cannot be matched (black). The turn stops after frame 7: the constant
   // velocity carries 7° a frame into frame 8, the gyro measures the stop.
-  OdometryOptions gyro;  // imu.gyro_prior is off by default (gyro_prior.h)
-  gyro.imu.gyro_prior = true;
+  OdometryOptions gyro;  // imu.gyro_prior is on by default (gyro_prior.h)
+  ASSERT_TRUE(gyro.imu.gyro_prior);
   const std::vector<OdometryResult> with = RunTurnWithGyro(gyro, true);
   const std::vector<OdometryResult> without = RunTurnWithGyro(gyro, false);
   for (int i : {7, 8}) {
