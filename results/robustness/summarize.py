@@ -58,7 +58,10 @@ def main(runs_dir, out_dir):
           "l_hallway (16 m, 485 frames), only `textures.seed` changed; frame strides 1, 2, 3, 5 "
           "(the in-place turn moves the image ~10 px per frame at stride 1, ~49 px at stride 5), "
           "plus a pitched and a 640x480 camera and the low-texture `plain_corridor` scene. "
-          "Made by `results/robustness/sweep.sh` (same frames as `suites/robustness.yaml`). "
+          "Made by `results/robustness/sweep.sh` (same frames as `suites/robustness.yaml`; "
+          "rendered in the KITTI layout, without an IMU, so every configuration here runs "
+          "without the gyro, as `suites/robustness.yaml` with `imu.gyro_prior: false`; the "
+          "default with the gyro: results/gyro_prior/vehicle_sweep.md). "
           "Cells: end-pose error in % of the path / frames without a measured motion.", ""]
     for c, title in CONFIGS:
         if not any(r["config"] == c for r in rows):

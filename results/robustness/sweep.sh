@@ -5,7 +5,9 @@
 # the low-texture plain_corridor scene at strides 1, 2, 3, 5.
 # Each hallway is rendered once (vobench render, KITTI layout) and every run reads the same
 # frames (vobench run --dataset --stride), which gives the same trajectories as simulating each
-# run anew (suites/robustness.yaml) at a tenth of the time.
+# run anew (suites/robustness.yaml) with imu.gyro_prior: false, at a tenth of the time: the
+# KITTI layout carries no IMU, so these are the VO without the gyro (on by default for a
+# sequence with one; the same 40 default runs with it: results/gyro_prior/vehicle_sweep.md).
 #   results/robustness/sweep.sh [WORK_DIR]      # default /tmp/vobench_robustness; ~40 min at -j2
 #   CONFIGS="default paper" results/robustness/sweep.sh   # a subset of the configurations
 #   BIN=/path/to/vobench JOBS=1 results/robustness/sweep.sh   # another build, one job
