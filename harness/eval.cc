@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "harness/dataset/kalibr.h"
 #include "harness/dataset/rig.h"
 #include "harness/trajectory_io.h"
 
@@ -120,6 +121,7 @@ bool OpenEuroc(const std::string& dir, const EvalOptions& options, StereoSequenc
     sequence->T_imu_cam0.linear() =
         reader->cam0().T_body_cam.linear() * rectification->R_cam0_rect0;
     sequence->imu_extrinsics_known = true;
+    info->imu_extrinsics_path = reader->cam0().path + " (T_BS: EuRoC's body is the IMU)";
   }
   sequence->expected_frames = static_cast<int>(reader->size());
   sequence->next = [reader, rectification, next = size_t{0}](DatasetFrame* frame,
@@ -176,6 +178,34 @@ bool OpenRosbag(const std::string& path, const EvalOptions& options, StereoSeque
   sequence->camera = info->camera;
   sequence->has_imu = reader->has_imu();
   sequence->imu = reader->imu();
+  // The IMU's mounting, which camera_info cannot hold: --imu-extrinsics, else Kalibr's
+  // camchain-imucam.yaml beside the bag (render writes it), else the --calib files' cam0 T_BS
+  // (EuRoC's body frame is its IMU's, as `--format euroc` takes it). Cam0's pose turned by the
+  // rectification's rotation: the VO's camera is the rectified left one.
+  const fs::path beside = fs::path(path).parent_path() / kKalibrCamchainFileName;
+  std::error_code ec;
+  Eigen::Isometry3d T_imu_cam0 = Eigen::Isometry3d::Identity();
+  if (!options.imu_extrinsics.empty()) {
+    if (!sequence->has_imu)
+      return Fail(error, "--imu-extrinsics " + options.imu_extrinsics + ": " + path +
+                             " has no IMU messages on " + options.rosbag_topics.imu +
+                             " (--imu names the topic)");
+    if (!ReadKalibrImuExtrinsics(options.imu_extrinsics, &T_imu_cam0, error)) return false;
+    info->imu_extrinsics_path = options.imu_extrinsics;
+  } else if (sequence->has_imu && fs::exists(beside, ec)) {
+    if (!ReadKalibrImuExtrinsics(beside.string(), &T_imu_cam0, error)) return false;
+    info->imu_extrinsics_path = beside.string();
+  } else if (sequence->has_imu && !options.calib_left.empty()) {
+    EurocCameraCalibration cam0;
+    if (!ReadEurocSensorYaml(options.calib_left, &cam0, error)) return false;
+    T_imu_cam0 = cam0.T_body_cam;
+    info->imu_extrinsics_path = options.calib_left + " (T_BS: EuRoC's body is the IMU)";
+  }
+  if (!info->imu_extrinsics_path.empty()) {
+    sequence->T_imu_cam0 = T_imu_cam0;
+    sequence->T_imu_cam0.linear() = T_imu_cam0.linear() * reader->rectification().R_cam0_rect0;
+    sequence->imu_extrinsics_known = true;
+  }
   sequence->expected_frames = static_cast<int>(reader->size());
   sequence->next = [reader, next = size_t{0}](DatasetFrame* frame, std::string* err) mutable {
     if (next >= reader->size()) return false;
@@ -190,6 +220,10 @@ bool EvalOptions::IsValid(std::string* error) const {
   if (format != DatasetFormat::kKitti && format != DatasetFormat::kEuroc &&
       format != DatasetFormat::kTum && format != DatasetFormat::kRosbag)
     return Fail(error, "format must be kitti, euroc, tum or rosbag");
+  if (!imu_extrinsics.empty() && format != DatasetFormat::kRosbag)
+    return Fail(error,
+                "--imu-extrinsics is read with --format rosbag only (a EuRoC folder's "
+                "cam0 sensor.yaml holds the camera's pose on the IMU)");
   if (!std::isfinite(max_difference_s) || max_difference_s < 0.0)
     return Fail(error, "max difference must be finite and >= 0 (0 = the format's default), got " +
                            FormatDouble(max_difference_s));

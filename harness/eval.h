@@ -43,6 +43,9 @@ struct EvalOptions {
   RectificationOptions rectification;   // EuRoC raw pairs (and raw bags)
   RosbagTopics rosbag_topics;           // rosbag: the topics read
   std::string calib_left, calib_right;  // rosbag: EuRoC sensor.yaml files instead of camera_info
+  std::string imu_extrinsics;  // rosbag: Kalibr camchain-imucam.yaml, cam0's pose on the IMU (for
+                               // the VO's gyro); "" = camchain-imucam.yaml beside the bag, else
+                               // the --calib files' T_BS, else unknown (the gyro is not used)
 
   bool IsValid(std::string* error) const;
 };
@@ -53,13 +56,14 @@ double DefaultMaxDifference(DatasetFormat format);
 
 // What the dataset held, for the report.
 struct EvalInfo {
-  size_t dataset_frames = 0;       // stereo frames in the dataset (before --max-frames)
-  size_t unpaired_frames = 0;      // images without a partner in the other camera (euroc, tum)
-  std::string ground_truth_path;   // "" when there is none
-  size_t ground_truth_frames = 0;  // dataset frames with an associated ground-truth pose
-  double max_difference_s = 0.0;   // the association tolerance used (seconds)
-  bool rectified = false;          // the raw pair was remapped (euroc with a real raw pair)
-  vo::StereoCamera camera;         // the camera the VO ran with (rectified for euroc)
+  size_t dataset_frames = 0;        // stereo frames in the dataset (before --max-frames)
+  size_t unpaired_frames = 0;       // images without a partner in the other camera (euroc, tum)
+  std::string ground_truth_path;    // "" when there is none
+  size_t ground_truth_frames = 0;   // dataset frames with an associated ground-truth pose
+  double max_difference_s = 0.0;    // the association tolerance used (seconds)
+  bool rectified = false;           // the raw pair was remapped (euroc with a real raw pair)
+  vo::StereoCamera camera;          // the camera the VO ran with (rectified for euroc)
+  std::string imu_extrinsics_path;  // where the IMU's mounting came from ("" = unknown or no IMU)
 };
 
 // Opens `dir` in `options.format`, runs the VO over its frames (run_options.max_frames caps

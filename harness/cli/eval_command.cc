@@ -21,6 +21,7 @@ struct EvalArgs {
   std::string out;                 // default out/eval/<dataset folder name>
   RosbagTopics topics;             // rosbag
   std::vector<std::string> calib;  // rosbag: cam0.yaml cam1.yaml
+  std::string imu_extrinsics;      // rosbag: Kalibr camchain-imucam.yaml
   int max_frames = 0;
   double max_difference_s = 0.0;
   bool no_plots = false;
@@ -50,6 +51,7 @@ int RunEval(const EvalArgs& a, bool max_difference_given, const std::string& ros
     options.calib_left = a.calib[0];
     options.calib_right = a.calib[1];
   }
+  options.imu_extrinsics = a.imu_extrinsics;
   options.gt_path = a.gt;
   if (max_difference_given && !(a.max_difference_s > 0.0)) {
     std::fprintf(stderr, "vobench eval: --max-difference: expected seconds > 0, got %g\n",
@@ -99,6 +101,18 @@ int RunEval(const EvalArgs& a, bool max_difference_given, const std::string& ros
   std::printf("camera          %dx%d, fx %.2f fy %.2f cx %.2f cy %.2f px, baseline %.4f m%s\n",
               cam.width, cam.height, cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px, cam.baseline_m,
               info.rectified ? " (rectified from the raw calibration)" : "");
+  if (sequence.has_imu) {
+    std::printf("imu             %g Hz; ", sequence.imu.rate_hz);
+    if (!sequence.imu_extrinsics_known)
+      std::printf(
+          "its mounting unknown: the gyro not used (--imu-extrinsics "
+          "camchain-imucam.yaml)\n");
+    else if (!vo_options.imu.gyro_prior)
+      std::printf("the gyro not used (imu.gyro_prior: false)\n");
+    else
+      std::printf("the VO uses its gyro (imu.gyro_prior), cam0 on the IMU from %s\n",
+                  info.imu_extrinsics_path.c_str());
+  }
   if (info.ground_truth_path.empty()) {
     std::printf("ground truth    none: trajectory and per-frame log only, no accuracy metrics\n");
   } else {
@@ -143,6 +157,11 @@ Command AddEvalCommand(CLI::App& app) {
                    "rosbag: two EuRoC sensor.yaml files (cam0 cam1) instead of the image "
                    "topics' camera_info (EuRoC's bags have none)")
       ->expected(2);
+  eval->add_option("--imu-extrinsics", a->imu_extrinsics,
+                   "rosbag: the cameras' poses on the IMU, a Kalibr camchain-imucam.yaml (cam0's "
+                   "T_cam_imu), so the VO can use the bag's gyro (imu.gyro_prior). Default: "
+                   "camchain-imucam.yaml beside the bag (render writes it), else the --calib "
+                   "files' T_BS (EuRoC: the body is the IMU); none: the gyro is not used");
   eval->add_option("--gt", a->gt,
                    "Ground truth, TUM format (t tx ty tz qx qy qz qw): the left camera for "
                    "kitti/tum, the body/IMU for euroc; for kitti also KITTI poses (12 numbers "
@@ -160,7 +179,8 @@ Command AddEvalCommand(CLI::App& app) {
   eval->add_flag("-q,--quiet", a->quiet, "No progress display");
   return {eval, [a, eval] {
             std::string rosbag_flag;
-            for (const char* flag : {"--left", "--right", "--imu", "--gt-topic", "--calib"})
+            for (const char* flag :
+                 {"--left", "--right", "--imu", "--gt-topic", "--calib", "--imu-extrinsics"})
               if (rosbag_flag.empty() && eval->count(flag) > 0) rosbag_flag = flag;
             return RunEval(*a, eval->count("--max-difference") > 0, rosbag_flag);
           }};

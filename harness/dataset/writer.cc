@@ -11,6 +11,7 @@
 
 #include "harness/dataset/euroc_imu.h"
 #include "harness/dataset/internal.h"
+#include "harness/dataset/kalibr.h"
 #include "harness/trajectory_io.h"
 
 namespace harness {
@@ -342,6 +343,7 @@ bool DatasetWriter::Add(const DatasetFrame& frame, std::string* error) {
   if (has_gt_) T_world_cam0_.push_back(frame.T_world_cam0);
   if (options_.format == DatasetFormat::kEuroc)
     imu_.insert(imu_.end(), frame.imu.begin(), frame.imu.end());
+  bag_has_imu_ = bag_has_imu_ || (bag_ && !frame.imu.empty());
   return true;
 }
 
@@ -493,6 +495,17 @@ bool DatasetWriter::Finish(std::string* error) {
   if (options_.format == DatasetFormat::kEuroc && !WriteEurocSensorFolders(error)) return false;
   if (options_.format == DatasetFormat::kTum && !WriteTumText(error)) return false;
   if (bag_ && !bag_->Close(error)) return false;
+  if (bag_has_imu_) {
+    // The bag's camera_info holds no mounting on the IMU: Kalibr's camchain-imucam.yaml beside
+    // it does (the rectified left camera's, whose images the bag holds).
+    Eigen::Isometry3d T_imu_left = CameraInImuFrame(options_.T_body_cam0, options_.T_body_imu);
+    if (rectify_) T_imu_left.linear() = T_imu_left.linear() * options_.rectification->R_cam0_rect0;
+    const RosbagTopics topics;
+    if (!WriteTextFile(Join(partial_dir_, kKalibrCamchainFileName),
+                       KalibrCamchainYaml(rectified_camera_, T_imu_left, topics.left, topics.right),
+                       error))
+      return false;
+  }
 
   // Publish: rename the partial folder to DIR (replacing an old vobench dataset when allowed).
   if (!folder_.Publish(error)) return false;

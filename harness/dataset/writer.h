@@ -7,7 +7,8 @@
 //   - calib.txt holds P0..P3 (P2 = P0, P3 = P1: the grey pair stands in for the colour pair) and
 //     an identity Tr, as pykitti and cv::datasets::SLAM_kitti expect of the odometry calib.txt;
 //   - kRosbag: one ROS bag DIR/<DIR's name>.bag in the layout of EuRoC's bags (rosbag.h), its
-//     stamps the EuRoC export's;
+//     stamps the EuRoC export's; with IMU samples also DIR/camchain-imucam.yaml (Kalibr's:
+//     the cameras' poses relative to the IMU, which camera_info cannot hold; kalibr.h);
 //   - the EuRoC, TUM and bag stamps are Options::stamp_offset_ns + the frame time in nanoseconds;
 //     all stamps of a sequence have the same number of digits, so the file names sort in time
 //     order (`vobench render` starts the simulator's clock at kSimulationEpochNs: 19 digits).
@@ -147,6 +148,8 @@ class DatasetWriter {
   std::vector<sim::ImuSample> imu_;              // the frames' IMU samples (kEuroc)
   std::vector<int> compression_params_;
   std::unique_ptr<RosbagWriter> bag_;  // kRosbag: the bag in the partial folder
+  bool bag_has_imu_ = false;           // kRosbag: a frame carried IMU samples (Finish writes
+                                       // camchain-imucam.yaml, kalibr.h)
 };
 
 }  // namespace harness

@@ -16,7 +16,10 @@
 #include <vector>
 
 #include "harness/dataset.h"
+#include "harness/dataset/euroc_imu.h"
+#include "harness/dataset/kalibr.h"
 #include "harness/trajectory_io.h"
+#include "sim/simulator.h"
 #include "tests/harness/cli_test_util.h"
 #include "tests/sim/sim_test_util.h"
 
@@ -198,8 +201,10 @@ TEST_F(RosbagTest, EvalGivesTheKittiEvalMetricsBitForBit) {
     ASSERT_EQ(i, times.size());
   }
   vobench_test::WriteText(Path("gt.txt"), tum);
+  // The KITTI layout has no IMU: the bag's run without its gyro (imu.gyro_prior: false).
+  vobench_test::WriteText(Path("no_gyro.yaml"), "imu:\n  gyro_prior: false\n");
   const auto bag = RunVobench("eval --format rosbag --dataset " + Bag() + " --out " + Path("bag") +
-                              " --no-plots -q");
+                              " --config " + Path("no_gyro.yaml") + " --no-plots -q");
   ASSERT_EQ(bag.exit_code, 0) << bag.output;
   EXPECT_THAT(bag.output, HasSubstr("19 of 19 frames associated"));
   const auto kitti = RunVobench("eval --format kitti --dataset " + Kitti() + " --gt " +
@@ -241,6 +246,113 @@ TEST_F(RosbagTest, CalibrationFromEurocSensorYamlFiles) {
   options.calib_right.clear();
   EXPECT_FALSE(bag.Open(Bag(), options, &error));
   EXPECT_THAT(error, HasSubstr("--calib needs two"));
+}
+
+// The bag's gyro (issue #35): render writes Kalibr's camchain-imucam.yaml beside the bag (the
+// IMU's mounting, which camera_info cannot hold); eval reads it there, or from --imu-extrinsics,
+// or takes the --calib files' T_BS, and the VO then runs as `vobench run` does on the scenario
+// with its gyro (to 1e-5: the bag's stamps are nanoseconds since the simulation's epoch, as
+// EuRoC's). Without a mounting the gyro is not used: the run is the one without the gyro, bit
+// for bit.
+TEST_F(RosbagTest, TheBagsGyroIsUsedWithTheImuMountingBesideTheBagOrGiven) {
+  const std::string scenario = (*root_ / "short.yaml").string();
+  const auto run = RunVobench("run " + scenario + " --out " + Path("run") + " --no-plots -q");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  vobench_test::WriteText(Path("no_gyro.yaml"), "imu:\n  gyro_prior: false\n");
+  const auto run_no_gyro = RunVobench("run " + scenario + " --config " + Path("no_gyro.yaml") +
+                                      " --out " + Path("run_no_gyro") + " --no-plots -q");
+  ASSERT_EQ(run_no_gyro.exit_code, 0) << run_no_gyro.output;
+  const std::string with_gyro = vobench_test::ReadAll(Path("run") + "/trajectory_kitti.txt");
+  const std::string without_gyro =
+      vobench_test::ReadAll(Path("run_no_gyro") + "/trajectory_kitti.txt");
+  ASSERT_NE(with_gyro, without_gyro);
+
+  // The mounting render wrote is the simulated rig's (the IMU on the chassis, cam0 on the body).
+  ASSERT_TRUE(fs::exists(Kitti() + "/camchain-imucam.yaml"));
+  Eigen::Isometry3d T_imu_cam0;
+  std::string error;
+  ASSERT_TRUE(ReadKalibrImuExtrinsics(Kitti() + "/camchain-imucam.yaml", &T_imu_cam0, &error))
+      << error;
+  sim::Scenario s;
+  ASSERT_TRUE(sim::LoadScenario(scenario, &s, &error)) << error;
+  auto simulator = sim::Simulator::Create(s, &error);
+  ASSERT_TRUE(simulator) << error;
+  const Eigen::Isometry3d expected =
+      CameraInImuFrame(simulator->calibration().T_body_cam0, simulator->calibration().T_body_imu);
+  EXPECT_LT((T_imu_cam0.matrix() - expected.matrix()).cwiseAbs().maxCoeff(), 1e-12);
+
+  // Beside the bag: read by itself.
+  const auto beside = RunVobench("eval --format rosbag --dataset " + Bag() + " --out " +
+                                 Path("beside") + " -q --no-plots");
+  ASSERT_EQ(beside.exit_code, 0) << beside.output;
+  EXPECT_THAT(beside.output,
+              HasSubstr("the VO uses its gyro (imu.gyro_prior), cam0 on the IMU from " + Kitti() +
+                        "/camchain-imucam.yaml"));
+  const int frames = 19;
+  vobench_test::ExpectTrajectoriesNear(
+      vobench_test::ReadAll(Path("beside") + "/trajectory_kitti.txt"), with_gyro, frames, 1e-5,
+      "beside");
+
+  // A copy of the bag alone (with its rig.yaml): the mounting unknown, the gyro not used.
+  fs::create_directories(Path("alone"));
+  fs::copy_file(Bag(), Path("alone/short.bag"));
+  fs::copy_file(Kitti() + "/rig.yaml", Path("alone/rig.yaml"));
+  const auto alone = RunVobench("eval --format rosbag --dataset " + Path("alone/short.bag") +
+                                " --out " + Path("alone_out") + " -q --no-plots");
+  ASSERT_EQ(alone.exit_code, 0) << alone.output;
+  EXPECT_THAT(alone.output, HasSubstr("its mounting unknown: the gyro not used"));
+  EXPECT_EQ(vobench_test::ReadAll(Path("alone_out") + "/trajectory_kitti.txt"), without_gyro);
+
+  // --imu-extrinsics names the file.
+  const auto given = RunVobench("eval --format rosbag --dataset " + Path("alone/short.bag") +
+                                " --imu-extrinsics " + Kitti() + "/camchain-imucam.yaml --out " +
+                                Path("given") + " -q --no-plots");
+  ASSERT_EQ(given.exit_code, 0) << given.output;
+  EXPECT_EQ(vobench_test::ReadAll(Path("given") + "/trajectory_kitti.txt"),
+            vobench_test::ReadAll(Path("beside") + "/trajectory_kitti.txt"));
+
+  // --calib: the EuRoC files' cam0 T_BS (EuRoC's body frame is its IMU's).
+  const auto calib = RunVobench("eval --format rosbag --dataset " + Path("alone/short.bag") +
+                                " --calib " + Euroc() + "/mav0/cam0/sensor.yaml " + Euroc() +
+                                "/mav0/cam1/sensor.yaml --out " + Path("calib") + " -q --no-plots");
+  ASSERT_EQ(calib.exit_code, 0) << calib.output;
+  EXPECT_THAT(calib.output,
+              HasSubstr("cam0 on the IMU from " + Euroc() + "/mav0/cam0/sensor.yaml"));
+  vobench_test::ExpectTrajectoriesNear(
+      vobench_test::ReadAll(Path("calib") + "/trajectory_kitti.txt"), with_gyro, frames, 1e-5,
+      "calib");
+}
+
+TEST_F(RosbagTest, BadImuExtrinsicsAreRefused) {
+  // Not a rigid transform: exit 2, the file and key named, nothing written.
+  vobench_test::WriteText(Path("bad.yaml"),
+                          "cam0:\n  T_cam_imu:\n  - [2, 0, 0, 0]\n  - [0, 1, 0, 0]\n"
+                          "  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\n");
+  const auto bad = RunVobench("eval --format rosbag --dataset " + Bag() + " --imu-extrinsics " +
+                              Path("bad.yaml") + " --out " + Path("out") + " -q --no-plots");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_THAT(bad.output, HasSubstr(Path("bad.yaml")));
+  EXPECT_THAT(bad.output, HasSubstr("T_cam_imu"));
+  EXPECT_FALSE(fs::exists(Path("out")));
+  // A file that is not there.
+  const auto missing = RunVobench("eval --format rosbag --dataset " + Bag() + " --imu-extrinsics " +
+                                  Path("none.yaml") + " --out " + Path("out") + " -q --no-plots");
+  EXPECT_EQ(missing.exit_code, 2) << missing.output;
+  EXPECT_THAT(missing.output, HasSubstr(Path("none.yaml")));
+  EXPECT_FALSE(fs::exists(Path("out")));
+  // A bag without IMU messages on the topic: the mounting of nothing.
+  const auto no_imu =
+      RunVobench("eval --format rosbag --dataset " + Bag() + " --imu /none" + " --imu-extrinsics " +
+                 Kitti() + "/camchain-imucam.yaml --out " + Path("out") + " -q --no-plots");
+  EXPECT_EQ(no_imu.exit_code, 2) << no_imu.output;
+  EXPECT_THAT(no_imu.output, HasSubstr("no IMU messages on /none"));
+  EXPECT_FALSE(fs::exists(Path("out")));
+  // Not a bag: the flag is the bag's.
+  const auto kitti = RunVobench("eval --format kitti --dataset " + Kitti() + " --imu-extrinsics " +
+                                Kitti() + "/camchain-imucam.yaml --out " + Path("out") + " -q");
+  EXPECT_EQ(kitti.exit_code, 2) << kitti.output;
+  EXPECT_THAT(kitti.output, HasSubstr("--imu-extrinsics: only with --format rosbag"));
+  EXPECT_FALSE(fs::exists(Path("out")));
 }
 
 TEST_F(RosbagTest, SwappedImageTopicsAreRefused) {
