@@ -11,7 +11,13 @@ uint64_t ImuNoiseSeed(uint64_t scenario_seed) {
 }
 
 ImuNoiseModel::ImuNoiseModel(const ImuOptions& options, uint64_t seed)
-    : options_(options), rng_(seed), dt_s_(1.0 / options.rate_hz) {}
+    : options_(options), rng_(seed), dt_s_(1.0 / options.rate_hz) {
+  // The turn-on bias: three draws first, only when asked for (otherwise the stream is the one
+  // of a scenario without the key).
+  if (options.gyro_turn_on_bias_sigma_radps > 0.0)
+    for (int i = 0; i < 3; ++i)
+      gyro_bias_[i] = options.gyro_turn_on_bias_sigma_radps * rng_.Normal();
+}
 
 void ImuNoiseModel::Apply(ImuSample* s) {
   const double white_g = options_.gyro_noise_density / std::sqrt(dt_s_);

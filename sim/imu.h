@@ -7,8 +7,10 @@
 //   bias_{k+1} = bias_k + sigma_bc * sqrt(dt) * N(0, 1)                  (random walk sigma_bc)
 //
 // per axis, for the gyro (rad/s) and the accelerometer (specific force, m/s^2: gravity
-// included, +9.81 m/s^2 up at rest), with dt = 1 / rate_hz. The biases start at 0 (no turn-on
-// bias). The noise has its own random stream derived from the scenario seed (ImuNoiseSeed), so
+// included, +9.81 m/s^2 up at rest), with dt = 1 / rate_hz. The gyro's bias starts at a turn-on
+// bias of σ imu.gyro_turn_on_bias_sigma_radps per axis (default 0), the accelerometer's at 0.
+// With imu.pre_roll_s the samples start that long before frame 0 (the robot standing while it
+// settles). The noise has its own random stream derived from the scenario seed (ImuNoiseSeed), so
 // the camera images do not depend on it.
 #pragma once
 

@@ -131,6 +131,18 @@ std::string ImuProblem(const Scenario& s, std::string* key) {
       *key = std::string("imu.") + name;
       return "expected a finite number, got " + Num(v);
     }
+  if (!(o.gyro_turn_on_bias_sigma_radps >= 0 && o.gyro_turn_on_bias_sigma_radps <= 1.0)) {
+    *key = "imu.gyro_turn_on_bias_sigma_radps";
+    return "expected a number in [0, 1] rad/s, got " + Num(o.gyro_turn_on_bias_sigma_radps);
+  }
+  // (A bad settle_s is settle_s's own error, told at its line.)
+  if (!(o.pre_roll_s >= 0 && std::isfinite(o.pre_roll_s) &&
+        (!(s.settle_s >= 0) || o.pre_roll_s <= s.settle_s))) {
+    *key = "imu.pre_roll_s";
+    return "expected seconds in [0, settle_s = " + Num(s.settle_s) +
+           "] (the samples are taken while the robot stands before frame 0), got " +
+           Num(o.pre_roll_s);
+  }
   *key = "imu.rate_hz";
   if (!(o.rate_hz > 0) || !(s.physics_dt_s > 0)) return "expected > 0 Hz, got " + Num(o.rate_hz);
   const double steps = 1.0 / (o.rate_hz * s.physics_dt_s);
@@ -798,7 +810,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
                           "z_m",
                           "roll_deg",
                           "pitch_deg",
-                          "yaw_deg"};
+                          "yaw_deg",
+                          "gyro_turn_on_bias_sigma_radps",
+                          "pre_roll_s"};
     ImuOptions& o = s.imu;
     double* values[] = {&o.rate_hz,
                         &o.gyro_noise_density,
@@ -810,7 +824,9 @@ bool ParseScenario(const std::string& yaml_text, const std::string& source_name,
                         &o.z_m,
                         &o.roll_deg,
                         &o.pitch_deg,
-                        &o.yaw_deg};
+                        &o.yaw_deg,
+                        &o.gyro_turn_on_bias_sigma_radps,
+                        &o.pre_roll_s};
     r.CheckKeys(n, "imu", std::vector<std::string>(std::begin(keys), std::end(keys)));
     for (size_t i = 0; i < std::size(keys) && r.ok(); ++i) r.Double(n, "imu", keys[i], values[i]);
   }
@@ -994,6 +1010,11 @@ std::string ScenarioToYaml(const Scenario& s) {
            {"pitch_deg", imu.pitch_deg},
            {"yaw_deg", imu.yaw_deg}})
     out << YAML::Key << k << YAML::Value << v;
+  // Written only when set: a scenario without them emits the bytes it did before they existed.
+  if (imu.gyro_turn_on_bias_sigma_radps != 0.0)
+    out << YAML::Key << "gyro_turn_on_bias_sigma_radps" << YAML::Value
+        << imu.gyro_turn_on_bias_sigma_radps;
+  if (imu.pre_roll_s != 0.0) out << YAML::Key << "pre_roll_s" << YAML::Value << imu.pre_roll_s;
   out << YAML::EndMap;
   EmitCalibrationAndFrames(s, &out);
   EmitPeopleAndLights(s, &out);

@@ -122,6 +122,15 @@ struct ImuOptions {
   // top of the chassis above the axle, axes of the body.
   double x_m = 0.0, y_m = 0.0, z_m = 0.19;                // position (m)
   double roll_deg = 0.0, pitch_deg = 0.0, yaw_deg = 0.0;  // R = Rz(yaw) Ry(pitch) Rx(roll)
+  // A real gyro's turn-on bias (a MEMS gyro's is 0.1-5 deg/s; EuRoC's ADIS16448 read 0.078
+  // rad/s about z standing): σ per axis of the gyro's bias at the first sample (rad/s, >= 0),
+  // drawn from the IMU's noise stream; 0 = the bias starts at 0 (and the stream is as before).
+  double gyro_turn_on_bias_sigma_radps = 0.0;
+  // IMU samples this long before frame 0 (s, 0 .. settle_s), taken while the robot stands
+  // (settling): frame 0 carries them, at negative times, as a recording started before the
+  // robot moved does (the VO's standing start learns the gyro's bias from them,
+  // vo/gyro_prior.h). 0 = samples from frame 0 on.
+  double pre_roll_s = 0.0;
 };
 
 // Calibration error (issue #34): the calibration vobench EXPORTS (render's calib.txt and EuRoC

@@ -146,6 +146,7 @@ struct Simulator::Impl {
   // IMU: site, sensordata addresses, physics steps per sample, noise, samples not yet handed out.
   int imu_site = -1, gyro_adr = -1, accel_adr = -1;
   long imu_every = 1;
+  long imu_pre_roll_steps = 0;  // IMU samples start this many steps before start_step
   std::unique_ptr<ImuNoiseModel> imu_noise;
   std::vector<ImuSample> imu_pending;
   // Navigation (sim/navigation.h): the belief the follower steers on in the closed loop, the
@@ -367,6 +368,9 @@ std::unique_ptr<Simulator> Simulator::Create(const Scenario& scenario, std::stri
     if (im.building_geom[g]) im.nav.wall_contacts = 0;
   }
   im.start_step = std::lround(scenario.settle_s / scenario.physics_dt_s);
+  // The IMU's pre-roll: samples on the last settling steps, a whole number of sample periods.
+  im.imu_pre_roll_steps = std::min(
+      im.start_step, std::lround(scenario.imu.pre_roll_s * scenario.imu.rate_hz) * im.imu_every);
   im.warnings_at_start = g_warning_count;
   return sim;
 }
@@ -560,7 +564,8 @@ bool Simulator::Capture(StereoFrame* frame, std::string* error) {
     mj_step2(m, d);
     // The IMU on its steps: kinematics and gyro of mj_step1, accelerometer of mj_step2, all of
     // the state at `step` (mj_step2 integrates qpos/qvel only).
-    if (step >= im.start_step && (step - im.start_step) % im.imu_every == 0) {
+    if (step >= im.start_step - im.imu_pre_roll_steps &&
+        (step - im.start_step) % im.imu_every == 0) {
       ImuSample s;
       s.time_s = (step - im.start_step) * dt;
       s.has_gt = true;
