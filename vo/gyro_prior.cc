@@ -3,6 +3,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "vo/options_check.h"
@@ -127,6 +129,9 @@ void GyroPrior::Reset() {
   standing_start_ = false;
   bias_variance_ = options_.initial_bias_sigma_radps * options_.initial_bias_sigma_radps;
   bias_updates_ = 0;
+  moving_start_ = false;
+  have_large_ = false;
+  large_.setZero();
   last_ = GyroRotation();
   stretch_s_ = 0.0;
   stretch_gyro_.setIdentity();
@@ -211,7 +216,24 @@ void GyroPrior::Observe(bool measured, const Eigen::Matrix3d& R_prev_curr_vo) {
   if (stretch_s_ < options_.bias_window_s) return;
   // gyro ≈ vo · Exp((b − b_est) T): the estimate's error is −Log(gyro⁻¹ vo) / T.
   const Eigen::Vector3d error = -LogSO3(stretch_gyro_.transpose() * stretch_vo_) / stretch_s_;
-  if (error.allFinite() && error.norm() <= options_.max_bias_radps) {
+  if (error.allFinite() && error.norm() > options_.max_bias_radps && !standing_start_ &&
+      !moving_start_ && bias_updates_ == 0 && error.norm() <= options_.max_standing_bias_radps) {
+    // The moving start: a turn-on bias beyond max_bias_radps without a standing start shows as
+    // the same large observation stretch after stretch; two in a row that agree within
+    // max_bias_radps give the bias their mean, as a standing start would (a VO's bad stretch
+    // does not repeat itself so).
+    if (have_large_ && (error - large_).norm() <= options_.max_bias_radps) {
+      const Eigen::Vector3d mean = 0.5 * (error + large_);
+      bias_ += mean;
+      bias_origin_ = bias_;
+      bias_variance_ = std::max(bias_variance_, (0.5 * (error - large_)).squaredNorm());
+      moving_start_ = true;
+    } else {
+      large_ = error;
+      have_large_ = true;
+    }
+  } else if (error.allFinite() && error.norm() <= options_.max_bias_radps) {
+    have_large_ = false;
     const double k = options_.bias_gain;
     bias_ += k * error;
     const Eigen::Vector3d online = bias_ - bias_origin_;

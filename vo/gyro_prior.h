@@ -33,7 +33,13 @@
 // and is dropped. Before that, the standing start (ImuOptions::standing_start_s): the samples
 // of the last second before the first frame, when they look still, give the bias as their
 // mean (a real gyro's turn-on bias, too large for the online filter's bound, which then holds
-// its corrections within max_bias_radps of that estimate).
+// its corrections within max_bias_radps of that estimate). Without a standing start, the moving
+// start: before any observation has been taken in, two stretches in a row whose observations
+// are both beyond max_bias_radps (and at most max_standing_bias_radps) and agree within
+// max_bias_radps give the bias their mean, as a standing start would (a turn-on bias repeats
+// itself stretch after stretch; a VO's bad stretch does not). Until then the prior uses a bias
+// of 0: a sequence that starts moving with a large turn-on bias is off by it for the first two
+// stretches (results/gyro_prior/default_on.md).
 #pragma once
 
 #include <Eigen/Core>
@@ -165,6 +171,7 @@ class GyroPrior {
 
   const Eigen::Vector3d& bias_radps() const { return bias_; }
   bool standing_start() const { return standing_start_; }  // the bias came from a standing start
+  bool moving_start() const { return moving_start_; }      // ... from the moving start (Observe)
   double bias_variance() const { return bias_variance_; }
   int bias_updates() const { return bias_updates_; }
   void Reset();
@@ -181,6 +188,9 @@ class GyroPrior {
   Eigen::Vector3d bias_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d bias_origin_ = Eigen::Vector3d::Zero();  // the standing start's (or 0)
   bool standing_start_ = false;
+  bool moving_start_ = false;  // the bias came from two large observations in a row (Observe)
+  bool have_large_ = false;    // large_ holds the last large observation (none accepted yet)
+  Eigen::Vector3d large_ = Eigen::Vector3d::Zero();
   double bias_variance_ = 0.0;
   int bias_updates_ = 0;
   // The last Next's result (the interval Observe speaks of).
