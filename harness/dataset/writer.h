@@ -3,7 +3,9 @@
 // simulated sequences (`vobench render`) run through the same readers as real ones, and other
 // systems' readers take them as they are:
 //   - every YAML file starts with OpenCV's "%YAML:1.0" line (cv::FileStorage needs it; EuRoC's
-//     own files have it; vobench's yaml-cpp readers skip it);
+//     own files have it; vobench's yaml-cpp readers skip it), but the bag's
+//     camchain-imucam.yaml: Kalibr's files are plain YAML, read by PyYAML, which refuses
+//     OpenCV's directive;
 //   - calib.txt holds P0..P3 (P2 = P0, P3 = P1: the grey pair stands in for the colour pair) and
 //     an identity Tr, as pykitti and cv::datasets::SLAM_kitti expect of the odometry calib.txt;
 //   - kRosbag: one ROS bag DIR/<DIR's name>.bag in the layout of EuRoC's bags (rosbag.h), its
