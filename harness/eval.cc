@@ -117,9 +117,7 @@ bool OpenEuroc(const std::string& dir, const EvalOptions& options, StereoSequenc
     // EuRoC's body frame is its IMU's (imu0's T_BS is the identity, in the real datasets and in
     // vobench's exports): the rectified left camera in the IMU frame is cam0's T_BS turned by
     // the rectification's rotation (a rotation about cam0's centre).
-    sequence->T_imu_cam0 = reader->cam0().T_body_cam;
-    sequence->T_imu_cam0.linear() =
-        reader->cam0().T_body_cam.linear() * rectification->R_cam0_rect0;
+    sequence->T_imu_cam0 = RectifiedLeftIn(rectification->T_body_cam0, rectification->R_cam0_rect0);
     sequence->imu_extrinsics_known = true;
     info->imu_extrinsics_path = reader->cam0().path + " (T_BS: EuRoC's body is the IMU)";
   }
@@ -196,14 +194,11 @@ bool OpenRosbag(const std::string& path, const EvalOptions& options, StereoSeque
     if (!ReadKalibrImuExtrinsics(beside.string(), &T_imu_cam0, error)) return false;
     info->imu_extrinsics_path = beside.string();
   } else if (sequence->has_imu && !options.calib_left.empty()) {
-    EurocCameraCalibration cam0;
-    if (!ReadEurocSensorYaml(options.calib_left, &cam0, error)) return false;
-    T_imu_cam0 = cam0.T_body_cam;
+    T_imu_cam0 = reader->rectification().T_body_cam0;  // the --calib file's, as the reader read it
     info->imu_extrinsics_path = options.calib_left + " (T_BS: EuRoC's body is the IMU)";
   }
   if (!info->imu_extrinsics_path.empty()) {
-    sequence->T_imu_cam0 = T_imu_cam0;
-    sequence->T_imu_cam0.linear() = T_imu_cam0.linear() * reader->rectification().R_cam0_rect0;
+    sequence->T_imu_cam0 = RectifiedLeftIn(T_imu_cam0, reader->rectification().R_cam0_rect0);
     sequence->imu_extrinsics_known = true;
   }
   sequence->expected_frames = static_cast<int>(reader->size());

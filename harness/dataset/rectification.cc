@@ -72,6 +72,13 @@ bool RectificationOptions::IsValid(std::string* error) const {
   return true;
 }
 
+Eigen::Isometry3d RectifiedLeftIn(const Eigen::Isometry3d& T_frame_cam0,
+                                  const Eigen::Matrix3d& R_cam0_rect0) {
+  Eigen::Isometry3d T = T_frame_cam0;
+  T.linear() = T_frame_cam0.linear() * R_cam0_rect0;
+  return T;
+}
+
 bool ComputeStereoRectification(const EurocCameraCalibration& cam0,
                                 const EurocCameraCalibration& cam1,
                                 const RectificationOptions& options,
@@ -132,6 +139,7 @@ bool ComputeStereoRectification(const EurocCameraCalibration& cam0,
     r.camera.cx_px = cam0.cu_px;
     r.camera.cy_px = cam0.cv_px;
     r.camera.baseline_m = t.x();
+    r.T_body_cam0 = cam0.T_body_cam;
     if (!r.camera.IsValid(&why)) return Fail(error, where + why);
     *rectification = r;
     return true;
@@ -199,6 +207,7 @@ bool ComputeStereoRectification(const EurocCameraCalibration& cam0,
   r.camera.baseline_m = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
   r.R_cam0_rect0 = ToEigen3(R1).transpose();
   r.R_cam1_rect1 = ToEigen3(R2).transpose();
+  r.T_body_cam0 = cam0.T_body_cam;
   // The result must be the ideal pair the VO assumes: rect1 at +baseline along rect0's x.
   const Eigen::Vector3d t_rect0_rect1 = r.R_cam0_rect0.transpose() * t;
   const double off_axis = std::max(std::abs(t_rect0_rect1.y()), std::abs(t_rect0_rect1.z()));

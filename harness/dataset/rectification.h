@@ -44,11 +44,19 @@ struct StereoRectification {
   vo::StereoCamera camera;  // the rectified camera (output image size and intrinsics)
   Eigen::Matrix3d R_cam0_rect0 = Eigen::Matrix3d::Identity();  // rectified left frame in raw cam0
   Eigen::Matrix3d R_cam1_rect1 = Eigen::Matrix3d::Identity();  // rectified right frame in raw cam1
+  // Raw cam0 in the calibration's body frame (cam0's T_BS; EuRoC's body is its IMU), identity
+  // when the rectification was not computed from sensor.yaml files.
+  Eigen::Isometry3d T_body_cam0 = Eigen::Isometry3d::Identity();
   cv::Mat map0_x, map0_y;  // CV_32FC1 (height x width): raw cam0 pixel of each rectified pixel;
                            // empty = identity (no remap needed)
   cv::Mat map1_x, map1_y;  // the same for cam1
   bool IsIdentity() const { return map0_x.empty() && map1_x.empty(); }
 };
+
+// The rectified left camera in a frame where raw cam0 is at T_frame_cam0: the same centre,
+// turned by R_cam0_rect0 (a rotation about cam0's centre).
+Eigen::Isometry3d RectifiedLeftIn(const Eigen::Isometry3d& T_frame_cam0,
+                                  const Eigen::Matrix3d& R_cam0_rect0);
 
 struct RectificationOptions {
   // Free scaling of the rectified view, in [0, 1] (cv::stereoRectify's alpha; the balance of

@@ -418,9 +418,7 @@ bool DatasetWriter::WriteEurocGroundTruth(std::string* error) const {
 
 Eigen::Isometry3d DatasetWriter::LeftCameraPose(size_t i) const {
   if (!rectify_) return T_world_cam0_[i];
-  Eigen::Isometry3d T_cam0_rect0 = Eigen::Isometry3d::Identity();
-  T_cam0_rect0.linear() = options_.rectification->R_cam0_rect0;
-  return T_world_cam0_[i] * T_cam0_rect0;
+  return RectifiedLeftIn(T_world_cam0_[i], options_.rectification->R_cam0_rect0);
 }
 
 bool DatasetWriter::WriteTumText(std::string* error) const {
@@ -499,7 +497,7 @@ bool DatasetWriter::Finish(std::string* error) {
     // The bag's camera_info holds no mounting on the IMU: Kalibr's camchain-imucam.yaml beside
     // it does (the rectified left camera's, whose images the bag holds).
     Eigen::Isometry3d T_imu_left = CameraInImuFrame(options_.T_body_cam0, options_.T_body_imu);
-    if (rectify_) T_imu_left.linear() = T_imu_left.linear() * options_.rectification->R_cam0_rect0;
+    if (rectify_) T_imu_left = RectifiedLeftIn(T_imu_left, options_.rectification->R_cam0_rect0);
     const RosbagTopics topics;
     if (!WriteTextFile(Join(partial_dir_, kKalibrCamchainFileName),
                        KalibrCamchainYaml(rectified_camera_, T_imu_left, topics.left, topics.right),
