@@ -24,21 +24,6 @@ bool StereoCamera::IsValid(std::string* error) const {
   return false;
 }
 
-bool StereoCamera::ProjectLeft(const Eigen::Vector3d& p_cam0, Eigen::Vector2d* uv_px,
-                               double min_depth_m) const {
-  if (!(p_cam0.z() > min_depth_m)) return false;
-  *uv_px << fx_px * p_cam0.x() / p_cam0.z() + cx_px, fy_px * p_cam0.y() / p_cam0.z() + cy_px;
-  return true;
-}
-
-bool StereoCamera::ProjectRight(const Eigen::Vector3d& p_cam0, Eigen::Vector2d* uv_px,
-                                double min_depth_m) const {
-  if (!(p_cam0.z() > min_depth_m)) return false;
-  *uv_px << fx_px * (p_cam0.x() - baseline_m) / p_cam0.z() + cx_px,
-      fy_px * p_cam0.y() / p_cam0.z() + cy_px;
-  return true;
-}
-
 Eigen::Vector3d StereoCamera::Backproject(double u_px, double v_px, double disparity_px) const {
   return BackprojectDepth(u_px, v_px, DepthFromDisparity(disparity_px));
 }

@@ -7,6 +7,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "vo/sad_block_matcher.h"
 
@@ -214,6 +216,9 @@ struct DisparityEstimator::Impl {
   // (post-filtered) and right views in 1/16 px (kUnevaluated until computed), counts.
   bool prepared = false;
   cv::Mat sparse_image, sparse_left, sparse_right;
+  // The pixels of sparse_left / sparse_right evaluated since Prepare (offsets): the next Prepare
+  // resets those rather than the whole maps.
+  std::vector<int> touched_left, touched_right;
   PixelCounts counts;
 };
 
@@ -451,10 +456,17 @@ DisparityResult DisparityEstimator::PrepareAtPixels(const cv::Mat& left, const c
   }
   s.sad->Prepare(left, right, num_disparities);
   left.copyTo(s.sparse_image);
-  s.sparse_left.create(left.size(), CV_16S);
-  s.sparse_left.setTo(kUnevaluated);
-  s.sparse_right.create(left.size(), CV_16S);
-  s.sparse_right.setTo(kUnevaluated);
+  for (auto [map, touched] : {std::make_pair(&s.sparse_left, &s.touched_left),
+                              std::make_pair(&s.sparse_right, &s.touched_right)}) {
+    if (map->size() == left.size() && map->type() == CV_16S && map->isContinuous()) {
+      int16_t* cache = map->ptr<int16_t>();
+      for (int i : *touched) cache[i] = kUnevaluated;
+    } else {
+      map->create(left.size(), CV_16S);
+      map->setTo(kUnevaluated);
+    }
+    touched->clear();
+  }
   s.prepared = true;
   result.ok = true;
   return result;
@@ -467,6 +479,7 @@ float DisparityEstimator::DisparityAt(int x, int y) {
   }
   int16_t& cached = s.sparse_left.at<int16_t>(y, x);
   if (cached != kUnevaluated) return cached < 0 ? kInvalidDisparity : cached / 16.0f;
+  s.touched_left.push_back(y * s.sparse_left.cols + x);
   const DisparityOptions& o = options_;
   ++s.counts.left;
   // The post-filters of Compute, in its order of effect (texture first: it needs no costs).
@@ -485,6 +498,7 @@ float DisparityEstimator::DisparityAt(int x, int y) {
     const int x_r = x_r_fixed / kDisparityScale;
     int16_t& d_r = s.sparse_right.at<int16_t>(y, x_r);
     if (d_r == kUnevaluated) {
+      s.touched_right.push_back(y * s.sparse_right.cols + x_r);
       d_r = s.sad->RightAt(x_r, y);
       ++s.counts.right;
     }

@@ -83,8 +83,10 @@ void FastHarris(const cv::Mat& image, int block, double k, cv::Mat* dx, cv::Mat*
   cv::Sobel(image, *dy, CV_16S, 0, 1, 3, 1.0, 0.0, cv::BORDER_REFLECT_101);
   const int width = image.cols, height = image.rows, half = block / 2;
   response->create(height, width, CV_32F);
-  response->setTo(0.0f);
-  if (width < block || height < block) return;
+  if (width < block || height < block) {
+    response->setTo(0.0f);
+    return;
+  }
   // Column sums over the current window rows of gx^2, gy^2, gx*gy, then their block sums.
   sums->assign(6 * static_cast<size_t>(width), 0);
   int* sxx = sums->data();
@@ -94,6 +96,15 @@ void FastHarris(const cv::Mat& image, int block, double k, cv::Mat* dx, cv::Mat*
   int* myy = mxx + width;
   int* mxy = myy + width;
   const int n = width - block + 1;
+  // The rows below write rows [half, last_row], columns [half, half + n): zero the rest.
+  const int last_row = height - block + half;
+  response->rowRange(0, half).setTo(0.0f);
+  response->rowRange(last_row + 1, height).setTo(0.0f);
+  for (int y = half; y <= last_row; ++y) {
+    float* row = response->ptr<float>(y);
+    std::fill(row, row + half, 0.0f);
+    std::fill(row + half + n, row + width, 0.0f);
+  }
   const double scale = 1.0 / (4.0 * block * 255.0);
   const float scale2 = static_cast<float>(scale * scale);
   for (int row = 0; row < block; ++row) {

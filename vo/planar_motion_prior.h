@@ -139,7 +139,65 @@ class PlanarMotionResidual {
     return true;
   }
 
+  // operator() for ceres::Jet, with the constant vectors and weights entering as doubles
+  // rather than as Jets with a zero derivative: the same operations on the values in the same
+  // order (Eigen's for a cross product, a quaternion rotating a vector and a 3-vector dot
+  // product), so the same residuals and derivatives (up to the sign of a zero), with about
+  // half the operations on derivatives. The Schur bundle adjustment's linearisation
+  // (schur_lm.cc); PlanarMotionPriorTest compares the two.
+  template <typename J>
+  bool EvaluateJets(const J* pose_a, const J* pose_b, J* r) const {
+    using Vec3 = Eigen::Matrix<J, 3, 1>;
+    const Eigen::Quaternion<J> qa(pose_a[3], pose_a[0], pose_a[1], pose_a[2]);
+    const Eigen::Quaternion<J> qb(pose_b[3], pose_b[0], pose_b[1], pose_b[2]);
+    const Vec3 ta(pose_a[4], pose_a[5], pose_a[6]);
+    const Vec3 tb(pose_b[4], pose_b[5], pose_b[6]);
+    Eigen::Quaternion<J> q = qa.conjugate() * qb;
+    if (q.w() < J(0)) q.coeffs() = -q.coeffs();
+    const Vec3 t = qa.conjugate() * (tb - ta);
+    const Vec3 Ru = Rotate(q, u_);
+    r[0] = Dot(e1_, Ru) * w_tilt_;
+    r[1] = Dot(e2_, Ru) * w_tilt_;
+    r[2] = Dot(u_, t) * w_lift_;
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    const J half_yaw = atan2(Dot(u_, q.vec()), q.w());
+    const J c = cos(half_yaw), s = sin(half_yaw);
+    const Vec3 lateral(c * e2_[0] - s * e1_[0], c * e2_[1] - s * e1_[1], c * e2_[2] - s * e1_[2]);
+    const Vec3 Re1 = Rotate(q, e1_);
+    const Vec3 axle_step(t[0] - axle_ * (Re1[0] - e1_[0]), t[1] - axle_ * (Re1[1] - e1_[1]),
+                         t[2] - axle_ * (Re1[2] - e1_[2]));
+    r[3] = lateral.dot(axle_step) * w_slip_;
+    if (!floor_) {
+      r[4] = r[5] = r[6] = J(0);
+      return true;
+    }
+    const Vec3 up_world = Rotate(qb, u_);
+    r[4] = Dot(f1_, up_world) * w_floor_tilt_;
+    r[5] = Dot(f2_, up_world) * w_floor_tilt_;
+    r[6] = (Dot(w_, tb) - floor_height_) * w_floor_height_;
+    return true;
+  }
+
  private:
+  // c · v in Eigen's order for a 3-vector of Jets (c₀v₀ + (c₁v₁ + c₂v₂)).
+  template <typename V>
+  static typename V::Scalar Dot(const Eigen::Vector3d& c, const V& v) {
+    return c[0] * v[0] + (c[1] * v[1] + c[2] * v[2]);
+  }
+  // q v for a constant v, as Eigen's QuaternionBase::_transformVector: uv = 2 q_v × v,
+  // v + w uv + q_v × uv.
+  template <typename J>
+  static Eigen::Matrix<J, 3, 1> Rotate(const Eigen::Quaternion<J>& q, const Eigen::Vector3d& v) {
+    const J x = q.x(), y = q.y(), z = q.z();
+    Eigen::Matrix<J, 3, 1> uv(y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]);
+    uv += uv;
+    return Eigen::Matrix<J, 3, 1>(v[0] + q.w() * uv[0] + (y * uv[2] - z * uv[1]),
+                                  v[1] + q.w() * uv[1] + (z * uv[0] - x * uv[2]),
+                                  v[2] + q.w() * uv[2] + (x * uv[1] - y * uv[0]));
+  }
+
   Eigen::Vector3d u_, e1_, e2_, w_, f1_, f2_;
   double axle_, w_tilt_, w_lift_, w_slip_;
   bool floor_;

@@ -3,11 +3,11 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <ceres/tiny_solver.h>
-#include <ceres/tiny_solver_autodiff_function.h>
 
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <sstream>
@@ -180,11 +180,13 @@ template <typename T>
 bool StereoResiduals(double fx, double fy, double cx, double cy, double b,
                      const Eigen::Matrix<T, 3, 1>& p, const Eigen::Vector2d& uv, double d,
                      T* residual) {
+  // The constants enter as doubles, not as Jets with a zero derivative: the same values, fewer
+  // operations on derivatives.
   if (!(p.z() > T(1e-9))) return false;
   const T inv_z = T(1.0) / p.z();
-  residual[0] = T(fx) * p.x() * inv_z + T(cx) - T(uv.x());
-  residual[1] = T(fy) * p.y() * inv_z + T(cy) - T(uv.y());
-  residual[2] = T(fx) * (p.x() - T(b)) * inv_z + T(cx) - T(uv.x() - d);
+  residual[0] = fx * p.x() * inv_z + cx - uv.x();
+  residual[1] = fy * p.y() * inv_z + cy - uv.y();
+  residual[2] = fx * (p.x() - b) * inv_z + cx - (uv.x() - d);
   residual[3] = residual[1];
   return true;
 }
@@ -237,57 +239,110 @@ struct FreePointPrevCost : CorrespondenceCost {
   }
 };
 
-// Reprojection residuals of fixed previous-frame points for ceres::TinySolver: 4 per
-// correspondence, parameters x = [angle-axis of R_curr_prev (3), t_curr_prev (3)].
-struct FixedPointsFunctor {
-  const StereoCamera* cam;
-  const std::vector<StereoCorrespondence>* corr;
-  const std::vector<int>* indices;
+// ceres::AngleAxisRotatePoint split in two: the rotation's terms (angle, its sine and cosine,
+// the axis), computed once for all points, and the part of each point. The same operations in
+// the same order as Ceres', so the same values and, for Jets, the same derivatives (with a
+// constant point given as doubles: equal, a zero's sign aside); what it saves is the square
+// root, two divisions and four sines and cosines of every point.
+template <typename T>
+class AngleAxisRotation {
+ public:
+  explicit AngleAxisRotation(const T angle_axis[3]) {
+    using std::cos;
+    using std::sin;
+    using std::sqrt;
+    const T theta2 = ceres::DotProduct(angle_axis, angle_axis);
+    small_ = !(theta2 > T(std::numeric_limits<double>::epsilon()));
+    if (small_) {  // first-order: R p = p + angle_axis × p
+      for (int i = 0; i < 3; ++i) w_[i] = angle_axis[i];
+      return;
+    }
+    const T theta = sqrt(theta2);
+    cos_ = cos(theta);
+    sin_ = sin(theta);
+    const T theta_inverse = T(1.0) / theta;
+    for (int i = 0; i < 3; ++i) w_[i] = angle_axis[i] * theta_inverse;
+    one_minus_cos_ = T(1.0) - cos_;
+  }
 
-  int NumResiduals() const { return 4 * static_cast<int>(indices->size()); }
+  // pt: T, or double for a constant point (its terms then have no derivative to carry).
+  template <typename P>
+  void Rotate(const P pt[3], T result[3]) const {
+    const T w_cross_pt[3] = {w_[1] * pt[2] - w_[2] * pt[1], w_[2] * pt[0] - w_[0] * pt[2],
+                             w_[0] * pt[1] - w_[1] * pt[0]};
+    if (small_) {
+      for (int i = 0; i < 3; ++i) result[i] = pt[i] + w_cross_pt[i];
+      return;
+    }
+    const T tmp = (w_[0] * pt[0] + w_[1] * pt[1] + w_[2] * pt[2]) * one_minus_cos_;
+    for (int i = 0; i < 3; ++i) result[i] = pt[i] * cos_ + w_cross_pt[i] * sin_ + w_[i] * tmp;
+  }
+
+ private:
+  bool small_ = false;
+  T w_[3];  // the unit axis (the angle-axis itself when small_)
+  T cos_, sin_, one_minus_cos_;
+};
+
+// Reprojection residuals of fixed previous-frame points for ceres::TinySolver: 4 per
+// correspondence, parameters x = [angle-axis of R_curr_prev (3), t_curr_prev (3)], the
+// Jacobian by forward-mode automatic differentiation (ceres::Jet) as
+// ceres::TinySolverAutoDiffFunction computes it (the same residuals and derivatives, a zero's
+// sign aside; its failure behaviour too: residuals and Jacobian untouched when a point is not
+// in front), with the rotation's terms computed once per evaluation rather than once per point
+// and the points and intrinsics as doubles rather than Jets.
+class FixedPointsFunction {
+ public:
+  using Scalar = double;
+  enum { NUM_RESIDUALS = Eigen::Dynamic, NUM_PARAMETERS = 6 };
+
+  FixedPointsFunction(const StereoCamera& cam, const std::vector<StereoCorrespondence>& corr,
+                      const std::vector<int>& indices)
+      : cam_(cam), corr_(corr), indices_(indices), jets_(NumResiduals()) {}
+
+  int NumResiduals() const { return 4 * static_cast<int>(indices_.size()); }
+
+  bool operator()(const double* x, double* residuals, double* jacobian) const {
+    if (jacobian == nullptr) return Evaluate(x, residuals);
+    Jet x_jet[6];
+    for (int i = 0; i < 6; ++i) {
+      x_jet[i].a = x[i];
+      x_jet[i].v.setZero();
+      x_jet[i].v[i] = 1.0;
+    }
+    if (!Evaluate(x_jet, jets_.data())) return false;
+    const int n = NumResiduals();
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 6>> J(jacobian, n, 6);
+    for (int r = 0; r < n; ++r) {
+      residuals[r] = jets_[r].a;
+      J.row(r) = jets_[r].v;
+    }
+    return true;
+  }
+
+ private:
+  using Jet = ceres::Jet<double, 6>;
 
   template <typename T>
-  bool operator()(const T* x, T* residuals) const {
-    for (size_t k = 0; k < indices->size(); ++k) {
-      const StereoCorrespondence& c = (*corr)[(*indices)[k]];
-      const T p_prev[3] = {T(c.p_prev_cam0.x()), T(c.p_prev_cam0.y()), T(c.p_prev_cam0.z())};
+  bool Evaluate(const T* x, T* residuals) const {
+    const AngleAxisRotation<T> rotation(x);
+    for (size_t k = 0; k < indices_.size(); ++k) {
+      const StereoCorrespondence& c = corr_[indices_[k]];
       T p[3];
-      ceres::AngleAxisRotatePoint(x, p_prev, p);
+      rotation.Rotate(c.p_prev_cam0.data(), p);
       const Eigen::Matrix<T, 3, 1> p_curr(p[0] + x[3], p[1] + x[4], p[2] + x[5]);
-      if (!StereoResiduals(cam->fx_px, cam->fy_px, cam->cx_px, cam->cy_px, cam->baseline_m, p_curr,
+      if (!StereoResiduals(cam_.fx_px, cam_.fy_px, cam_.cx_px, cam_.cy_px, cam_.baseline_m, p_curr,
                            c.uv_curr_px, c.disparity_curr_px, residuals + 4 * k))
         return false;
     }
     return true;
   }
-};
 
-// Fast Levenberg-Marquardt fit of T_curr_prev to the current-frame reprojections of fixed
-// points (ceres::TinySolver: dense 6×6 normal equations, derivatives by autodiff). Used for
-// the local optimisation, where building a ceres::Problem per call would cost too much.
-bool FitReprojectionFixedPoints(const StereoCamera& cam,
-                                const std::vector<StereoCorrespondence>& corr,
-                                const std::vector<int>& indices, int max_iterations,
-                                Eigen::Isometry3d* T_curr_prev) {
-  if (indices.size() < 3) return false;
-  using Function = ceres::TinySolverAutoDiffFunction<FixedPointsFunctor, Eigen::Dynamic, 6>;
-  const FixedPointsFunctor functor{&cam, &corr, &indices};
-  Function function(functor);
-  Eigen::Matrix<double, 6, 1> x;
-  const Eigen::AngleAxisd aa(T_curr_prev->linear());
-  x.head<3>() = aa.angle() * aa.axis();
-  x.tail<3>() = T_curr_prev->translation();
-  ceres::TinySolver<Function> solver;
-  solver.options.max_num_iterations = max_iterations;
-  solver.Solve(function, &x);
-  if (!x.allFinite()) return false;
-  const double angle = x.head<3>().norm();
-  T_curr_prev->setIdentity();
-  if (angle > 0.0)
-    T_curr_prev->linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
-  T_curr_prev->translation() = x.tail<3>();
-  return true;
-}
+  const StereoCamera& cam_;
+  const std::vector<StereoCorrespondence>& corr_;
+  const std::vector<int>& indices_;
+  mutable std::vector<Jet> jets_;  // the residuals with their derivatives
+};
 
 // Nonlinear refinement of T_curr_prev on the inliers (see ransac.h). Returns false when
 // Ceres fails.
@@ -353,6 +408,28 @@ RansacResult Fail(RansacResult::Status status, const std::string& message, size_
 }
 
 }  // namespace
+
+bool FitReprojectionFixedPoints(const StereoCamera& cam,
+                                const std::vector<StereoCorrespondence>& corr,
+                                const std::vector<int>& indices, int max_iterations,
+                                Eigen::Isometry3d* T_curr_prev) {
+  if (indices.size() < 3) return false;
+  FixedPointsFunction function(cam, corr, indices);
+  Eigen::Matrix<double, 6, 1> x;
+  const Eigen::AngleAxisd aa(T_curr_prev->linear());
+  x.head<3>() = aa.angle() * aa.axis();
+  x.tail<3>() = T_curr_prev->translation();
+  ceres::TinySolver<FixedPointsFunction> solver;
+  solver.options.max_num_iterations = max_iterations;
+  solver.Solve(function, &x);
+  if (!x.allFinite()) return false;
+  const double angle = x.head<3>().norm();
+  T_curr_prev->setIdentity();
+  if (angle > 0.0)
+    T_curr_prev->linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
+  T_curr_prev->translation() = x.tail<3>();
+  return true;
+}
 
 RansacResult EstimateMotionRansac(const StereoCamera& cam,
                                   const std::vector<StereoCorrespondence>& corr,

@@ -208,6 +208,18 @@ bool StereoReprojectionErrors(const StereoCamera& cam, const Eigen::Isometry3d& 
                               const StereoCorrespondence& c, double min_depth_m,
                               Eigen::Vector2d* err_left_px, Eigen::Vector2d* err_right_px);
 
+// LO-RANSAC's local optimisation: T_curr_prev (in: the start, out: the fit) fitted to the
+// current-frame reprojections (StereoReprojectionErrors) of the fixed previous-frame points of
+// corr[indices] by ceres::TinySolver (Levenberg-Marquardt, at most max_iterations, over the
+// angle-axis and the translation). The Jacobian is the one ceres::TinySolverAutoDiffFunction
+// gives, computed with the rotation's terms once per evaluation (the same fit bit for bit,
+// RansacTest.TheLocalFitIsCeresAutoDiffFitBitForBit). False with fewer than 3 points or a
+// non-finite result.
+bool FitReprojectionFixedPoints(const StereoCamera& cam,
+                                const std::vector<StereoCorrespondence>& corr,
+                                const std::vector<int>& indices, int max_iterations,
+                                Eigen::Isometry3d* T_curr_prev);
+
 // Robust T_prev_curr from putative stereo correspondences (see the header comment). Never throws.
 RansacResult EstimateMotionRansac(const StereoCamera& cam,
                                   const std::vector<StereoCorrespondence>& correspondences,

@@ -81,6 +81,7 @@ void Recovery::Reset() {
   previous_frame_features_.clear();
   scene_planes_.clear();
   scene_planes_age_ = 0;
+  pending_planes_.clear();
   previous_left_ = cv::Mat();
   chain_valid_ = false;
   chain_frame_index_ = -1;
@@ -92,9 +93,9 @@ void Recovery::EndFrame(const std::vector<Feature>& features, const Eigen::Isome
   // Only the bridge alignment reads the previous frame's features: no copy per frame otherwise.
   if (motion_.ground_vehicle && options_.vehicle_bridge_alignment) {
     previous_frame_features_ = features;
-    if (options_.vehicle_direct_alignment) UpdateScenePlanes(features, T_prev_curr);
+    if (options_.vehicle_direct_alignment) DeferScenePlanes(features, T_prev_curr);
   } else if (!motion_.ground_vehicle && options_.free_direct_alignment && gyro) {
-    UpdateScenePlanes(features, T_prev_curr);
+    DeferScenePlanes(features, T_prev_curr);
   }
   previous_left_ = std::move(left);
 }
@@ -136,7 +137,7 @@ Eigen::Isometry3d Recovery::BridgedPose(const BridgeContext& c, OdometryResult* 
 Eigen::Isometry3d Recovery::DirectAlignedPose(const BridgeContext& c,
                                               const Eigen::Isometry3d& bridged,
                                               OdometryResult* result) {
-  if (scene_planes_.empty() || previous_left_.empty() || c.current_left.empty()) return bridged;
+  if (previous_left_.empty() || c.current_left.empty() || ScenePlanes().empty()) return bridged;
   const RecoveryOptions& o = options_;
   const Clock::time_point t = Clock::now();
   const Eigen::Vector3d up = WorldUpInCamera(c.T_world_prev);
@@ -165,7 +166,7 @@ Eigen::Isometry3d Recovery::DirectMotion(const BridgeContext& c,
 Eigen::Isometry3d Recovery::FreeDirectAlignedPose(const BridgeContext& c,
                                                   const Eigen::Isometry3d& bridged,
                                                   OdometryResult* result) {
-  if (scene_planes_.empty() || previous_left_.empty() || c.current_left.empty()) return bridged;
+  if (previous_left_.empty() || c.current_left.empty() || ScenePlanes().empty()) return bridged;
   const Clock::time_point t = Clock::now();
   const Eigen::Isometry3d start = c.T_world_prev.inverse() * bridged;
   const FreeDirectAlignmentResult direct =
@@ -176,24 +177,55 @@ Eigen::Isometry3d Recovery::FreeDirectAlignedPose(const BridgeContext& c,
   return DirectMotion(c, direct.T_prev_curr, result);
 }
 
-void Recovery::UpdateScenePlanes(const std::vector<Feature>& features,
-                                 const Eigen::Isometry3d& T_prev_curr) {
-  std::vector<ScenePlane> fitted;
-  if (FitScenePlanes(camera_, features, kScenePlaneTolerancePx, kScenePlaneMinInliers,
-                     kScenePlaneMinFraction, kScenePlaneMinSpreadM, kMaxScenePlanes, &fitted)) {
-    scene_planes_ = fitted;
-    scene_planes_age_ = 0;
-  } else if (!scene_planes_.empty() && IsFinitePose(T_prev_curr) &&
-             ++scene_planes_age_ <= kMaxScenePlaneAge) {
-    std::vector<ScenePlane> moved;
-    for (const ScenePlane& plane : scene_planes_) {
-      const ScenePlane m = TransformPlane(plane, T_prev_curr);
-      if (m.distance_m > 0.0) moved.push_back(m);  // the camera is still in front of it
-    }
-    scene_planes_.swap(moved);
-  } else {
+void Recovery::DeferScenePlanes(const std::vector<Feature>& features,
+                                const Eigen::Isometry3d& T_prev_curr) {
+  // A plane is carried for kMaxScenePlaneAge frames after its fit: the planes after the last
+  // kMaxScenePlaneAge + 1 frames depend on those frames only (none of them fits: none left).
+  if (pending_planes_.size() > static_cast<size_t>(kMaxScenePlaneAge)) {
+    pending_planes_.pop_front();
     scene_planes_.clear();
   }
+  PendingPlaneFrame frame;
+  frame.T_prev_curr = T_prev_curr;
+  for (const Feature& f : features) {  // those FitScenePlanes reads, in order
+    if (f.has_depth()) frame.features.push_back(f);
+  }
+  pending_planes_.push_back(std::move(frame));
+}
+
+const std::vector<ScenePlane>& Recovery::ScenePlanes() {
+  if (pending_planes_.empty()) return scene_planes_;
+  // The newest frame whose features fit planes sets them (age 0); the frames after it carry
+  // them (or drop them, as the frame-by-frame update would); with no such frame, the planes
+  // held before the pending frames are carried.
+  size_t first = 0;
+  for (size_t i = pending_planes_.size(); i-- > 0;) {
+    std::vector<ScenePlane> fitted;
+    if (FitScenePlanes(camera_, pending_planes_[i].features, kScenePlaneTolerancePx,
+                       kScenePlaneMinInliers, kScenePlaneMinFraction, kScenePlaneMinSpreadM,
+                       kMaxScenePlanes, &fitted)) {
+      scene_planes_ = fitted;
+      scene_planes_age_ = 0;
+      first = i + 1;
+      break;
+    }
+  }
+  for (size_t i = first; i < pending_planes_.size(); ++i) {
+    const Eigen::Isometry3d& T_prev_curr = pending_planes_[i].T_prev_curr;
+    if (!scene_planes_.empty() && IsFinitePose(T_prev_curr) &&
+        ++scene_planes_age_ <= kMaxScenePlaneAge) {
+      std::vector<ScenePlane> moved;
+      for (const ScenePlane& plane : scene_planes_) {
+        const ScenePlane m = TransformPlane(plane, T_prev_curr);
+        if (m.distance_m > 0.0) moved.push_back(m);  // the camera is still in front of it
+      }
+      scene_planes_.swap(moved);
+    } else {
+      scene_planes_.clear();
+    }
+  }
+  pending_planes_.clear();
+  return scene_planes_;
 }
 
 Eigen::Isometry3d Recovery::AlignedBridgePose(const BridgeContext& c,

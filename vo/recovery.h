@@ -39,6 +39,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <deque>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -215,6 +216,14 @@ class Recovery {
 
   void Reset();
 
+  // The planes the direct alignment of the next frame starts from (previous camera frame): those
+  // of the last frame given to EndFrame whose features fit planes (FitScenePlanes), moved by the
+  // motions since, for at most 30 frames; none without. Computed when asked (a frame without
+  // matches), not at every EndFrame: the frames' fits are tried newest first, so it usually
+  // fits one frame rather than every frame, and gives what fitting every frame in turn gives,
+  // bit for bit (RecoveryTest.ScenePlanesAreTheFrameByFrameUpdates).
+  const std::vector<ScenePlane>& ScenePlanes();
+
  private:
   // The prior's motion for a frame without a measured motion, made planar (PlanarPart about
   // the world's up) for a ground vehicle unless the caller gave the prior.
@@ -230,10 +239,9 @@ class Recovery {
   // velocity and the frame's motion (direct_motion, motion_measured); the frame's pose.
   Eigen::Isometry3d DirectMotion(const BridgeContext& c, const Eigen::Isometry3d& T_prev_curr,
                                  OdometryResult* result);
-  // The planes of `features`, else the previous ones moved by T_prev_curr (for at most 30
-  // frames), for the next frame's direct alignment.
-  void UpdateScenePlanes(const std::vector<Feature>& features,
-                         const Eigen::Isometry3d& T_prev_curr);
+  // EndFrame's part for the planes: this frame's features with depth and its motion are kept
+  // for ScenePlanes().
+  void DeferScenePlanes(const std::vector<Feature>& features, const Eigen::Isometry3d& T_prev_curr);
 
   StereoCamera camera_;
   RecoveryOptions options_;
@@ -242,9 +250,16 @@ class Recovery {
   bool predicted_ = true;                         // the tracker's matcher.prediction is not kNone
   std::vector<Feature> previous_frame_features_;  // the previous call's features
   // The planes of the features in the previous output's camera frame
-  // (vehicle_direct_alignment), carried for scene_planes_age_ frames since they were fitted.
+  // (vehicle_direct_alignment), carried for scene_planes_age_ frames since they were fitted:
+  // as of the frame before the first of pending_planes_ (the frames not yet taken in, oldest
+  // first, each its features with depth and its motion; at most 31: a plane is carried for 30).
   std::vector<ScenePlane> scene_planes_;
   int scene_planes_age_ = 0;
+  struct PendingPlaneFrame {
+    std::vector<Feature> features;
+    Eigen::Isometry3d T_prev_curr;
+  };
+  std::deque<PendingPlaneFrame> pending_planes_;
   cv::Mat previous_left_;     // the previous call's left image (empty after ProcessFeatures)
   bool chain_valid_ = false;  // the last lost frame with at least min_features features, since
   int64_t chain_frame_index_ = -1;  // the last tracked one, ...

@@ -136,7 +136,7 @@ void PlanarResidualAndJacobians(const PlanarMotionResidual& f, const PoseBlock7&
     pa[c] = Jet(a[c], c);
     pb[c] = Jet(b[c], 7 + c);
   }
-  f(pa, pb, out);
+  f.EvaluateJets(pa, pb, out);
   Eigen::Matrix<double, kLinkRows, 14> J;
   for (int k = 0; k < kLinkRows; ++k) {
     (*r)(k) = out[k].a;

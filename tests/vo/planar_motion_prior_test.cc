@@ -1,10 +1,12 @@
 // The vehicle's up from its motions (VehicleUpEstimate) against an exactly known up.
 #include "vo/planar_motion_prior.h"
 
+#include <ceres/jet.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <random>
 
 #include "vo/prior_motion.h"  // vo::VehicleMotion
 
@@ -67,6 +69,51 @@ TEST(VehicleUpEstimateTest, NonFiniteMotionsAreIgnored) {
   bad.translation().x() = NAN;
   up.AddMotion(bad, 0.01, 0.005);
   EXPECT_EQ(up.up(), before);
+}
+
+// EvaluateJets (the Schur bundle adjustment's linearisation) against operator() on ceres::Jet
+// (what AutoDiffCostFunction differentiates): the same residuals and derivatives, equal as
+// numbers (a zero's sign may differ), for random poses, ups and floors.
+TEST(PlanarMotionResidualTest, EvaluateJetsIsTheAutoDiffResidualAndJacobian) {
+  using Jet = ceres::Jet<double, 14>;
+  std::mt19937 rng(7u);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  auto random_unit = [&] {
+    return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  };
+  int compared = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    PlanarMotionPrior prior;
+    prior.enabled = true;
+    prior.up_cam = trial % 5 == 0 ? Eigen::Vector3d(0, -1, 0) : random_unit();
+    prior.axle_behind_camera_m = 0.3 * std::abs(normal(rng));
+    prior.tilt_sigma_rad = 0.01 + 0.02 * std::abs(normal(rng));
+    prior.lift_sigma_m = 0.01;
+    prior.slip_sigma_m = 0.02;
+    prior.flat_floor = trial % 2 == 0;
+    prior.floor_up_world = random_unit();
+    prior.floor_height_m = normal(rng);
+    prior.floor_tilt_sigma_rad = 0.02;
+    prior.floor_height_sigma_m = 0.05;
+    const PlanarMotionResidual f(prior);
+    Jet a[7], b[7];
+    for (Jet* pose : {a, b}) {
+      const Eigen::Quaterniond q(Eigen::AngleAxisd(M_PI * normal(rng), random_unit()));
+      const double values[7] = {q.x(), q.y(), q.z(), q.w(), normal(rng), normal(rng), normal(rng)};
+      for (int c = 0; c < 7; ++c) pose[c] = Jet(values[c], (pose == a ? 0 : 7) + c);
+    }
+    Jet reference[7], fast[7];
+    ASSERT_TRUE(f(a, b, reference));
+    ASSERT_TRUE(f.EvaluateJets(a, b, fast));
+    for (int k = 0; k < 7; ++k) {
+      ASSERT_EQ(fast[k].a, reference[k].a) << "trial " << trial << ", residual " << k;
+      for (int j = 0; j < 14; ++j)
+        ASSERT_EQ(fast[k].v[j], reference[k].v[j])
+            << "trial " << trial << ", residual " << k << ", parameter " << j;
+    }
+    ++compared;
+  }
+  EXPECT_EQ(compared, 200);
 }
 
 }  // namespace

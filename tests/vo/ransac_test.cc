@@ -1,5 +1,8 @@
 #include "vo/ransac.h"
 
+#include <ceres/rotation.h>
+#include <ceres/tiny_solver.h>
+#include <ceres/tiny_solver_autodiff_function.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -72,7 +75,7 @@ Synthetic MakeData(uint64_t seed, int n, double outlier_ratio, double sigma_px,
     const double z = 1.5 + 4.5 * rng.Uniform();
     const Eigen::Vector3d p_prev_true = cam.BackprojectDepth(uv_prev.x(), uv_prev.y(), z);
     const Eigen::Vector3d p_curr_true = T_curr_prev * p_prev_true;
-    Eigen::Vector2d l, r, lp, rp;
+    Eigen::Vector2d l, r, lp = Eigen::Vector2d::Zero(), rp = Eigen::Vector2d::Zero();
     if (!cam.ProjectLeft(p_curr_true, &l) || !cam.ProjectRight(p_curr_true, &r) ||
         !InImage(cam, l) || !InImage(cam, r))
       continue;
@@ -351,6 +354,95 @@ TEST(RansacTest, MakeStereoCorrespondencesSkipsFeaturesWithoutDepth) {
   EXPECT_EQ(c[0].uv_curr_px, curr[2].uv_px);
   EXPECT_EQ(c[0].disparity_curr_px, 10.0);
   EXPECT_EQ(c[1].track_age, 2);
+}
+
+// The local fit as first written: ceres::TinySolverAutoDiffFunction over a functor rotating
+// each point with ceres::AngleAxisRotatePoint, its constants as Jets. FitReprojectionFixedPoints
+// computes the rotation's terms once per evaluation and its constants as doubles; the fit must
+// not change by a bit.
+struct ReferenceFixedPointsFunctor {
+  const StereoCamera* cam;
+  const std::vector<StereoCorrespondence>* corr;
+  const std::vector<int>* indices;
+
+  int NumResiduals() const { return 4 * static_cast<int>(indices->size()); }
+
+  template <typename T>
+  bool operator()(const T* x, T* residuals) const {
+    for (size_t k = 0; k < indices->size(); ++k) {
+      const StereoCorrespondence& c = (*corr)[(*indices)[k]];
+      const T p_prev[3] = {T(c.p_prev_cam0.x()), T(c.p_prev_cam0.y()), T(c.p_prev_cam0.z())};
+      T p[3];
+      ceres::AngleAxisRotatePoint(x, p_prev, p);
+      const T px = p[0] + x[3], py = p[1] + x[4], pz = p[2] + x[5];
+      if (!(pz > T(1e-9))) return false;
+      const T inv_z = T(1.0) / pz;
+      T* r = residuals + 4 * k;
+      r[0] = T(cam->fx_px) * px * inv_z + T(cam->cx_px) - T(c.uv_curr_px.x());
+      r[1] = T(cam->fy_px) * py * inv_z + T(cam->cy_px) - T(c.uv_curr_px.y());
+      r[2] = T(cam->fx_px) * (px - T(cam->baseline_m)) * inv_z + T(cam->cx_px) -
+             T(c.uv_curr_px.x() - c.disparity_curr_px);
+      r[3] = r[1];
+    }
+    return true;
+  }
+};
+
+bool ReferenceFit(const StereoCamera& cam, const std::vector<StereoCorrespondence>& corr,
+                  const std::vector<int>& indices, int max_iterations, Eigen::Isometry3d* T) {
+  using Function =
+      ceres::TinySolverAutoDiffFunction<ReferenceFixedPointsFunctor, Eigen::Dynamic, 6>;
+  const ReferenceFixedPointsFunctor functor{&cam, &corr, &indices};
+  Function function(functor);
+  Eigen::Matrix<double, 6, 1> x;
+  const Eigen::AngleAxisd aa(T->linear());
+  x.head<3>() = aa.angle() * aa.axis();
+  x.tail<3>() = T->translation();
+  ceres::TinySolver<Function> solver;
+  solver.options.max_num_iterations = max_iterations;
+  solver.Solve(function, &x);
+  if (!x.allFinite()) return false;
+  const double angle = x.head<3>().norm();
+  T->setIdentity();
+  if (angle > 0.0) T->linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
+  T->translation() = x.tail<3>();
+  return true;
+}
+
+TEST(RansacTest, TheLocalFitIsCeresAutoDiffFitBitForBit) {
+  const StereoCamera cam = TestCamera();
+  int compared = 0;
+  for (uint64_t seed = 1; seed <= 12; ++seed) {
+    // Noisy inliers and outliers (the fit sees both, as LO-RANSAC's may).
+    const Synthetic data = MakeData(seed, 40, seed % 3 == 0 ? 0.3 : 0.0, 0.5);
+    std::vector<int> indices;
+    for (int i = 0; i < static_cast<int>(data.corr.size()); ++i) indices.push_back(i);
+    // Starts: the truth moved a little, the identity (a rotation near zero: Ceres' first-order
+    // branch below 1.5e-8 rad), and one a few degrees off.
+    const Eigen::Isometry3d truth = TrueMotion().inverse();
+    Eigen::Isometry3d tiny = Eigen::Isometry3d::Identity();
+    tiny.linear() =
+        Eigen::AngleAxisd(1e-9, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    Eigen::Isometry3d off = truth;
+    off.linear() =
+        Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY()).toRotationMatrix() * off.linear();
+    off.translation() += Eigen::Vector3d(0.02, 0.0, -0.05);
+    for (const Eigen::Isometry3d& start : {truth, tiny, off}) {
+      for (int iterations : {1, 3, 10}) {
+        Eigen::Isometry3d fast = start, reference = start;
+        const bool fast_ok = FitReprojectionFixedPoints(cam, data.corr, indices, iterations, &fast);
+        const bool reference_ok = ReferenceFit(cam, data.corr, indices, iterations, &reference);
+        ASSERT_EQ(fast_ok, reference_ok) << "seed " << seed;
+        if (!fast_ok) continue;
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 4; ++c)
+            ASSERT_EQ(fast.matrix()(r, c), reference.matrix()(r, c))
+                << "seed " << seed << ", " << iterations << " iterations, entry " << r << "," << c;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 12 * 3 * 3);
 }
 
 }  // namespace

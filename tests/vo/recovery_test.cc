@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "tests/test_util.h"
@@ -154,6 +155,93 @@ TEST(RecoveryTest, OptionsRefuseABadFieldByName) {
        [](RecoveryOptions* o) { o->vehicle_max_vertical_shift_ratio = NAN; }},
       {"reinit_after_lost_frames", [](RecoveryOptions* o) { o->reinit_after_lost_frames = 0; }},
   });
+}
+
+// The planes as the frame-by-frame update made them before they were deferred: fit each
+// frame's features, else carry the last planes (at most 30 frames), else none.
+class EagerScenePlanes {
+ public:
+  explicit EagerScenePlanes(const StereoCamera& camera) : camera_(camera) {}
+  void EndFrame(const std::vector<Feature>& features, const Eigen::Isometry3d& T_prev_curr) {
+    std::vector<ScenePlane> fitted;
+    if (FitScenePlanes(camera_, features, 1.0, 6, 0.6, 0.05, 3, &fitted)) {
+      planes_ = fitted;
+      age_ = 0;
+    } else if (!planes_.empty() && T_prev_curr.matrix().allFinite() && ++age_ <= 30) {
+      std::vector<ScenePlane> moved;
+      for (const ScenePlane& plane : planes_) {
+        const ScenePlane m = TransformPlane(plane, T_prev_curr);
+        if (m.distance_m > 0.0) moved.push_back(m);
+      }
+      planes_.swap(moved);
+    } else {
+      planes_.clear();
+    }
+  }
+  const std::vector<ScenePlane>& planes() const { return planes_; }
+
+ private:
+  StereoCamera camera_;
+  std::vector<ScenePlane> planes_;
+  int age_ = 0;
+};
+
+// Features on two planes (a floor and a wall) that FitScenePlanes finds, or five scattered in
+// depth, too few for a plane; shifted a little per frame.
+std::vector<Feature> PlaneFeatures(const StereoCamera& camera, bool on_planes, int frame) {
+  std::vector<Feature> features;
+  SplitMix64 rng(1000 + frame);
+  for (int i = 0; i < (on_planes ? 60 : 5); ++i) {
+    Feature f;
+    f.uv_px = Eigen::Vector2d(20.0 + 280.0 * rng.Uniform(), 20.0 + 200.0 * rng.Uniform());
+    double z;
+    if (!on_planes) {
+      z = 1.0 + 9.0 * rng.Uniform();
+    } else if (i % 2 == 0) {  // the wall z = 3 + 0.01 frame
+      z = 3.0 + 0.01 * frame;
+    } else {  // the floor y = 1 (camera frame, y down), below the horizon
+      f.uv_px.y() = camera.cy_px + 10.0 + 100.0 * rng.Uniform();
+      z = camera.fy_px * 1.0 / (f.uv_px.y() - camera.cy_px);
+    }
+    f.p_cam0 = camera.BackprojectDepth(f.uv_px.x(), f.uv_px.y(), z);
+    f.disparity_px = camera.fx_px * camera.baseline_m / z;
+    if (i % 13 == 0) f.disparity_px = -1.0;  // some without depth
+    features.push_back(f);
+  }
+  return features;
+}
+
+TEST(RecoveryTest, ScenePlanesAreTheFrameByFrameUpdates) {
+  const StereoCamera camera = test::TestCamera();
+  MotionOptions motion;
+  motion.ground_vehicle = true;  // the vehicle's direct alignment keeps the planes
+  // Which frames have planes: runs of fits, gaps shorter and longer than the 30 frames a plane
+  // is carried, a non-finite motion; asked every frame, now and then, or after long gaps.
+  auto fits = [](int k) { return k < 5 || (k >= 20 && k < 22) || (k >= 60 && k < 64) || k == 100; };
+  for (int ask_every : {1, 7, 45}) {
+    Recovery recovery(camera, RecoveryOptions(), motion, TrackerOptions());
+    EagerScenePlanes eager(camera);
+    int nonempty = 0, compared = 0;
+    for (int k = 0; k < 140; ++k) {
+      Eigen::Isometry3d T = Pose(0.5 * std::sin(0.1 * k), 0.0, Eigen::Vector3d(0.0, 0.0, 0.05));
+      if (k == 62) T.translation().x() = std::numeric_limits<double>::quiet_NaN();
+      const std::vector<Feature> features = PlaneFeatures(camera, fits(k), k);
+      recovery.EndFrame(features, T, cv::Mat());
+      eager.EndFrame(features, T);
+      if (k % ask_every != 0) continue;
+      const std::vector<ScenePlane>& lazy = recovery.ScenePlanes();
+      ASSERT_EQ(lazy.size(), eager.planes().size()) << "frame " << k << ", every " << ask_every;
+      for (size_t i = 0; i < lazy.size(); ++i) {
+        EXPECT_TRUE(lazy[i].normal == eager.planes()[i].normal) << "frame " << k;
+        EXPECT_EQ(lazy[i].distance_m, eager.planes()[i].distance_m) << "frame " << k;
+        EXPECT_EQ(lazy[i].inliers, eager.planes()[i].inliers) << "frame " << k;
+      }
+      nonempty += lazy.empty() ? 0 : 1;
+      ++compared;
+    }
+    EXPECT_GT(nonempty, 0) << "every " << ask_every;
+    EXPECT_LT(nonempty, compared) << "every " << ask_every;
+  }
 }
 
 }  // namespace
