@@ -23,21 +23,20 @@ struct StereoCamera {
   // True when all numbers are finite and positive where they must be; otherwise fills *error.
   bool IsValid(std::string* error) const;
 
-  // Projects p_cam0 (metres, cam0 frame) into the left image. False when z <= min_depth_m.
-  // (Inline: RANSAC projects every correspondence under every hypothesis.)
+  // Projects p_cam0 (metres, cam0 frame) into the left image. False when z <= min_depth_m
+  // (*uv_px is written in either case; it means nothing then). Inline: RANSAC projects every
+  // correspondence under every hypothesis.
   bool ProjectLeft(const Eigen::Vector3d& p_cam0, Eigen::Vector2d* uv_px,
                    double min_depth_m = 1e-6) const {
-    if (!(p_cam0.z() > min_depth_m)) return false;
     *uv_px << fx_px * p_cam0.x() / p_cam0.z() + cx_px, fy_px * p_cam0.y() / p_cam0.z() + cy_px;
-    return true;
+    return p_cam0.z() > min_depth_m;
   }
   // Projects p_cam0 into the right image (cam1 = cam0 shifted by baseline_m along x).
   bool ProjectRight(const Eigen::Vector3d& p_cam0, Eigen::Vector2d* uv_px,
                     double min_depth_m = 1e-6) const {
-    if (!(p_cam0.z() > min_depth_m)) return false;
     *uv_px << fx_px * (p_cam0.x() - baseline_m) / p_cam0.z() + cx_px,
         fy_px * p_cam0.y() / p_cam0.z() + cy_px;
-    return true;
+    return p_cam0.z() > min_depth_m;
   }
   // 3D point in cam0 from a left-image pixel and its disparity (x_left - x_right, pixels > 0).
   Eigen::Vector3d Backproject(double u_px, double v_px, double disparity_px) const;
