@@ -47,8 +47,10 @@ bool StrongerFirst(double r_a, double x_a, double y_a, double r_b, double x_b, d
 constexpr int kFastHarrisMaxBlock = 31;
 
 // Adds (sign = 1) or removes (sign = -1) one row of derivative products to the column sums.
-void AccumulateRow(const int16_t* __restrict gx, const int16_t* __restrict gy, int width, int sign,
-                   int* __restrict sxx, int* __restrict syy, int* __restrict sxy) {
+inline __attribute__((always_inline)) void AccumulateRow(const int16_t* __restrict gx,
+                                                         const int16_t* __restrict gy, int width,
+                                                         int sign, int* __restrict sxx,
+                                                         int* __restrict syy, int* __restrict sxy) {
   for (int x = 0; x < width; ++x) {
     const int a = gx[x], b = gy[x];
     sxx[x] += sign * a * a;
@@ -59,7 +61,8 @@ void AccumulateRow(const int16_t* __restrict gx, const int16_t* __restrict gy, i
 
 // Block-wide horizontal sums: out[x] = sum_{j < block} in[x + j], x < n (loops ordered so
 // that the compiler vectorises along x).
-void BoxRow(const int* __restrict in, int n, int block, int* __restrict out) {
+inline __attribute__((always_inline)) void BoxRow(const int* __restrict in, int n, int block,
+                                                  int* __restrict out) {
   for (int x = 0; x < n; ++x) out[x] = in[x];
   for (int j = 1; j < block; ++j) {
     for (int x = 0; x < n; ++x) out[x] += in[x + j];
@@ -67,8 +70,10 @@ void BoxRow(const int* __restrict in, int n, int block, int* __restrict out) {
 }
 
 // R = det(M) - k trace(M)^2 from the block sums of one row.
-void HarrisRow(const int* __restrict mxx, const int* __restrict myy, const int* __restrict mxy,
-               int n, float scale2, float k, float* __restrict out) {
+inline __attribute__((always_inline)) void HarrisRow(const int* __restrict mxx,
+                                                     const int* __restrict myy,
+                                                     const int* __restrict mxy, int n, float scale2,
+                                                     float k, float* __restrict out) {
   for (int x = 0; x < n; ++x) {
     const float a = static_cast<float>(mxx[x]) * scale2;
     const float c = static_cast<float>(myy[x]) * scale2;
@@ -77,8 +82,60 @@ void HarrisRow(const int* __restrict mxx, const int* __restrict myy, const int* 
   }
 }
 
-void FastHarris(const cv::Mat& image, int block, double k, cv::Mat* dx, cv::Mat* dy,
-                std::vector<int>* sums, cv::Mat* response) {
+// The response's rows [half, height - block + half], columns [half, half + width - block + 1)
+// from the derivatives (the block sums in `sums`, 6 * width ints, zero on entry).
+inline __attribute__((always_inline)) void HarrisRowsImpl(const cv::Mat& dx, const cv::Mat& dy,
+                                                          int block, float scale2, float k,
+                                                          int* sums, cv::Mat* response) {
+  const int width = dx.cols, height = dx.rows, half = block / 2;
+  int* sxx = sums;
+  int* syy = sxx + width;
+  int* sxy = syy + width;
+  int* mxx = sxy + width;
+  int* myy = mxx + width;
+  int* mxy = myy + width;
+  const int n = width - block + 1;
+  for (int row = 0; row < block; ++row) {
+    AccumulateRow(dx.ptr<int16_t>(row), dy.ptr<int16_t>(row), width, 1, sxx, syy, sxy);
+  }
+  // Output row y uses window rows [y - half, y - half + block) (cv::boxFilter's anchor).
+  for (int y = half;; ++y) {
+    BoxRow(sxx, n, block, mxx);
+    BoxRow(syy, n, block, myy);
+    BoxRow(sxy, n, block, mxy);
+    HarrisRow(mxx, myy, mxy, n, scale2, k, response->ptr<float>(y) + half);
+    const int add = y - half + block, remove = y - half;
+    if (add >= height) break;
+    AccumulateRow(dx.ptr<int16_t>(add), dy.ptr<int16_t>(add), width, 1, sxx, syy, sxy);
+    AccumulateRow(dx.ptr<int16_t>(remove), dy.ptr<int16_t>(remove), width, -1, sxx, syy, sxy);
+  }
+}
+
+// Compiled twice: for every x86-64 (SSE2) and, where the CPU has it, for AVX2 (twice the
+// lanes). The same values either way: integer sums, and element-wise float products and
+// differences without contraction (-ffp-contract=off), whatever the vector width
+// (FeaturesTest.TheHarrisResponseIsTheSameWithAndWithoutAvx2).
+__attribute__((flatten)) void HarrisRowsBaseline(const cv::Mat& dx, const cv::Mat& dy, int block,
+                                                 float scale2, float k, int* sums,
+                                                 cv::Mat* response) {
+  HarrisRowsImpl(dx, dy, block, scale2, k, sums, response);
+}
+#if defined(__x86_64__) && defined(__GNUC__)
+__attribute__((target("avx2"), flatten)) void HarrisRowsAvx2(const cv::Mat& dx, const cv::Mat& dy,
+                                                             int block, float scale2, float k,
+                                                             int* sums, cv::Mat* response) {
+  HarrisRowsImpl(dx, dy, block, scale2, k, sums, response);
+}
+bool HarrisHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+#else
+bool HarrisHasAvx2() { return false; }
+#endif
+
+void FastHarris(const cv::Mat& image, int block, double k, bool allow_avx2, cv::Mat* dx,
+                cv::Mat* dy, std::vector<int>* sums, cv::Mat* response) {
   cv::Sobel(image, *dx, CV_16S, 1, 0, 3, 1.0, 0.0, cv::BORDER_REFLECT_101);
   cv::Sobel(image, *dy, CV_16S, 0, 1, 3, 1.0, 0.0, cv::BORDER_REFLECT_101);
   const int width = image.cols, height = image.rows, half = block / 2;
@@ -89,12 +146,6 @@ void FastHarris(const cv::Mat& image, int block, double k, cv::Mat* dx, cv::Mat*
   }
   // Column sums over the current window rows of gx^2, gy^2, gx*gy, then their block sums.
   sums->assign(6 * static_cast<size_t>(width), 0);
-  int* sxx = sums->data();
-  int* syy = sxx + width;
-  int* sxy = syy + width;
-  int* mxx = sxy + width;
-  int* myy = mxx + width;
-  int* mxy = myy + width;
   const int n = width - block + 1;
   // The rows below write rows [half, last_row], columns [half, half + n): zero the rest.
   const int last_row = height - block + half;
@@ -107,20 +158,13 @@ void FastHarris(const cv::Mat& image, int block, double k, cv::Mat* dx, cv::Mat*
   }
   const double scale = 1.0 / (4.0 * block * 255.0);
   const float scale2 = static_cast<float>(scale * scale);
-  for (int row = 0; row < block; ++row) {
-    AccumulateRow(dx->ptr<int16_t>(row), dy->ptr<int16_t>(row), width, 1, sxx, syy, sxy);
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (allow_avx2 && HarrisHasAvx2()) {
+    HarrisRowsAvx2(*dx, *dy, block, scale2, static_cast<float>(k), sums->data(), response);
+    return;
   }
-  // Output row y uses window rows [y - half, y - half + block) (cv::boxFilter's anchor).
-  for (int y = half;; ++y) {
-    BoxRow(sxx, n, block, mxx);
-    BoxRow(syy, n, block, myy);
-    BoxRow(sxy, n, block, mxy);
-    HarrisRow(mxx, myy, mxy, n, scale2, static_cast<float>(k), response->ptr<float>(y) + half);
-    const int add = y - half + block, remove = y - half;
-    if (add >= height) break;
-    AccumulateRow(dx->ptr<int16_t>(add), dy->ptr<int16_t>(add), width, 1, sxx, syy, sxy);
-    AccumulateRow(dx->ptr<int16_t>(remove), dy->ptr<int16_t>(remove), width, -1, sxx, syy, sxy);
-  }
+#endif
+  HarrisRowsBaseline(*dx, *dy, block, scale2, static_cast<float>(k), sums->data(), response);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -256,7 +300,7 @@ class HarrisDetector final : public FeatureDetector {
   void ComputeResponse(const cv::Mat& image) {
     const HarrisOptions& h = options_.harris;
     if (h.aperture_size == 3 && h.block_size <= kFastHarrisMaxBlock) {
-      FastHarris(image, h.block_size, h.k, &dx_, &dy_, &sums_, &response_);
+      FastHarris(image, h.block_size, h.k, true, &dx_, &dy_, &sums_, &response_);
     } else {
       cv::cornerHarris(image, response_, h.block_size, h.aperture_size, h.k,
                        cv::BORDER_REFLECT_101);
@@ -449,7 +493,8 @@ bool DetectorOptions::IsValid(std::string* error) const {
   return true;
 }
 
-bool HarrisResponse(const cv::Mat& image, const HarrisOptions& options, cv::Mat* response) {
+bool HarrisResponse(const cv::Mat& image, const HarrisOptions& options, cv::Mat* response,
+                    bool allow_avx2) {
   if (response == nullptr || image.empty() || image.type() != CV_8UC1 ||
       !options.IsValid(nullptr)) {
     return false;
@@ -457,7 +502,7 @@ bool HarrisResponse(const cv::Mat& image, const HarrisOptions& options, cv::Mat*
   if (options.aperture_size == 3 && options.block_size <= kFastHarrisMaxBlock) {
     cv::Mat dx, dy;
     std::vector<int> sums;
-    FastHarris(image, options.block_size, options.k, &dx, &dy, &sums, response);
+    FastHarris(image, options.block_size, options.k, allow_avx2, &dx, &dy, &sums, response);
   } else {
     cv::cornerHarris(image, *response, options.block_size, options.aperture_size, options.k,
                      cv::BORDER_REFLECT_101);

@@ -110,7 +110,10 @@ std::unique_ptr<FeatureDetector> CreateFeatureDetector(const DetectorOptions& op
 // sums unnormalised). Equal to cv::cornerHarris(image, R, block_size, aperture_size, k) up to
 // float rounding, except within block_size/2 px of the edge of `image`, which are 0 on the fast
 // path (aperture 3, block <= 31). False for an empty or non-CV_8UC1 image or invalid options.
-bool HarrisResponse(const cv::Mat& image, const HarrisOptions& options, cv::Mat* response);
+// The fast path uses AVX2 where the CPU has it unless allow_avx2 is false: the same values
+// (integer sums, element-wise float arithmetic); the switch is for the test that says so.
+bool HarrisResponse(const cv::Mat& image, const HarrisOptions& options, cv::Mat* response,
+                    bool allow_avx2 = true);
 
 // Keeps features in the order given (strongest first), taking at most max_per_bucket per cell
 // of a bucket_cols x bucket_rows grid over [margin, size - margin) and at most max_features

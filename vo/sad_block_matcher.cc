@@ -31,27 +31,34 @@ constexpr int16_t kNoCost = INT16_MAX;
 void PrefilterXSobelPadded(const cv::Mat& src, int cap, int pad_left, int half, cv::Mat* dst) {
   const int w = src.cols, h = src.rows;
   dst->create(h + 2 * half, w + pad_left + half, CV_8UC1);
+  // The horizontal differences of source rows, each computed once: slot y % 3 holds row y
+  // (consecutive output rows read clamped rows y - 1, y, y + 1, so the three never collide).
   std::vector<int16_t> diff(3 * static_cast<size_t>(w));
+  int slot_row[3] = {-1, -1, -1};
+  auto row_diff = [&](int y) -> const int16_t* {
+    int16_t* d = &diff[static_cast<size_t>(y % 3) * w];
+    if (slot_row[y % 3] == y) return d;
+    slot_row[y % 3] = y;
+    const uint8_t* row = src.ptr<uint8_t>(y);
+    if (w == 1) {
+      d[0] = 0;
+      return d;
+    }
+    d[0] = static_cast<int16_t>(row[1] - row[0]);
+    for (int x = 1; x < w - 1; ++x) d[x] = static_cast<int16_t>(row[x + 1] - row[x - 1]);
+    d[w - 1] = static_cast<int16_t>(row[w - 1] - row[w - 2]);
+    return d;
+  };
   for (int Y = 0; Y < dst->rows; ++Y) {
     uint8_t* out = dst->ptr<uint8_t>(Y);
     std::fill(out, out + pad_left, static_cast<uint8_t>(cap));
     std::fill(out + pad_left + w, out + dst->cols, static_cast<uint8_t>(cap));
     // Rows Y - 1, Y, Y + 1 of the padded image, clamped into the source.
-    for (int r = 0; r < 3; ++r) {
-      const int y = std::min(std::max(Y - half - 1 + r, 0), h - 1);
-      const uint8_t* row = src.ptr<uint8_t>(y);
-      int16_t* d = &diff[static_cast<size_t>(r) * w];
-      if (w == 1) {
-        d[0] = 0;
-        continue;
-      }
-      d[0] = static_cast<int16_t>(row[1] - row[0]);
-      for (int x = 1; x < w - 1; ++x) d[x] = static_cast<int16_t>(row[x + 1] - row[x - 1]);
-      d[w - 1] = static_cast<int16_t>(row[w - 1] - row[w - 2]);
-    }
-    const int16_t* d0 = &diff[0];
-    const int16_t* d1 = &diff[static_cast<size_t>(w)];
-    const int16_t* d2 = &diff[2 * static_cast<size_t>(w)];
+    const auto clamped = [&](int r) { return std::min(std::max(Y - half - 1 + r, 0), h - 1); };
+    const int y0 = clamped(0), y1 = clamped(1), y2 = clamped(2);
+    const int16_t* d0 = row_diff(y0);
+    const int16_t* d1 = row_diff(y1);
+    const int16_t* d2 = row_diff(y2);
     uint8_t* o = out + pad_left;
     const int16_t lo = static_cast<int16_t>(-cap), hi = static_cast<int16_t>(cap);
     for (int x = 0; x < w; ++x) {

@@ -240,6 +240,27 @@ void BM_PipelineHarris(benchmark::State& state) {
 }
 BENCHMARK(BM_PipelineHarris)->Apply(SizeArgs);
 
+// The Harris response alone (vo::HarrisResponse, the detector's fast path: two cv::Sobel, the
+// integer block sums, the float pass), with AVX2 (arg avx2 1, where the CPU has it) and without
+// (0, the SSE2 build): the same values (HarrisTest), this is their cost.
+void BM_HarrisResponse(benchmark::State& state) {
+  const StereoPair& p =
+      PairOfSize(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const bool avx2 = state.range(2) != 0;
+  cv::Mat response;
+  for (auto _ : state) {
+    vo::HarrisResponse(p.left, vo::HarrisOptions(), &response, avx2);
+    benchmark::DoNotOptimize(response.data);
+  }
+}
+BENCHMARK(BM_HarrisResponse)
+    ->ArgNames({"w", "h", "avx2"})
+    ->Args({320, 240, 0})
+    ->Args({320, 240, 1})
+    ->Args({1241, 376, 0})
+    ->Args({1241, 376, 1})
+    ->Unit(benchmark::kMicrosecond);
+
 // The dense map (disparity_mode dense).
 void BM_PipelineDisparityDense(benchmark::State& state) {
   const StereoPair& p =

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -152,6 +153,26 @@ TEST(HarrisTest, ResponseMatchesOpenCv) {
   EXPECT_FALSE(HarrisResponse(cv::Mat(), HarrisOptions(), &response));
   EXPECT_FALSE(HarrisResponse(cv::Mat(10, 10, CV_32F), HarrisOptions(), &response));
   EXPECT_FALSE(HarrisResponse(image, HarrisOptions(), nullptr));
+}
+
+TEST(HarrisTest, TheResponseIsTheSameWithAndWithoutAvx2) {
+  // Odd widths leave a remainder after every vector width; a saturated rectangle gives the
+  // largest products. Bit for bit: integer sums and element-wise float arithmetic.
+  for (const cv::Size size : {cv::Size(320, 240), cv::Size(37, 29), cv::Size(1241, 376)}) {
+    cv::Mat image = Texture(size.width, size.height, 5);
+    cv::rectangle(image, cv::Rect(size.width / 4, size.height / 4, size.width / 3, size.height / 3),
+                  cv::Scalar(255), cv::FILLED);
+    for (int block : {2, 3, 5, 31}) {
+      HarrisOptions options;
+      options.block_size = block;
+      cv::Mat with, without;
+      ASSERT_TRUE(HarrisResponse(image, options, &with, true));
+      ASSERT_TRUE(HarrisResponse(image, options, &without, false));
+      ASSERT_EQ(with.size(), without.size());
+      EXPECT_EQ(std::memcmp(with.data, without.data, with.total() * with.elemSize()), 0)
+          << size << " block " << block;
+    }
+  }
 }
 
 TEST(HarrisTest, FindsRectangleCorners) {

@@ -78,6 +78,9 @@ def accuracy(size):  # the first run's (both programs are deterministic)
 cpu = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
 model = next((l.split(":", 1)[1].strip() for l in cpu.splitlines() if l.startswith("Model name")), platform.processor())
 commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+if subprocess.run(["git", "status", "--porcelain", "--", "vo", "harness", "sim", "CMakeLists.txt"],
+                  capture_output=True, text=True).stdout.strip():
+    commit += " with uncommitted changes to the sources (the commit that records this file)"
 out = ["# Speed against libviso2: median time per frame (ms), one pinned core", "",
        f"Machine: {model}. vobench {commit} (Release, `vobench run --dataset`, `vo_ms_median`); "
        f"libviso2 (srv/viso2, VisualOdometryStereo with its default parameters, -O3 -msse3; the "
