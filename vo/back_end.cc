@@ -28,7 +28,9 @@ bool PositiveFinite(double x) { return x > 0.0 && std::isfinite(x); }
 BundleAdjustmentOptions DefaultOdometryBundleAdjustmentOptions() {
   BundleAdjustmentOptions options;
   options.min_frames_per_point = 2;
-  options.max_num_iterations = 10;
+  // 10 before 2026-12-07: beyond 3 the accuracy does not change, the time does
+  // (results/speed/ba_budget.md, 336 runs; the warm-started window is near its optimum).
+  options.max_num_iterations = 3;
   options.solver = BaSolver::kSchurLm;
   options.linear_solver = BaLinearSolver::kDenseSchur;  // when solver = kCeres
   return options;

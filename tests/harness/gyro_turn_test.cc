@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -137,6 +138,19 @@ TEST_F(GyroTurnTest, WithTheGyroEveryFrameOfATurnBeforeAPlainWallTurnsAsTheTruth
   }
   EXPECT_LT(vehicle.end_rotation_error_deg, 0.5);
   EXPECT_LT(free.end_rotation_error_deg, 1.0);
+  // The README's figures.
+  for (const TurnRun* t : {&vehicle, &free}) {
+    double worst = 0.0, worst_featureless = 0.0;
+    for (size_t k = 0; k < t->step_error_deg.size(); ++k) {
+      worst = std::max(worst, t->step_error_deg[k]);
+      if (t->featureless[k]) worst_featureless = std::max(worst_featureless, t->step_error_deg[k]);
+    }
+    std::printf(
+        "%s with the gyro: worst frame %.3f deg (featureless frames %.3f deg), end %.3f "
+        "deg, lost %d\n",
+        t == &vehicle ? "vehicle" : "free", worst, worst_featureless, t->end_rotation_error_deg,
+        t->lost_frames);
+  }
 }
 
 TEST_F(GyroTurnTest, WithoutTheGyroThePlainWallsFramesAreLostAndTheTurnUnderRead) {
@@ -144,6 +158,8 @@ TEST_F(GyroTurnTest, WithoutTheGyroThePlainWallsFramesAreLostAndTheTurnUnderRead
     const TurnRun t = RunTurn(dir_, free ? "free" : "vehicle", free, false);
     EXPECT_GE(t.lost_frames, 8) << free;
     EXPECT_GT(t.end_rotation_error_deg, 20.0) << free;
+    std::printf("%s without the gyro: end %.2f deg, lost %d\n", free ? "free" : "vehicle",
+                t.end_rotation_error_deg, t.lost_frames);
   }
 }
 
