@@ -467,10 +467,18 @@ TEST(OwnershipCliTest, SecondConcurrentWriterFailsFastAndTheFirstCompletes) {
          std::chrono::steady_clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   ASSERT_FALSE(EntriesStartingWith(dir.str(), "o.partial-").empty()) << ReadAll(log);
+  // The first is held still while the second runs: on a loaded machine the first's 80 frames can
+  // otherwise end before the second even starts (CI saw the second find no writer at all).
+  ASSERT_EQ(kill(first, SIGSTOP), 0);
+  const bool first_still_writing = !EntriesStartingWith(dir.str(), "o.partial-").empty();
   const auto start = std::chrono::steady_clock::now();
-  const auto second = RunVobench("run l_hallway --max-frames 5 --no-plots -q --out " + out);
+  const auto second = first_still_writing
+                          ? RunVobench("run l_hallway --max-frames 5 --no-plots -q --out " + out)
+                          : vobench_test::CommandResult{};
   const double second_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(kill(first, SIGCONT), 0);
+  ASSERT_TRUE(first_still_writing) << "the first published before it was held";
   EXPECT_EQ(second.exit_code, 1) << second.output;
   EXPECT_THAT(second.output, HasSubstr("vobench run: " + out + ": another vobench (pid " +
                                        std::to_string(first) + ") is writing this folder"));
